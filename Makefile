@@ -1,0 +1,34 @@
+# NavCam convenience targets. The real build is CMake; this file only chains
+# "install what is missing" -> configure -> build -> run.
+BUILD   ?= build
+TESTBUILD ?= build-test
+JOBS    ?= $(shell nproc)
+CMAKE_FLAGS ?=
+
+.PHONY: all deps build demo test bench clean
+
+all: build
+
+deps:
+	@scripts/install-deps.sh
+
+build: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+	cmake --build $(BUILD) -j $(JOBS)
+
+# The main job on the built-in default scene: no data, no hardware.
+demo: build
+	scripts/demo.sh $(BUILD)/navcam out
+
+# From scratch: a fresh build tree, warnings as errors, every ctest test.
+test: deps
+	rm -rf $(TESTBUILD)
+	cmake -S . -B $(TESTBUILD) -DCMAKE_BUILD_TYPE=Release -DNAVCAM_WERROR=ON $(CMAKE_FLAGS)
+	cmake --build $(TESTBUILD) -j $(JOBS)
+	cd $(TESTBUILD) && ctest --output-on-failure -j $(JOBS) --timeout 600
+
+bench: build
+	$(BUILD)/bench_render
+
+clean:
+	rm -rf $(BUILD) $(TESTBUILD) out

@@ -1,0 +1,144 @@
+/* image_fits.c - the FITS back-end of image_io, with cfitsio.
+ *
+ * OpenImageIO's FITS writer leaves string values unquoted and cuts them at
+ * 72 characters, which standard FITS readers reject; cfitsio writes conforming
+ * headers. NavCam's attributes get 8-character keywords from the table below
+ * (long values continue with the CONTINUE convention), with the attribute
+ * name as the card's comment; any other attribute becomes HIERARCH NAVCAM
+ * NAME (cfitsio 4.2 drops the continuation of long HIERARCH values, so those
+ * must stay short).
+ * Rows are written top row first: FITS row 1 is image row y = 0.
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <fitsio.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "image_io_impl.h"
+
+static const char *const fits_keys[][2] = {
+    {"Software", "CREATOR"},
+    {"navcam:version", "NCVERSN"},
+    {"navcam:quantity", "QUANTITY"},
+    {"navcam:units", "BUNIT"},
+    {"navcam:camera_position_m", "CAMPOS"},
+    {"navcam:camera_attitude_q", "CAMQUAT"},
+    {"navcam:quaternion_convention", "QCONVENT"},
+    {"navcam:camera_frame", "CAMFRAME"},
+    {"navcam:sun_direction_scene", "SUNDIR"},
+    {"navcam:sun_irradiance_w_m2", "SUNIRR"},
+    {"navcam:intrinsics_fx_fy_cx_cy_px", "INTRINS"},
+    {"navcam:samples_per_pixel", "SPP"},
+    {"navcam:body0_position_m", "BODYPOS"},
+    {"navcam:body0_attitude_q", "BODYQUAT"},
+    {"navcam:preview_scale", "PRVSCALE"},
+    {"navcam:preview_rule", "PRVRULE"},
+};
+
+static void fits_key(const char *attr, char *key, size_t len)
+{
+    for (size_t i = 0; i < sizeof fits_keys / sizeof fits_keys[0]; i++)
+        if (!strcmp(attr, fits_keys[i][0])) {
+            snprintf(key, len, "%s", fits_keys[i][1]);
+            return;
+        }
+    const char *colon = strchr(attr, ':');
+    snprintf(key, len, "%s%s", colon ? "NAVCAM " : "", colon ? colon + 1 : attr);
+    for (char *k = key; *k; k++)
+        *k = (char)toupper((unsigned char)*k);
+}
+
+static int fits_fail(const char *path, const char *op, int status)
+{
+    char msg[FLEN_STATUS];
+    fits_get_errstatus(status, msg);
+    return nc_error(NC_EIMAGE, "%s: cfitsio %s: %s", path, op, msg);
+}
+
+int nc__fits_write(const char *path, const float *px, int w, int h, const struct nc_image_attr *attrs, int nattrs)
+{
+    fitsfile *f = NULL;
+    int status = 0;
+    char fname[4200];
+    snprintf(fname, sizeof fname, "!%s", path); /* '!' = overwrite */
+    long naxes[2] = {w, h};
+    if (fits_create_file(&f, fname, &status) || fits_create_img(f, FLOAT_IMG, 2, naxes, &status))
+        goto fail;
+    fits_write_key_longwarn(f, &status);
+    for (int i = 0; i < nattrs && !status; i++) {
+        char key[80];
+        fits_key(attrs[i].name, key, sizeof key);
+        fits_write_key_longstr(f, key, attrs[i].value, attrs[i].name, &status);
+    }
+    fits_write_comment(f, "Row 1 is the top image row (y = 0, +Y down).", &status);
+    fits_write_comment(f, "Each NavCam metadata card carries its attribute name as its comment.", &status);
+    if (status || fits_write_img(f, TFLOAT, 1, (LONGLONG)w * h, (void *)px, &status))
+        goto fail;
+    if (fits_close_file(f, &status))
+        return fits_fail(path, "close", status);
+    return 0;
+fail:;
+    int rc = fits_fail(path, "write", status);
+    status = 0;
+    if (f)
+        fits_close_file(f, &status);
+    return rc;
+}
+
+int nc__fits_read(const char *path, float **px, int *w, int *h)
+{
+    fitsfile *f = NULL;
+    int status = 0, naxis = 0;
+    long naxes[2] = {0, 0};
+    if (fits_open_image(&f, path, READONLY, &status) || fits_get_img_dim(f, &naxis, &status) ||
+        fits_get_img_size(f, 2, naxes, &status)) {
+        int rc = fits_fail(path, "open", status);
+        status = 0;
+        if (f)
+            fits_close_file(f, &status);
+        return rc;
+    }
+    size_t n = (size_t)naxes[0] * (size_t)naxes[1];
+    float *buf = malloc((n ? n : 1) * sizeof *buf);
+    int anynul = 0;
+    if (!buf) {
+        fits_close_file(f, &status);
+        return nc_error(-ENOMEM, "%s: out of memory", path);
+    }
+    if (fits_read_img(f, TFLOAT, 1, (LONGLONG)n, NULL, buf, &anynul, &status)) {
+        int rc = fits_fail(path, "read", status);
+        free(buf);
+        status = 0;
+        fits_close_file(f, &status);
+        return rc;
+    }
+    fits_close_file(f, &status);
+    *w = (int)naxes[0];
+    *h = (int)naxes[1];
+    *px = buf;
+    return 0;
+}
+
+int nc__fits_read_attr(const char *path, const char *name, char *buf, size_t len)
+{
+    fitsfile *f = NULL;
+    int status = 0;
+    char key[80], *val = NULL;
+    fits_key(name, key, sizeof key);
+    if (fits_open_image(&f, path, READONLY, &status))
+        return fits_fail(path, "open", status);
+    fits_read_key_longstr(f, key, &val, NULL, &status);
+    int rc = 0;
+    if (status)
+        rc = nc_error(NC_EIMAGE, "%s: no keyword %s (%s)", path, key, name);
+    else
+        snprintf(buf, len, "%s", val);
+    if (val)
+        fits_free_memory(val, &status);
+    status = 0;
+    fits_close_file(f, &status);
+    return rc;
+}

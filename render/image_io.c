@@ -1,0 +1,177 @@
+/* image_io.c - image files by extension: float32 formats keep values as
+ * given, PNG gets a 16-bit linear preview with its scale in the metadata.
+ * NaN and Inf never reach a file. Metadata also goes, as one JSON object, into
+ * ImageDescription, the one field every format here keeps. */
+#include "image_io.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "error.h"
+#include "image_io_impl.h"
+
+enum fmt { FMT_NONE, FMT_EXR, FMT_TIFF, FMT_FITS, FMT_PNG };
+
+static enum fmt format_of(const char *path)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash))
+        return FMT_NONE;
+    dot++;
+    if (!strcasecmp(dot, "exr"))
+        return FMT_EXR;
+    if (!strcasecmp(dot, "tif") || !strcasecmp(dot, "tiff"))
+        return FMT_TIFF;
+    if (!strcasecmp(dot, "fits") || !strcasecmp(dot, "fit") || !strcasecmp(dot, "fts"))
+        return FMT_FITS;
+    if (!strcasecmp(dot, "png"))
+        return FMT_PNG;
+    return FMT_NONE;
+}
+
+int nc_image_format_ok(const char *path, int *is_float)
+{
+    enum fmt f = format_of(path);
+    if (is_float)
+        *is_float = f == FMT_EXR || f == FMT_TIFF || f == FMT_FITS;
+    return f != FMT_NONE;
+}
+
+/* {"name": "value", ...} with JSON string escapes. */
+static char *describe(const struct nc_image_attr *attrs, int nattrs)
+{
+    size_t cap = 64;
+    for (int i = 0; i < nattrs; i++)
+        cap += 2 * (strlen(attrs[i].name) + strlen(attrs[i].value)) + 16;
+    char *s = malloc(cap), *p = s;
+    if (!s)
+        return NULL;
+    *p++ = '{';
+    for (int i = 0; i < nattrs; i++) {
+        const char *parts[2] = {attrs[i].name, attrs[i].value};
+        if (i)
+            *p++ = ',', *p++ = ' ';
+        for (int k = 0; k < 2; k++) {
+            *p++ = '"';
+            for (const char *c = parts[k]; *c; c++) {
+                if (*c == '"' || *c == '\\')
+                    *p++ = '\\';
+                *p++ = (unsigned char)*c < 0x20 ? ' ' : *c;
+            }
+            *p++ = '"';
+            if (k == 0)
+                *p++ = ':', *p++ = ' ';
+        }
+    }
+    *p++ = '}';
+    *p = '\0';
+    return s;
+}
+
+int nc_image_write(const char *path, const float *px, int w, int h, const struct nc_image_attr *attrs, int nattrs,
+                   double *preview_scale)
+{
+    enum fmt f = format_of(path);
+    if (f == FMT_NONE)
+        return nc_error(NC_EIMAGE,
+                        "%s: unsupported output format (use .exr, .tif or .fits for float32 values, .png for a 16-bit preview)",
+                        path);
+    size_t n = (size_t)w * (size_t)h;
+    float *clean = malloc((n ? n : 1) * sizeof *clean);
+    uint16_t *dn = NULL;
+    struct nc_image_attr *all = malloc((size_t)(nattrs + 2) * sizeof *all);
+    char *desc = NULL, scale_txt[64];
+    int rc;
+    if (!clean || !all) {
+        rc = nc_error(-ENOMEM, "%s: out of memory", path);
+        goto out;
+    }
+    double vmax = 0;
+    for (size_t i = 0; i < n; i++) {
+        clean[i] = isfinite(px[i]) ? px[i] : 0.0f;
+        if (clean[i] > vmax)
+            vmax = clean[i];
+    }
+    memcpy(all, attrs, (size_t)nattrs * sizeof *all);
+    int nall = nattrs;
+    if (preview_scale)
+        *preview_scale = 0;
+    if (f == FMT_PNG) {
+        double scale = vmax > 0 ? vmax : 1.0;
+        snprintf(scale_txt, sizeof scale_txt, "%.17g", scale);
+        all[nall++] = (struct nc_image_attr){"navcam:preview_scale", scale_txt};
+        all[nall++] = (struct nc_image_attr){"navcam:preview_rule",
+                                             "value = DN / 65535 * navcam:preview_scale (linear, in navcam:units)"};
+        if (preview_scale)
+            *preview_scale = scale;
+        if (!(dn = malloc((n ? n : 1) * sizeof *dn))) {
+            rc = nc_error(-ENOMEM, "%s: out of memory", path);
+            goto out;
+        }
+        for (size_t i = 0; i < n; i++) {
+            double v = clean[i] / scale * 65535.0;
+            dn[i] = (uint16_t)(v <= 0 ? 0 : v >= 65535 ? 65535 : lround(v));
+        }
+    }
+    if (!(desc = describe(all, nall))) {
+        rc = nc_error(-ENOMEM, "%s: out of memory", path);
+        goto out;
+    }
+    if (f == FMT_FITS)
+        rc = nc__fits_write(path, clean, w, h, all, nall);
+    else
+        rc = nc__oiio_write(path, f == FMT_PNG ? (const void *)dn : clean, w, h, f != FMT_PNG, all, nall, desc);
+out:
+    free(clean);
+    free(dn);
+    free(all);
+    free(desc);
+    return rc;
+}
+
+int nc_image_read(const char *path, float **px, int *w, int *h)
+{
+    return format_of(path) == FMT_FITS ? nc__fits_read(path, px, w, h) : nc__oiio_read(path, px, w, h);
+}
+
+/* Value of "name" in the JSON object written by describe(). */
+static int json_get(const char *json, const char *name, char *buf, size_t len)
+{
+    char pat[256];
+    snprintf(pat, sizeof pat, "\"%s\": \"", name);
+    const char *p = strstr(json, pat);
+    if (!p)
+        return -1;
+    p += strlen(pat);
+    size_t k = 0;
+    for (; *p && *p != '"' && k + 1 < len; p++) {
+        if (*p == '\\' && p[1])
+            p++;
+        buf[k++] = *p;
+    }
+    buf[k] = '\0';
+    return 0;
+}
+
+int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len)
+{
+    enum fmt f = format_of(path);
+    if (f == FMT_FITS)
+        return nc__fits_read_attr(path, name, buf, len);
+    if (f != FMT_TIFF)
+        return nc__oiio_read_attr(path, name, buf, len);
+    /* TIFF keeps only ImageDescription. */
+    char *desc = malloc(65536);
+    if (!desc)
+        return nc_error(-ENOMEM, "out of memory");
+    int rc = nc__oiio_read_attr(path, "ImageDescription", desc, 65536);
+    if (rc == 0 && json_get(desc, name, buf, len) < 0)
+        rc = nc_error(NC_EIMAGE, "%s: no attribute '%s' in ImageDescription", path, name);
+    free(desc);
+    return rc;
+}

@@ -1,0 +1,38 @@
+/* image_io.h - image files through OpenImageIO, behind a C interface.
+ *
+ * The format follows the file extension: .exr, .tif/.tiff and .fits store
+ * float32 values as given; .png stores a 16-bit linear preview scaled so that
+ * the largest finite value maps to 65535, with that scale written into the
+ * file's metadata. NaN and Inf are written as 0. This is the only file that
+ * touches OpenImageIO (C++).
+ */
+#ifndef NC_IMAGE_IO_H
+#define NC_IMAGE_IO_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct nc_image_attr {
+    const char *name;     /* e.g. "navcam:camera_position_m" */
+    const char *value;
+};
+
+/* 1 if the extension is a supported output format (and *is_float), else 0. */
+int nc_image_format_ok(const char *path, int *is_float);
+/* Write a single-channel image; *preview_scale (may be NULL) receives the
+ * value that 65535 stands for in a 16-bit preview, 0 for float formats. */
+int nc_image_write(const char *path, const float *px, int width, int height, const struct nc_image_attr *attrs,
+                   int nattrs, double *preview_scale);
+/* Read the first channel as float (caller frees *px). */
+int nc_image_read(const char *path, float **px, int *width, int *height);
+/* Read one string attribute; 0 on success, negative if absent. */
+int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

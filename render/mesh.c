@@ -1,0 +1,642 @@
+/* mesh.c - OBJ and PLY loaders and the procedural asteroid. */
+#include "mesh.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "error.h"
+
+void nc_mesh_free(struct nc_mesh *m)
+{
+    free(m->v);
+    free(m->tri);
+    memset(m, 0, sizeof *m);
+}
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 0;
+    size_t c = *cap ? *cap : 1024;
+    while (c < need)
+        c *= 2;
+    void *q = realloc(*p, c * elem);
+    if (!q)
+        return -ENOMEM;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+static int check_mesh(const char *path, const struct nc_mesh *m)
+{
+    if (m->nt == 0)
+        return nc_error(NC_EMESH, "%s: mesh has no triangles", path);
+    if (m->nv > UINT32_MAX || m->nt > UINT32_MAX / 3)
+        return nc_error(NC_EMESH, "%s: mesh too large (%zu vertices, %zu triangles)", path, m->nv, m->nt);
+    return 0;
+}
+
+double nc_mesh_bounding_radius(const struct nc_mesh *m)
+{
+    double r2 = 0;
+    for (size_t t = 0; t < 3 * m->nt; t++) {
+        const double *p = m->v + 3 * (size_t)m->tri[t];
+        double d = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        if (d > r2)
+            r2 = d;
+    }
+    return sqrt(r2);
+}
+
+static const char *ext_of(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    return dot && (!slash || dot > slash) ? dot + 1 : "";
+}
+
+int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out)
+{
+    const char *ext = ext_of(path);
+    if (strcasecmp(ext, "obj") == 0)
+        return nc_mesh_load_obj(path, scale_to_m, out);
+    if (strcasecmp(ext, "ply") == 0)
+        return nc_mesh_load_ply(path, scale_to_m, out);
+    return nc_error(NC_EMESH, "%s: unknown mesh format '.%s' (expected .obj or .ply)", path, ext);
+}
+
+/* ---- OBJ -------------------------------------------------------------- */
+
+/* Parse one face corner "i", "i/t", "i//n" or "i/t/n"; negative = relative. */
+static int obj_index(const char **s, size_t nv, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(*s, &end, 10);
+    if (end == *s || errno)
+        return -1;
+    while (*end && !isspace((unsigned char)*end))
+        end++; /* skip /t/n */
+    *s = end;
+    if (v < 0)
+        v = (long)nv + v + 1;
+    *out = v;
+    return 0;
+}
+
+int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return nc_error(-errno, "%s: cannot open mesh: %s", path, strerror(errno));
+    struct nc_mesh m = {0};
+    size_t vcap = 0, tcap = 0, lineno = 0;
+    char *line = NULL;
+    size_t linecap = 0;
+    int rc = 0;
+    /* Faces may reference vertices defined later; check indices at the end
+     * but remember the line of each face for the message. */
+    size_t *face_line = NULL, flcap = 0;
+    while (getline(&line, &linecap, f) > 0) {
+        lineno++;
+        const char *s = line;
+        while (isspace((unsigned char)*s))
+            s++;
+        if (s[0] == 'v' && isspace((unsigned char)s[1])) {
+            if (grow((void **)&m.v, &vcap, 3 * (m.nv + 1), sizeof *m.v) < 0)
+                goto nomem;
+            char *end = (char *)s + 1;
+            for (int k = 0; k < 3; k++) {
+                const char *st = end;
+                double d = strtod(st, &end);
+                if (end == st) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: vertex needs 3 numbers", path, lineno);
+                    goto out;
+                }
+                if (!isfinite(d)) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: vertex coordinate is not finite", path, lineno);
+                    goto out;
+                }
+                m.v[3 * m.nv + k] = d * scale;
+            }
+            m.nv++;
+        } else if (s[0] == 'f' && isspace((unsigned char)s[1])) {
+            s++;
+            long idx[4];
+            int n = 0;
+            for (;;) {
+                while (isspace((unsigned char)*s))
+                    s++;
+                if (!*s || *s == '#')
+                    break;
+                long v;
+                if (obj_index(&s, m.nv, &v) < 0) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: bad face index", path, lineno);
+                    goto out;
+                }
+                if (n < 4)
+                    idx[n] = v;
+                n++;
+            }
+            if (n != 3) {
+                rc = nc_error(NC_EMESH, "%s:%zu: face with %d vertices; NavCam needs triangles (triangulate the mesh)",
+                              path, lineno, n);
+                goto out;
+            }
+            if (grow((void **)&m.tri, &tcap, 3 * (m.nt + 1), sizeof *m.tri) < 0 ||
+                grow((void **)&face_line, &flcap, m.nt + 1, sizeof *face_line) < 0)
+                goto nomem;
+            for (int k = 0; k < 3; k++) {
+                if (idx[k] < 1 || idx[k] > (long)UINT32_MAX) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: face index %ld out of range", path, lineno, idx[k]);
+                    goto out;
+                }
+                m.tri[3 * m.nt + k] = (uint32_t)(idx[k] - 1);
+            }
+            face_line[m.nt++] = lineno;
+        }
+        /* Comments, normals, texture coordinates, groups, materials: not needed. */
+    }
+    if (ferror(f)) {
+        rc = nc_error(-EIO, "%s: read error", path);
+        goto out;
+    }
+    for (size_t t = 0; t < m.nt; t++)
+        for (int k = 0; k < 3; k++)
+            if (m.tri[3 * t + k] >= m.nv) {
+                rc = nc_error(NC_EMESH, "%s:%zu: face index %u out of range (the file has %zu vertices)", path,
+                              face_line[t], m.tri[3 * t + k] + 1, m.nv);
+                goto out;
+            }
+    if ((rc = check_mesh(path, &m)) < 0)
+        goto out;
+    *out = m;
+    m = (struct nc_mesh){0};
+    goto out;
+nomem:
+    rc = nc_error(-ENOMEM, "%s: out of memory", path);
+out:
+    free(line);
+    free(face_line);
+    nc_mesh_free(&m);
+    fclose(f);
+    return rc;
+}
+
+/* ---- PLY -------------------------------------------------------------- */
+
+enum ply_type { PLY_NONE, PLY_I8, PLY_U8, PLY_I16, PLY_U16, PLY_I32, PLY_U32, PLY_F32, PLY_F64 };
+
+static enum ply_type ply_type_of(const char *s)
+{
+    static const struct { const char *name; enum ply_type t; } map[] = {
+        {"char", PLY_I8}, {"int8", PLY_I8}, {"uchar", PLY_U8}, {"uint8", PLY_U8},
+        {"short", PLY_I16}, {"int16", PLY_I16}, {"ushort", PLY_U16}, {"uint16", PLY_U16},
+        {"int", PLY_I32}, {"int32", PLY_I32}, {"uint", PLY_U32}, {"uint32", PLY_U32},
+        {"float", PLY_F32}, {"float32", PLY_F32}, {"double", PLY_F64}, {"float64", PLY_F64},
+    };
+    for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
+        if (strcmp(map[i].name, s) == 0)
+            return map[i].t;
+    return PLY_NONE;
+}
+
+static size_t ply_size(enum ply_type t)
+{
+    static const size_t sz[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
+    return sz[t];
+}
+
+struct ply_prop {
+    char name[64];
+    enum ply_type type, count_type; /* count_type != NONE: a list */
+};
+
+struct ply_elem {
+    char name[64];
+    size_t count;
+    struct ply_prop prop[32];
+    int nprop;
+};
+
+enum ply_format { PLY_ASCII, PLY_LE, PLY_BE };
+
+struct ply_reader {
+    FILE *f;
+    const char *path;
+    enum ply_format fmt;
+    size_t line; /* ASCII: current line */
+    char *buf;
+    size_t cap;
+    char *cur; /* ASCII: cursor in buf */
+};
+
+/* Read one number of type t; ASCII reads the next token (continuing lines). */
+static int ply_read(struct ply_reader *r, enum ply_type t, double *out)
+{
+    if (r->fmt == PLY_ASCII) {
+        for (;;) {
+            while (r->cur && isspace((unsigned char)*r->cur))
+                r->cur++;
+            if (r->cur && *r->cur)
+                break;
+            if (getline(&r->buf, &r->cap, r->f) <= 0)
+                return nc_error(NC_EMESH, "%s:%zu: unexpected end of file", r->path, r->line);
+            r->line++;
+            r->cur = r->buf;
+        }
+        char *end;
+        *out = strtod(r->cur, &end);
+        if (end == r->cur)
+            return nc_error(NC_EMESH, "%s:%zu: expected a number", r->path, r->line);
+        r->cur = end;
+        return 0;
+    }
+    unsigned char b[8];
+    size_t n = ply_size(t);
+    if (fread(b, 1, n, r->f) != n)
+        return nc_error(NC_EMESH, "%s: unexpected end of binary data", r->path);
+    int host_le = 1;
+    host_le = *(unsigned char *)&host_le;
+    if ((r->fmt == PLY_LE) != host_le)
+        for (size_t i = 0; i < n / 2; i++) {
+            unsigned char c = b[i];
+            b[i] = b[n - 1 - i];
+            b[n - 1 - i] = c;
+        }
+    union { int8_t i8; uint8_t u8; int16_t i16; uint16_t u16; int32_t i32; uint32_t u32; float f; double d; } u;
+    memcpy(&u, b, n);
+    switch (t) {
+    case PLY_I8: *out = u.i8; break;
+    case PLY_U8: *out = u.u8; break;
+    case PLY_I16: *out = u.i16; break;
+    case PLY_U16: *out = u.u16; break;
+    case PLY_I32: *out = u.i32; break;
+    case PLY_U32: *out = u.u32; break;
+    case PLY_F32: *out = u.f; break;
+    default: *out = u.d; break;
+    }
+    return 0;
+}
+
+static int ply_header(struct ply_reader *r, struct ply_elem *el, int *nel)
+{
+    char *line = NULL;
+    size_t cap = 0;
+    int rc = 0, seen_format = 0;
+    *nel = 0;
+    for (;;) {
+        if (getline(&line, &cap, r->f) <= 0) {
+            rc = nc_error(NC_EMESH, "%s: PLY header has no end_header", r->path);
+            break;
+        }
+        r->line++;
+        line[strcspn(line, "\r\n")] = '\0';
+        char a[64] = "", b[64] = "", c[64] = "", d[64] = "", e[64] = "";
+        int n = sscanf(line, "%63s %63s %63s %63s %63s", a, b, c, d, e);
+        if (r->line == 1) {
+            if (strcmp(a, "ply") != 0) {
+                rc = nc_error(NC_EMESH, "%s:1: not a PLY file (no 'ply' magic)", r->path);
+                break;
+            }
+            continue;
+        }
+        if (n <= 0 || strcmp(a, "comment") == 0 || strcmp(a, "obj_info") == 0)
+            continue;
+        if (strcmp(a, "format") == 0) {
+            seen_format = 1;
+            if (strcmp(b, "ascii") == 0)
+                r->fmt = PLY_ASCII;
+            else if (strcmp(b, "binary_little_endian") == 0)
+                r->fmt = PLY_LE;
+            else if (strcmp(b, "binary_big_endian") == 0)
+                r->fmt = PLY_BE;
+            else {
+                rc = nc_error(NC_EMESH, "%s:%zu: unknown PLY format '%s'", r->path, r->line, b);
+                break;
+            }
+        } else if (strcmp(a, "element") == 0 && n == 3) {
+            if (*nel == 16) {
+                rc = nc_error(NC_EMESH, "%s:%zu: too many PLY elements", r->path, r->line);
+                break;
+            }
+            struct ply_elem *x = &el[(*nel)++];
+            memset(x, 0, sizeof *x);
+            snprintf(x->name, sizeof x->name, "%s", b);
+            char *end;
+            errno = 0;
+            unsigned long long cnt = strtoull(c, &end, 10);
+            if (*end || errno || cnt > (1ull << 32)) {
+                rc = nc_error(NC_EMESH, "%s:%zu: bad element count '%s'", r->path, r->line, c);
+                break;
+            }
+            x->count = (size_t)cnt;
+        } else if (strcmp(a, "property") == 0 && *nel > 0) {
+            struct ply_elem *x = &el[*nel - 1];
+            if (x->nprop == 32) {
+                rc = nc_error(NC_EMESH, "%s:%zu: too many properties", r->path, r->line);
+                break;
+            }
+            struct ply_prop *p = &x->prop[x->nprop++];
+            if (strcmp(b, "list") == 0 && n == 5) {
+                p->count_type = ply_type_of(c);
+                p->type = ply_type_of(d);
+                snprintf(p->name, sizeof p->name, "%s", e);
+                if (!p->count_type || !p->type) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: unknown property type", r->path, r->line);
+                    break;
+                }
+            } else if (n == 3) {
+                p->type = ply_type_of(b);
+                p->count_type = PLY_NONE;
+                snprintf(p->name, sizeof p->name, "%s", c);
+                if (!p->type) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: unknown property type '%s'", r->path, r->line, b);
+                    break;
+                }
+            } else {
+                rc = nc_error(NC_EMESH, "%s:%zu: malformed property line", r->path, r->line);
+                break;
+            }
+        } else if (strcmp(a, "end_header") == 0) {
+            if (!seen_format)
+                rc = nc_error(NC_EMESH, "%s: PLY header has no format line", r->path);
+            break;
+        } else {
+            rc = nc_error(NC_EMESH, "%s:%zu: unexpected PLY header line '%s'", r->path, r->line, line);
+            break;
+        }
+    }
+    free(line);
+    return rc;
+}
+
+int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    struct ply_reader r = {.path = path};
+    r.f = fopen(path, "rb");
+    if (!r.f)
+        return nc_error(-errno, "%s: cannot open mesh: %s", path, strerror(errno));
+    struct ply_elem el[16];
+    int nel = 0, rc;
+    struct nc_mesh m = {0};
+    if ((rc = ply_header(&r, el, &nel)) < 0)
+        goto out;
+    int have_v = 0, have_f = 0;
+    for (int e = 0; e < nel; e++) {
+        struct ply_elem *x = &el[e];
+        int is_v = strcmp(x->name, "vertex") == 0, is_f = strcmp(x->name, "face") == 0;
+        int ix = -1, iy = -1, iz = -1, ilist = -1;
+        for (int p = 0; p < x->nprop; p++) {
+            const char *nm = x->prop[p].name;
+            if (is_v && !x->prop[p].count_type) {
+                if (!strcmp(nm, "x")) ix = p;
+                if (!strcmp(nm, "y")) iy = p;
+                if (!strcmp(nm, "z")) iz = p;
+            }
+            if (is_f && x->prop[p].count_type && (!strcmp(nm, "vertex_indices") || !strcmp(nm, "vertex_index")))
+                ilist = p;
+        }
+        if (is_v && (ix < 0 || iy < 0 || iz < 0)) {
+            rc = nc_error(NC_EMESH, "%s: PLY vertex element lacks x, y or z", path);
+            goto out;
+        }
+        if (is_f && ilist < 0) {
+            rc = nc_error(NC_EMESH, "%s: PLY face element lacks vertex_indices", path);
+            goto out;
+        }
+        if (is_v) {
+            have_v = 1;
+            m.nv = x->count;
+            if (!(m.v = malloc((x->count ? x->count : 1) * 3 * sizeof *m.v)))
+                goto nomem;
+        }
+        if (is_f) {
+            have_f = 1;
+            m.nt = x->count;
+            if (!(m.tri = malloc((x->count ? x->count : 1) * 3 * sizeof *m.tri)))
+                goto nomem;
+        }
+        for (size_t i = 0; i < x->count; i++) {
+            for (int p = 0; p < x->nprop; p++) {
+                struct ply_prop *pr = &x->prop[p];
+                double val;
+                if (!pr->count_type) {
+                    if ((rc = ply_read(&r, pr->type, &val)) < 0)
+                        goto out;
+                    if (is_v && (p == ix || p == iy || p == iz)) {
+                        if (!isfinite(val)) {
+                            rc = nc_error(NC_EMESH, "%s: vertex %zu has a non-finite coordinate", path, i);
+                            goto out;
+                        }
+                        m.v[3 * i + (p == ix ? 0 : p == iy ? 1 : 2)] = val * scale;
+                    }
+                    continue;
+                }
+                double cnt;
+                if ((rc = ply_read(&r, pr->count_type, &cnt)) < 0)
+                    goto out;
+                if (is_f && p == ilist && cnt != 3) {
+                    rc = nc_error(NC_EMESH, "%s: face %zu has %g vertices; NavCam needs triangles (triangulate the mesh)",
+                                  path, i, cnt);
+                    goto out;
+                }
+                if (cnt < 0 || cnt > 1e6) {
+                    rc = nc_error(NC_EMESH, "%s: bad list length %g", path, cnt);
+                    goto out;
+                }
+                for (long k = 0; k < (long)cnt; k++) {
+                    if ((rc = ply_read(&r, pr->type, &val)) < 0)
+                        goto out;
+                    if (is_f && p == ilist) {
+                        if (!have_v || val < 0 || val >= (double)m.nv || val != floor(val)) {
+                            rc = nc_error(NC_EMESH, "%s: face %zu index %g out of range (%zu vertices)", path, i,
+                                          val, m.nv);
+                            goto out;
+                        }
+                        m.tri[3 * i + k] = (uint32_t)val;
+                    }
+                }
+            }
+        }
+    }
+    if (!have_v || !have_f) {
+        rc = nc_error(NC_EMESH, "%s: PLY has no %s element", path, have_v ? "face" : "vertex");
+        goto out;
+    }
+    if ((rc = check_mesh(path, &m)) < 0)
+        goto out;
+    *out = m;
+    m = (struct nc_mesh){0};
+    goto out;
+nomem:
+    rc = nc_error(-ENOMEM, "%s: out of memory", path);
+out:
+    free(r.buf);
+    nc_mesh_free(&m);
+    fclose(r.f);
+    return rc;
+}
+
+/* ---- procedural asteroid ---------------------------------------------- */
+
+static uint64_t splitmix64(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static double uniform01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
+
+static struct nc_vec3 random_dir(uint64_t *s)
+{
+    double z = 2 * uniform01(s) - 1, phi = 2 * M_PI * uniform01(s), r = sqrt(1 - z * z);
+    return nc_v3(r * cos(phi), r * sin(phi), z);
+}
+
+/* Edge -> midpoint vertex map, open addressing. */
+struct edge_map {
+    uint64_t *key;
+    uint32_t *val;
+    size_t mask;
+};
+
+static uint32_t midpoint(struct edge_map *em, struct nc_mesh *m, uint32_t a, uint32_t b)
+{
+    uint64_t k = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
+    size_t h = (size_t)((k * 0x9e3779b97f4a7c15ull) >> 20) & em->mask;
+    while (em->key[h] != UINT64_MAX) {
+        if (em->key[h] == k)
+            return em->val[h];
+        h = (h + 1) & em->mask;
+    }
+    double *p = m->v + 3 * m->nv;
+    for (int i = 0; i < 3; i++)
+        p[i] = 0.5 * (m->v[3 * a + i] + m->v[3 * b + i]);
+    double n = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int i = 0; i < 3; i++)
+        p[i] /= n;
+    em->key[h] = k;
+    em->val[h] = (uint32_t)m->nv;
+    return (uint32_t)m->nv++;
+}
+
+int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    if (ap->subdivisions < 0 || ap->subdivisions > 9)
+        return nc_error(NC_ERANGE, "asteroid subdivisions must be 0..9, got %d", ap->subdivisions);
+    size_t nt = 20, nv = 12, ne = 30;
+    for (int i = 0; i < ap->subdivisions; i++) {
+        nv += ne;
+        ne = 2 * ne + 3 * nt;
+        nt *= 4;
+    }
+    struct nc_mesh m = {0};
+    m.v = malloc(nv * 3 * sizeof *m.v);
+    m.tri = malloc(nt * 3 * sizeof *m.tri);
+    uint32_t *tmp = malloc(nt * 3 * sizeof *tmp);
+    struct edge_map em = {0};
+    size_t cap = 64;
+    while (cap < 2 * ne)
+        cap *= 2;
+    em.key = malloc(cap * sizeof *em.key);
+    em.val = malloc(cap * sizeof *em.val);
+    em.mask = cap - 1;
+    if (!m.v || !m.tri || !tmp || !em.key || !em.val) {
+        free(tmp);
+        free(em.key);
+        free(em.val);
+        nc_mesh_free(&m);
+        return nc_error(-ENOMEM, "asteroid: out of memory for %zu triangles", nt);
+    }
+    /* Icosahedron. */
+    const double t = (1 + sqrt(5.0)) / 2;
+    const double iv[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                              {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    const uint32_t it[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                                {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                                {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    double n0 = sqrt(1 + t * t);
+    for (int i = 0; i < 12; i++)
+        for (int k = 0; k < 3; k++)
+            m.v[3 * i + k] = iv[i][k] / n0;
+    memcpy(m.tri, it, sizeof it);
+    m.nv = 12;
+    m.nt = 20;
+    for (int s = 0; s < ap->subdivisions; s++) {
+        memset(em.key, 0xff, cap * sizeof *em.key);
+        size_t n = 0;
+        for (size_t f = 0; f < m.nt; f++) {
+            uint32_t a = m.tri[3 * f], b = m.tri[3 * f + 1], c = m.tri[3 * f + 2];
+            uint32_t ab = midpoint(&em, &m, a, b), bc = midpoint(&em, &m, b, c), ca = midpoint(&em, &m, c, a);
+            const uint32_t nf[4][3] = {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}};
+            memcpy(tmp + 3 * n, nf, sizeof nf);
+            n += 4;
+        }
+        memcpy(m.tri, tmp, n * 3 * sizeof *tmp);
+        m.nt = n;
+    }
+    free(tmp);
+    free(em.key);
+    free(em.val);
+
+    /* Features: centre direction, angular radius (rad), kind. */
+    uint64_t rng = ap->seed ^ 0x4e6176436d417374ull;
+    int nlump = 24, ncr = ap->craters;
+    struct feature { struct nc_vec3 c; double a, amp, cos_reach; } *ft = malloc((size_t)(nlump + ncr) * sizeof *ft);
+    if (!ft) {
+        nc_mesh_free(&m);
+        return nc_error(-ENOMEM, "asteroid: out of memory");
+    }
+    for (int i = 0; i < nlump; i++) {
+        ft[i].c = random_dir(&rng);
+        ft[i].a = 0.35 + 0.65 * uniform01(&rng);
+        ft[i].amp = ap->lump_amplitude * (2 * uniform01(&rng) - 1);
+        ft[i].cos_reach = cos(fmin(M_PI, 3 * ft[i].a));
+    }
+    for (int i = nlump; i < nlump + ncr; i++) {
+        ft[i].c = random_dir(&rng);
+        /* Power-law sizes: many small craters, few large (cumulative ~ a^-1.5). */
+        ft[i].a = fmin(0.5, 0.03 * pow(1 - uniform01(&rng), -1 / 1.5));
+        ft[i].amp = 0.2 * ft[i].a; /* depth/diameter ~ 0.1 */
+        ft[i].cos_reach = cos(fmin(M_PI, 1.8 * ft[i].a));
+    }
+    for (size_t v = 0; v < m.nv; v++) {
+        struct nc_vec3 d = nc_v3(m.v[3 * v], m.v[3 * v + 1], m.v[3 * v + 2]);
+        double h = 0;
+        for (int i = 0; i < nlump + ncr; i++) {
+            double cs = nc_v3_dot(d, ft[i].c);
+            if (cs < ft[i].cos_reach)
+                continue;
+            double x = acos(fmin(1.0, cs)) / ft[i].a;
+            if (i < nlump)
+                h += ft[i].amp * exp(-x * x);
+            else {
+                double bowl = x < 1 ? (x * x - 1) : 0;
+                double rim = 0.25 * exp(-((x - 1) * (x - 1)) / (0.3 * 0.3));
+                h += ft[i].amp * (bowl + rim);
+            }
+        }
+        /* Radius of the ellipsoid along d, then the relative relief. */
+        double q = d.x * d.x / (ap->radii_m.x * ap->radii_m.x) + d.y * d.y / (ap->radii_m.y * ap->radii_m.y) +
+                   d.z * d.z / (ap->radii_m.z * ap->radii_m.z);
+        double r = (1 + h) / sqrt(q);
+        m.v[3 * v] = d.x * r;
+        m.v[3 * v + 1] = d.y * r;
+        m.v[3 * v + 2] = d.z * r;
+    }
+    free(ft);
+    *out = m;
+    return 0;
+}

@@ -1,0 +1,43 @@
+/* mesh.h - triangle meshes in the body-fixed frame, in metres (double).
+ *
+ * Loaders for Wavefront OBJ and PLY (ASCII and binary), and a procedural
+ * cratered asteroid. Loaders validate everything a renderer would trip on
+ * (non-triangles, indices out of range, non-finite coordinates, empty meshes)
+ * and report file and line; they never touch Embree.
+ */
+#ifndef NC_MESH_H
+#define NC_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "vec.h"
+
+struct nc_mesh {
+    double *v;      /* xyz per vertex, metres, body-fixed frame */
+    uint32_t *tri;  /* three vertex indices per triangle */
+    size_t nv, nt;
+};
+
+void nc_mesh_free(struct nc_mesh *m);
+/* Load OBJ or PLY (by extension), scaling coordinates by scale_to_m. */
+int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out);
+int nc_mesh_load_obj(const char *path, double scale_to_m, struct nc_mesh *out);
+int nc_mesh_load_ply(const char *path, double scale_to_m, struct nc_mesh *out);
+
+/* Procedural cratered asteroid: an icosphere (20 * 4^subdivisions triangles)
+ * on a triaxial ellipsoid, with smooth lumps and bowl craters with raised rims.
+ * Fully determined by its arguments. */
+struct nc_asteroid_params {
+    struct nc_vec3 radii_m;
+    int subdivisions;  /* 0..9 */
+    uint64_t seed;
+    int craters;       /* number of craters */
+    double lump_amplitude; /* relative radius variation of the lumps, e.g. 0.08 */
+};
+int nc_mesh_asteroid(const struct nc_asteroid_params *p, struct nc_mesh *out);
+
+/* Largest distance of a used vertex from the body origin, metres. */
+double nc_mesh_bounding_radius(const struct nc_mesh *m);
+
+#endif

@@ -1,0 +1,252 @@
+/* render.c - tiles, threads and shading. Hot path: one function,
+ * shade_tile(); nothing here allocates per pixel or per packet. */
+#include "render.h"
+
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "error.h"
+
+#define TILE 16 /* pixels; a tile is (TILE/4)^2 packets of 4x4 pixels */
+
+int nc_frame_alloc(struct nc_frame *f, int w, int h)
+{
+    size_t n = (size_t)w * (size_t)h;
+    memset(f, 0, sizeof *f);
+    f->width_px = w;
+    f->height_px = h;
+    f->radiance = malloc(n * sizeof(float));
+    f->iof = malloc(n * sizeof(float));
+    f->range_m = malloc(n * sizeof(float));
+    f->coverage = malloc(n * sizeof(float));
+    if (!f->radiance || !f->iof || !f->range_m || !f->coverage) {
+        nc_frame_free(f);
+        return nc_error(-ENOMEM, "out of memory for a %dx%d frame", w, h);
+    }
+    return 0;
+}
+
+void nc_frame_free(struct nc_frame *f)
+{
+    free(f->radiance);
+    free(f->iof);
+    free(f->range_m);
+    free(f->coverage);
+    memset(f, 0, sizeof *f);
+}
+
+int nc_renderer_init(struct nc_renderer *r, const struct nc_scene *s, int threads)
+{
+    memset(r, 0, sizeof *r);
+    if (threads <= 0)
+        threads = s->render.threads;
+    if (threads <= 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = n > 0 ? (int)n : 1;
+    }
+    r->threads = threads;
+    return nc_rt_create(s, threads, &r->rt);
+}
+
+void nc_renderer_free(struct nc_renderer *r)
+{
+    nc_rt_destroy(r->rt);
+    r->rt = NULL;
+}
+
+/* Counter-based hash -> uniform [0,1): the jitter of sample s of pixel p
+ * depends on (seed, p, s) only, never on thread or order. */
+static inline uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static inline double hash01(uint64_t seed, uint64_t a, uint64_t b)
+{
+    uint64_t z = mix64(seed * 0x9e3779b97f4a7c15ull + mix64(a * 0xd6e8feb86659fd93ull + b + 1));
+    return (double)(z >> 11) * 0x1.0p-53;
+}
+
+struct job {
+    const struct nc_renderer *r;
+    const struct nc_scene *s;
+    struct nc_rt *rt;
+    struct nc_frame *f;
+    struct nc_mat3 cam_R;
+    int tiles_x, tiles_y, n_strata;
+    atomic_int next;
+    /* Sun: constant in the scene frame unless the Sun is at a finite position. */
+    struct nc_vec3 sun_dir;
+    double sun_irr;
+};
+
+static void shade_tile(struct job *j, int tile)
+{
+    const struct nc_scene *s = j->s;
+    const struct nc_camera *c = &s->camera;
+    const int W = c->width_px, H = c->height_px, n = j->n_strata, spp = n * n;
+    const int x0 = (tile % j->tiles_x) * TILE, y0 = (tile / j->tiles_x) * TILE;
+    double acc_L[TILE * TILE], acc_iof[TILE * TILE], acc_range[TILE * TILE];
+    int hits[TILE * TILE];
+    memset(acc_L, 0, sizeof acc_L);
+    memset(acc_iof, 0, sizeof acc_iof);
+    memset(acc_range, 0, sizeof acc_range);
+    memset(hits, 0, sizeof hits);
+
+    struct nc_ray16 ray, shadow;
+    struct nc_hit16 hit;
+    int occluded[NC_PACKET];
+    double mu0[NC_PACKET], irr[NC_PACKET];
+    struct nc_photometry geo[NC_PACKET];
+
+    for (int sidx = 0; sidx < spp; sidx++) {
+        const int sx = sidx % n, sy = sidx / n;
+        for (int by = 0; by < TILE; by += 4)
+            for (int bx = 0; bx < TILE; bx += 4) {
+                /* Camera rays for a 4x4 pixel block. */
+                for (int i = 0; i < NC_PACKET; i++) {
+                    int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
+                    ray.valid[i] = (px < W && py < H) ? -1 : 0;
+                    double ox = 0, oy = 0;
+                    if (spp > 1) {
+                        uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                        ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)sidx)) / n - 0.5;
+                        oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)sidx + 1)) / n - 0.5;
+                    }
+                    struct nc_vec3 d = nc_v3_unit(nc_mat_mul_v(&j->cam_R, nc_camera_dir(c, px + ox, py + oy)));
+                    ray.ox[i] = ray.oy[i] = ray.oz[i] = 0.0f;
+                    ray.dx[i] = (float)d.x;
+                    ray.dy[i] = (float)d.y;
+                    ray.dz[i] = (float)d.z;
+                    ray.tnear[i] = 0.0f;
+                    ray.tfar[i] = INFINITY;
+                }
+                if (j->r->ray_hook)
+                    j->r->ray_hook(j->r->ray_hook_user, 0, &ray);
+                nc_rt_intersect16(j->rt, &ray, &hit, 1);
+
+                /* Shadow rays from the visible points that face both Sun and camera. */
+                int any = 0;
+                for (int i = 0; i < NC_PACKET; i++) {
+                    shadow.valid[i] = 0;
+                    if (hit.body[i] < 0)
+                        continue;
+                    struct nc_vec3 d = nc_v3(ray.dx[i], ray.dy[i], ray.dz[i]);
+                    struct nc_vec3 nrm = nc_v3_unit(nc_v3(hit.nx[i], hit.ny[i], hit.nz[i]));
+                    double mu = -nc_v3_dot(nrm, d);
+                    if (mu < 0) { /* back face of a mesh with inconsistent winding */
+                        nrm = nc_v3_scale(nrm, -1.0);
+                        mu = -mu;
+                    }
+                    double t = hit.t[i];
+                    struct nc_vec3 p = nc_v3_scale(d, t);
+                    struct nc_vec3 sdir = j->sun_dir;
+                    irr[i] = j->sun_irr;
+                    if (s->sun.has_position)
+                        nc_scene_sun_at(s, nc_v3_add(p, c->position_m), &sdir, &irr[i]);
+                    mu0[i] = nc_v3_dot(nrm, sdir);
+                    int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
+                    int k = (py - y0) * TILE + (px - x0);
+                    acc_range[k] += t;
+                    hits[k]++;
+                    if (!(mu0[i] > 0 && mu > 0))
+                        continue;
+                    geo[i] = (struct nc_photometry){mu0[i], mu, -nc_v3_dot(sdir, d)};
+                    /* Offset the origin off the surface by a few float ulps of the
+                     * camera-relative coordinates; tnear stays 0. */
+                    double eps = 4e-6 * t;
+                    shadow.ox[i] = (float)(p.x + eps * nrm.x);
+                    shadow.oy[i] = (float)(p.y + eps * nrm.y);
+                    shadow.oz[i] = (float)(p.z + eps * nrm.z);
+                    shadow.dx[i] = (float)sdir.x;
+                    shadow.dy[i] = (float)sdir.y;
+                    shadow.dz[i] = (float)sdir.z;
+                    shadow.tnear[i] = 0.0f;
+                    shadow.tfar[i] = INFINITY;
+                    shadow.valid[i] = -1;
+                    any = 1;
+                }
+                if (!any)
+                    continue;
+                if (j->r->ray_hook)
+                    j->r->ray_hook(j->r->ray_hook_user, 1, &shadow);
+                nc_rt_occluded16(j->rt, &shadow, occluded);
+                for (int i = 0; i < NC_PACKET; i++) {
+                    if (!shadow.valid[i] || occluded[i])
+                        continue;
+                    double r;
+                    nc_material_eval(&s->body[hit.body[i]].material, 1, &geo[i], &r);
+                    if (!(r >= 0 && r < INFINITY))
+                        r = 0; /* never let a model's NaN or Inf reach the frame */
+                    int k = (by + (i >> 2)) * TILE + bx + (i & 3);
+                    acc_L[k] += r * irr[i];
+                    acc_iof[k] += M_PI * r;
+                }
+            }
+    }
+    const double inv = 1.0 / spp;
+    for (int y = y0; y < y0 + TILE && y < H; y++)
+        for (int x = x0; x < x0 + TILE && x < W; x++) {
+            int k = (y - y0) * TILE + (x - x0);
+            size_t o = (size_t)y * (size_t)W + (size_t)x;
+            j->f->radiance[o] = (float)(acc_L[k] * inv);
+            j->f->iof[o] = (float)(acc_iof[k] * inv);
+            j->f->range_m[o] = hits[k] ? (float)(acc_range[k] / hits[k]) : 0.0f;
+            j->f->coverage[o] = (float)(hits[k] * inv);
+        }
+}
+
+static void *worker(void *arg)
+{
+    struct job *j = arg;
+    const int ntiles = j->tiles_x * j->tiles_y;
+    for (;;) {
+        int t = atomic_fetch_add(&j->next, 1);
+        if (t >= ntiles)
+            break;
+        shade_tile(j, t);
+    }
+    return NULL;
+}
+
+int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f)
+{
+    const struct nc_camera *c = &s->camera;
+    if (f->width_px != c->width_px || f->height_px != c->height_px)
+        return nc_error(NC_ERANGE, "frame is %dx%d but the camera is %dx%d", f->width_px, f->height_px,
+                        c->width_px, c->height_px);
+    int rc = nc_rt_update(r->rt, s);
+    if (rc < 0)
+        return rc;
+    struct job j = {.r = r, .s = s, .rt = r->rt, .f = f};
+    j.cam_R = nc_quat_to_mat(c->attitude_q);
+    j.tiles_x = (c->width_px + TILE - 1) / TILE;
+    j.tiles_y = (c->height_px + TILE - 1) / TILE;
+    j.n_strata = (int)lround(sqrt((double)s->render.samples_per_pixel));
+    if (j.n_strata < 1)
+        j.n_strata = 1;
+    atomic_init(&j.next, 0);
+    nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
+
+    int nthreads = r->threads, started = 0;
+    pthread_t tid[256];
+    if (nthreads > 256)
+        nthreads = 256;
+    for (int i = 1; i < nthreads; i++) {
+        if (pthread_create(&tid[started], NULL, worker, &j) != 0)
+            break; /* fewer threads only costs time, never changes pixels */
+        started++;
+    }
+    worker(&j);
+    for (int i = 0; i < started; i++)
+        pthread_join(tid[i], NULL);
+    return 0;
+}

@@ -1,0 +1,55 @@
+/* rt.h - ray-tracing back-end interface (implemented with Embree 3 in
+ * rt_embree.c, the only file that includes Embree headers).
+ *
+ * Rays live in the camera-relative scene frame: origin at the camera position,
+ * axes of the scene frame. Each body is an instance whose geometry is stored
+ * relative to an anchor point near the camera, in double-precision-derived
+ * float coordinates, so that precision follows the camera, not the body origin.
+ */
+#ifndef NC_RT_H
+#define NC_RT_H
+
+#include "scene.h"
+
+#define NC_PACKET 16
+
+struct nc_rt;
+
+struct nc_ray16 {
+    _Alignas(64) float ox[NC_PACKET];
+    float oy[NC_PACKET], oz[NC_PACKET];
+    float dx[NC_PACKET], dy[NC_PACKET], dz[NC_PACKET];
+    float tnear[NC_PACKET], tfar[NC_PACKET];
+    int valid[NC_PACKET]; /* -1 active, 0 inactive */
+};
+
+struct nc_hit16 {
+    float t[NC_PACKET];                    /* ray parameter of the hit (tfar) */
+    float nx[NC_PACKET], ny[NC_PACKET], nz[NC_PACKET]; /* geometric normal, scene frame, unnormalised */
+    int body[NC_PACKET];                   /* body index, -1 for a miss */
+};
+
+struct nc_rt_stats {
+    unsigned long reanchors; /* geometry rebuilt around a new anchor */
+};
+
+int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out);
+/* Bring the back-end to the scene's current camera and body poses. */
+int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s);
+/* Closest hits; coherent = camera rays. */
+void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit, int coherent);
+/* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
+void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
+void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
+
+/* For benchmarks: Embree alone on pre-built native packets. The packets are
+ * converted once (untimed); nc_rt_batch_trace() then only resets each packet
+ * and calls rtcIntersect16 (coherent) or rtcOccluded16, spread over `threads`
+ * threads in chunks, and returns the wall time in ms. */
+struct nc_rt_batch;
+int nc_rt_batch_create(const struct nc_ray16 *rays, size_t npackets, int occlusion, struct nc_rt_batch **out);
+double nc_rt_batch_trace(struct nc_rt *rt, struct nc_rt_batch *b, int threads);
+void nc_rt_batch_destroy(struct nc_rt_batch *b);
+void nc_rt_destroy(struct nc_rt *rt);
+
+#endif

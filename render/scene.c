@@ -1,0 +1,298 @@
+/* scene.c - building a scene from configuration, and the built-in default. */
+#include "scene.h"
+
+#include <libgen.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "error.h"
+
+const char nc_default_scene_yaml[] =
+    "# NavCam built-in default scene: a procedural cratered asteroid about 500 m\n"
+    "# across, seen by a narrow-angle navigation camera 6 km away at 40 deg phase.\n"
+    "bodies:\n"
+    "  - name: asteroid\n"
+    "    shape:\n"
+    "      type: asteroid\n"
+    "      radii_m: [280, 230, 200]\n"
+    "      subdivisions: 7\n"
+    "      seed: 7\n"
+    "      craters: 160\n"
+    "      lump_amplitude: 0.08\n"
+    "    material:\n"
+    "      model: lambert\n"
+    "      A: 0.05\n"
+    "    position_m: [0, 0, 0]\n"
+    "    attitude_q: [1, 0, 0, 0]\n"
+    "sun:\n"
+    "  direction: [0.643, -0.766, 0.0]\n"
+    "  distance_au: 1.2\n"
+    "camera:\n"
+    "  width_px: 1024\n"
+    "  height_px: 1024\n"
+    "  focal_length_m: 0.025\n"
+    "  pixel_pitch_m: 5.5e-6\n"
+    "  position_m: [0, -6000, 0]\n"
+    "  look_at_m: [0, 0, 0]\n"
+    "  up: [0, 0, 1]\n"
+    "render:\n"
+    "  samples_per_pixel: 4\n"
+    "  seed: 1\n";
+
+static const char *const shape_names[] = {"sphere", "ellipsoid", "mesh", "asteroid", NULL};
+
+/* Resolve a path given in the config relative to the file it came from. */
+static void resolve_path(const struct nc_cfg_node *n, const char *file, char *out, size_t len)
+{
+    if (file[0] == '/' || !n->origin || n->line == 0 || n->origin[0] == '<') {
+        snprintf(out, len, "%s", file);
+        return;
+    }
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", n->origin);
+    snprintf(out, len, "%s/%s", dirname(dir), file);
+}
+
+static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+{
+    int type = 0, rc;
+    if ((rc = nc_cfg_enum(sh, "type", shape_names, &type)) <= 0)
+        return rc ? rc : nc_cfg_missing(sh, "type", "sphere, ellipsoid, mesh or asteroid");
+    b->shape = (enum nc_shape_type)type;
+    switch (b->shape) {
+    case NC_SHAPE_SPHERE: {
+        double r;
+        if ((rc = nc_cfg_double(sh, "radius_m", 1e-6, 1e10, &r)) <= 0)
+            return rc ? rc : nc_cfg_missing(sh, "radius_m", "sphere radius in metres");
+        b->radii_m = nc_v3(r, r, r);
+        b->bounding_radius_m = r;
+        return 0;
+    }
+    case NC_SHAPE_ELLIPSOID:
+    case NC_SHAPE_ASTEROID: {
+        double r[3];
+        if ((rc = nc_cfg_doubles(sh, "radii_m", r, 3)) <= 0)
+            return rc ? rc : nc_cfg_missing(sh, "radii_m", "[a, b, c] semi-axes in metres");
+        for (int i = 0; i < 3; i++)
+            if (!(r[i] >= 1e-6 && r[i] <= 1e10))
+                return nc_cfg_error(nc_cfg_get(sh, "radii_m"), "semi-axes must be in [1e-6, 1e10] m");
+        b->radii_m = nc_v3(r[0], r[1], r[2]);
+        b->bounding_radius_m = fmax(r[0], fmax(r[1], r[2]));
+        if (b->shape == NC_SHAPE_ELLIPSOID)
+            return 0;
+        struct nc_asteroid_params ap = {.radii_m = b->radii_m, .subdivisions = 6, .seed = 1, .craters = 100,
+                                        .lump_amplitude = 0.08};
+        long v;
+        if ((rc = nc_cfg_int(sh, "subdivisions", 0, 9, &v)) < 0)
+            return rc;
+        if (rc)
+            ap.subdivisions = (int)v;
+        if ((rc = nc_cfg_int(sh, "seed", 0, 0x7fffffffL, &v)) < 0)
+            return rc;
+        if (rc)
+            ap.seed = (uint64_t)v;
+        if ((rc = nc_cfg_int(sh, "craters", 0, 100000, &v)) < 0)
+            return rc;
+        if (rc)
+            ap.craters = (int)v;
+        if ((rc = nc_cfg_double(sh, "lump_amplitude", 0, 0.5, &ap.lump_amplitude)) < 0)
+            return rc;
+        if ((rc = nc_mesh_asteroid(&ap, &b->mesh)) < 0)
+            return rc;
+        b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
+        return 0;
+    }
+    case NC_SHAPE_MESH: {
+        static const char *const units[] = {"m", "km", NULL};
+        const char *file;
+        int unit = 0;
+        double scale = 1;
+        if ((rc = nc_cfg_string(sh, "file", &file)) <= 0)
+            return rc ? rc : nc_cfg_missing(sh, "file", "path of an OBJ or PLY mesh");
+        if ((rc = nc_cfg_enum(sh, "unit", units, &unit)) <= 0)
+            return rc ? rc : nc_cfg_missing(sh, "unit", "the mesh's length unit: m or km");
+        if ((rc = nc_cfg_double(sh, "scale", 1e-9, 1e9, &scale)) < 0)
+            return rc;
+        char path[4096];
+        resolve_path(nc_cfg_get(sh, "file"), file, path, sizeof path);
+        if ((rc = nc_mesh_load(path, scale * (unit ? 1000.0 : 1.0), &b->mesh)) < 0) {
+            char why[800];
+            snprintf(why, sizeof why, "%s", nc_errmsg());
+            return nc_cfg_error(nc_cfg_get(sh, "file"), "%s", why);
+        }
+        b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
+        return 0;
+    }
+    }
+    return 0;
+}
+
+static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body *b)
+{
+    int rc;
+    item->used = 1;
+    if (item->kind != NC_CFG_MAP)
+        return nc_cfg_error(item, "expected a map describing a body (shape, material, pose)");
+    const char *name = NULL;
+    if ((rc = nc_cfg_string(item, "name", &name)) < 0)
+        return rc;
+    snprintf(b->name, sizeof b->name, "%s", name ? name : "");
+    if (!name)
+        snprintf(b->name, sizeof b->name, "body%d", index);
+    struct nc_cfg_node *sh, *mat;
+    if ((rc = nc_cfg_map(item, "shape", &sh)) <= 0)
+        return rc ? rc : nc_cfg_missing(item, "shape", "a map with 'type'");
+    if ((rc = shape_from_config(sh, b)) < 0)
+        return rc;
+    if ((rc = nc_cfg_map(item, "material", &mat)) < 0)
+        return rc;
+    if (rc == 0)
+        nc_material_init(&b->material, "lambert");
+    else if ((rc = nc_material_from_config(mat, &b->material)) < 0)
+        return rc;
+    b->position_m = nc_v3(0, 0, 0);
+    b->attitude_q = (struct nc_quat){1, 0, 0, 0};
+    if ((rc = nc_cfg_vec3(item, "position_m", &b->position_m)) < 0 ||
+        (rc = nc_cfg_quat(item, "attitude_q", &b->attitude_q)) < 0)
+        return rc;
+    return 0;
+}
+
+static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun)
+{
+    int rc, hd, hp, hdist;
+    double dist_au = 1.0;
+    if ((hd = nc_cfg_vec3(map, "direction", &sun->direction)) < 0)
+        return hd;
+    if ((hp = nc_cfg_vec3(map, "position_m", &sun->position_m)) < 0)
+        return hp;
+    if ((hdist = nc_cfg_double(map, "distance_au", 1e-3, 1e4, &dist_au)) < 0)
+        return hdist;
+    if ((rc = nc_cfg_double(map, "irradiance_w_m2", 0, 1e9, &sun->irradiance_w_m2)) < 0)
+        return rc;
+    sun->irradiance_override = rc;
+    if (hd && hp)
+        return nc_cfg_error(nc_cfg_get(map, "position_m"), "give either direction or position_m, not both");
+    if (!hd && !hp)
+        return nc_cfg_missing(map, "direction", "a vector toward the Sun in the body-fixed frame, or position_m");
+    if (hp && hdist)
+        return nc_cfg_error(nc_cfg_get(map, "distance_au"), "distance_au goes with direction; position_m sets the distance");
+    double d_m;
+    if (hd) {
+        if (nc_v3_norm(sun->direction) == 0)
+            return nc_cfg_error(nc_cfg_get(map, "direction"), "the Sun direction must not be zero");
+        sun->direction = nc_v3_unit(sun->direction);
+        d_m = dist_au * NC_AU_M;
+    } else {
+        d_m = nc_v3_norm(sun->position_m);
+        if (d_m < 1e3)
+            return nc_cfg_error(nc_cfg_get(map, "position_m"), "the Sun is closer than 1 km to the body");
+        sun->has_position = 1;
+    }
+    if (!sun->irradiance_override)
+        sun->irradiance_w_m2 = NC_SOLAR_CONSTANT_W_M2 * (NC_AU_M / d_m) * (NC_AU_M / d_m);
+    return 0;
+}
+
+static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings *r)
+{
+    long v;
+    int rc;
+    r->samples_per_pixel = 1;
+    r->seed = 0;
+    r->threads = 0;
+    if (!map)
+        return 0;
+    if ((rc = nc_cfg_int(map, "samples_per_pixel", 1, 1024, &v)) < 0)
+        return rc;
+    if (rc) {
+        long s = lround(sqrt((double)v));
+        if (s * s != v)
+            return nc_cfg_error(nc_cfg_get(map, "samples_per_pixel"),
+                                "expected a square number (1, 4, 9, 16, ...) for n x n stratified samples, got %ld", v);
+        r->samples_per_pixel = (int)v;
+    }
+    if ((rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+        return rc;
+    if (rc)
+        r->seed = (uint64_t)v;
+    if ((rc = nc_cfg_int(map, "threads", 0, 1024, &v)) < 0)
+        return rc;
+    if (rc)
+        r->threads = (int)v;
+    return 0;
+}
+
+int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s)
+{
+    memset(s, 0, sizeof *s);
+    struct nc_cfg_node *root = cfg->root, *bodies, *sun, *cam, *rnd = NULL;
+    int rc;
+    if (!root)
+        return nc_error(NC_ECONFIG, "empty configuration");
+    if ((rc = nc_cfg_seq(root, "bodies", &bodies)) <= 0)
+        return rc ? rc : nc_cfg_missing(root, "bodies", "a list of bodies");
+    if (bodies->nchild == 0 || bodies->nchild > NC_MAX_BODIES)
+        return nc_cfg_error(bodies, "expected 1 to %d bodies, got %zu", NC_MAX_BODIES, bodies->nchild);
+    for (size_t i = 0; i < bodies->nchild; i++) {
+        s->nbodies = (int)i + 1;
+        if ((rc = body_from_config(bodies->child[i], (int)i, &s->body[i])) < 0)
+            goto fail;
+    }
+    if ((rc = nc_cfg_map(root, "sun", &sun)) <= 0) {
+        rc = rc ? rc : nc_cfg_missing(root, "sun", "a map with direction or position_m");
+        goto fail;
+    }
+    if ((rc = sun_from_config(sun, &s->sun)) < 0)
+        goto fail;
+    if ((rc = nc_cfg_map(root, "camera", &cam)) <= 0) {
+        rc = rc ? rc : nc_cfg_missing(root, "camera", "a map with pose and intrinsics");
+        goto fail;
+    }
+    if ((rc = nc_camera_from_config(cam, &s->camera)) < 0)
+        goto fail;
+    if ((rc = nc_cfg_map(root, "render", &rnd)) < 0 || (rc = render_from_config(rnd, &s->render)) < 0)
+        goto fail;
+    if ((rc = nc_cfg_check_unused(cfg)) < 0)
+        goto fail;
+    return 0;
+fail:
+    nc_scene_free(s);
+    return rc;
+}
+
+int nc_scene_load(const char *path, const char *const *sets, int nsets, struct nc_scene *s)
+{
+    struct nc_cfg cfg;
+    nc_cfg_init(&cfg);
+    int rc = path ? nc_cfg_load_file(&cfg, path) : nc_cfg_load_string(&cfg, nc_default_scene_yaml, "<built-in default scene>");
+    for (int i = 0; rc >= 0 && i < nsets; i++)
+        rc = nc_cfg_set(&cfg, sets[i]);
+    if (rc >= 0)
+        rc = nc_scene_from_config(&cfg, s);
+    nc_cfg_free(&cfg);
+    return rc;
+}
+
+void nc_scene_free(struct nc_scene *s)
+{
+    for (int i = 0; i < s->nbodies; i++)
+        nc_mesh_free(&s->body[i].mesh);
+    s->nbodies = 0;
+}
+
+void nc_scene_sun_at(const struct nc_scene *s, struct nc_vec3 p, struct nc_vec3 *dir, double *irradiance_w_m2)
+{
+    const struct nc_body *b0 = &s->body[0];
+    if (!s->sun.has_position) {
+        *dir = nc_quat_rotate(b0->attitude_q, s->sun.direction);
+        *irradiance_w_m2 = s->sun.irradiance_w_m2;
+        return;
+    }
+    struct nc_vec3 sun = nc_v3_add(nc_quat_rotate(b0->attitude_q, s->sun.position_m), b0->position_m);
+    struct nc_vec3 d = nc_v3_sub(sun, p);
+    double r = nc_v3_norm(d), r0 = nc_v3_norm(s->sun.position_m);
+    *dir = nc_v3_scale(d, 1.0 / r);
+    *irradiance_w_m2 = s->sun.irradiance_w_m2 * (r0 / r) * (r0 / r);
+}

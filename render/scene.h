@@ -1,0 +1,71 @@
+/* scene.h - what is rendered: bodies (shape, material, pose), the Sun, the
+ * camera and render settings, read from a YAML configuration.
+ *
+ * Frames: the scene frame is where the camera and body poses live. Each body
+ * has a body-fixed frame; attitude_q rotates body-fixed vectors into the scene
+ * frame and position_m is the body origin in the scene frame. The Sun is given
+ * in the body-fixed frame of bodies[0]. All lengths in metres (double).
+ */
+#ifndef NC_SCENE_H
+#define NC_SCENE_H
+
+#include <stdint.h>
+
+#include "camera.h"
+#include "config.h"
+#include "material.h"
+#include "mesh.h"
+
+#define NC_AU_M 149597870700.0     /* IAU 2012, exact */
+#define NC_SOLAR_CONSTANT_W_M2 1361.0 /* total solar irradiance at 1 au */
+#define NC_MAX_BODIES 16
+
+enum nc_shape_type { NC_SHAPE_SPHERE, NC_SHAPE_ELLIPSOID, NC_SHAPE_MESH, NC_SHAPE_ASTEROID };
+
+struct nc_body {
+    char name[64];
+    enum nc_shape_type shape;
+    struct nc_vec3 radii_m; /* sphere/ellipsoid semi-axes along body x, y, z */
+    struct nc_mesh mesh;    /* mesh and asteroid */
+    double bounding_radius_m;
+    struct nc_material material;
+    struct nc_vec3 position_m; /* scene frame */
+    struct nc_quat attitude_q; /* body-fixed -> scene */
+};
+
+struct nc_sun {
+    int has_position;
+    struct nc_vec3 direction;   /* unit, toward the Sun, bodies[0] frame (when !has_position) */
+    struct nc_vec3 position_m;  /* bodies[0] frame (when has_position) */
+    double irradiance_w_m2;     /* at bodies[0] (direction) or at 1 au scaled by 1/d^2 (position) */
+    int irradiance_override;
+};
+
+struct nc_render_settings {
+    int samples_per_pixel; /* a square number: n x n strata */
+    uint64_t seed;
+    int threads; /* 0 = all cores */
+};
+
+struct nc_scene {
+    struct nc_body body[NC_MAX_BODIES];
+    int nbodies;
+    struct nc_sun sun;
+    struct nc_camera camera;
+    struct nc_render_settings render;
+};
+
+/* The built-in default scene (YAML text) used when no file is given. */
+extern const char nc_default_scene_yaml[];
+
+/* Build a scene from a loaded configuration; every key must be consumed. */
+int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s);
+/* Convenience: load file (NULL = built-in default), apply overrides, build. */
+int nc_scene_load(const char *path, const char *const *sets, int nsets, struct nc_scene *s);
+void nc_scene_free(struct nc_scene *s);
+
+/* Sun, in the scene frame, seen from scene point p: unit direction toward the
+ * Sun and the solar irradiance there (W m^-2). */
+void nc_scene_sun_at(const struct nc_scene *s, struct nc_vec3 p, struct nc_vec3 *dir, double *irradiance_w_m2);
+
+#endif

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# test_cli.sh - the navcam program through its real command line: help,
+# version, renders to every format, overrides, and error messages/exit codes.
+# Usage: test_cli.sh NAVCAM TMPDIR
+set -u
+navcam=$1
+tmp=$2
+rm -rf "$tmp" && mkdir -p "$tmp"
+pass=0
+fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+# expect CODE NEEDLE -- command...: exit code and a substring of stdout+stderr
+expect() {
+  local code=$1 needle=$2
+  shift 3
+  local out rc
+  out=$("$@" 2>&1)
+  rc=$?
+  if [ "$rc" -ne "$code" ]; then bad "$* -> exit $rc, want $code: $out"; return; fi
+  case "$out" in *"$needle"*) ok ;; *) bad "$* -> output lacks '$needle': $out" ;; esac
+}
+small=(--set camera.width_px=96 --set camera.height_px=96 --set bodies.0.shape.subdivisions=4)
+
+expect 0 "render [SCENE.yaml] -o OUT" -- "$navcam" --help
+expect 0 "navcam 0." -- "$navcam" --version
+expect 0 "--quantity" -- "$navcam" render --help
+expect 0 "--set KEY=VALUE" -- "$navcam" render --help
+expect 2 "Usage: navcam" -- "$navcam"
+expect 2 "unknown command 'paint'" -- "$navcam" paint
+expect 2 "missing -o OUT" -- "$navcam" render
+expect 2 "unsupported output format" -- "$navcam" render -o "$tmp/x.bmp"
+expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
+expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 0
+expect 0 "bodies:" -- "$navcam" scene
+
+# The built-in default scene with no config at all.
+expect 0 "wrote $tmp/default.png" -- "$navcam" render -o "$tmp/default.png" "${small[@]}"
+[ -s "$tmp/default.png" ] && ok || bad "default.png not written"
+for q in radiance iof range; do
+  for e in exr tif fits png; do
+    expect 0 "wrote $tmp/$q.$e" -- "$navcam" render -o "$tmp/$q.$e" --quantity "$q" "${small[@]}" -j 1
+  done
+done
+
+# A scene file plus overrides; the printed scene is itself a valid scene.
+"$navcam" scene > "$tmp/scene.yaml"
+expect 0 "wrote" -- "$navcam" render "$tmp/scene.yaml" -o "$tmp/s.exr" "${small[@]}" \
+  --set camera.position_m=[0,-4000,0] --set bodies.0.material.A=0.2
+
+# Config errors: file, line, key and what was expected; exit 1.
+printf 'bodies:\n  - shape: {type: sphere, radius_m: 100}\nsun: {direction: [1, 0, 0]}\ncamera:\n  width_px: 32\n  height_px: 32\n  fx_px: 40\n  fy_px: 40\n  position_m: [0, 0, -500]\n  attitude_q: [1, 0, 0, 0]\n  shutter: global\n' > "$tmp/bad.yaml"
+expect 1 "$tmp/bad.yaml:11: camera.shutter: unknown key" -- "$navcam" render "$tmp/bad.yaml" -o "$tmp/b.exr"
+expect 1 "--set camera.width_px=wide: camera.width_px: expected a whole number" -- \
+  "$navcam" render -o "$tmp/b.exr" --set camera.width_px=wide
+expect 1 "nowhere.yaml: cannot open" -- "$navcam" render "$tmp/nowhere.yaml" -o "$tmp/b.exr"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' > "$tmp/quad.obj"
+expect 1 "quad.obj:5: face with 4 vertices" -- "$navcam" render -o "$tmp/b.exr" \
+  --set "bodies.0.shape={type: mesh, file: $tmp/quad.obj, unit: m}"
+expect 1 "cannot write into directory '/nonexistent-dir'" -- "$navcam" render -o /nonexistent-dir/x.exr "${small[@]}"
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

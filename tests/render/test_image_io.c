@@ -1,0 +1,97 @@
+/* test_image_io.c - frames written through OpenImageIO read back exactly
+ * (float formats), within one DN of the stated scale (16-bit preview), with
+ * the metadata a user needs, and with NaN/Inf never reaching the file. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "frame_io.h"
+#include "image_io.h"
+#include "testutil.h"
+
+static const char yaml[] =
+    "bodies:\n"
+    "  - shape: {type: sphere, radius_m: 800}\n"
+    "    material: {model: lambert, A: 0.2}\n"
+    "sun: {direction: [0.3, 0, -1]}\n"
+    "camera: {width_px: 48, height_px: 36, fx_px: 60, fy_px: 60, position_m: [0, 0, -3000.123456789012],\n"
+    "         attitude_q: [1, 0, 0, 0]}\n";
+
+int main(void)
+{
+    struct nc_scene s;
+    nc_test_scene(yaml, NULL, 0, &s);
+    struct nc_frame f;
+    nc_test_render(&s, 1, &f);
+    const size_t n = (size_t)f.width_px * f.height_px;
+    const char *exts[] = {"exr", "tif", "fits", "png"};
+    for (int q = 0; q < 3; q++)
+        for (int e = 0; e < 4; e++) {
+            char name[64];
+            snprintf(name, sizeof name, "frame_%s.%s", nc_quantity_names[q], exts[e]);
+            const char *path = nc_test_path(name);
+            double scale = -1;
+            int rc = nc_frame_write(path, &f, (enum nc_quantity)q, &s, &scale);
+            CHECK(rc == 0, "%s: %s", name, nc_errmsg());
+            float *px = NULL;
+            int w = 0, h = 0;
+            rc = nc_image_read(path, &px, &w, &h);
+            CHECK(rc == 0 && w == f.width_px && h == f.height_px, "%s read back: %s", name, nc_errmsg());
+            if (rc < 0)
+                continue;
+            const float *src = q == 0 ? f.radiance : q == 1 ? f.iof : f.range_m;
+            double worst = 0, vmax = 0;
+            for (size_t i = 0; i < n; i++) {
+                double want = e == 3 ? src[i] / scale : src[i];
+                worst = fmax(worst, fabs(px[i] - want));
+                vmax = fmax(vmax, src[i]);
+            }
+            if (e < 3)
+                CHECK(worst == 0, "%s: float values changed by up to %g", name, worst);
+            else
+                CHECK(worst <= 0.5 / 65535 + 1e-9 && scale == vmax, "%s: preview error %g DN (scale %g, max %g)", name,
+                      worst * 65535, scale, vmax);
+            free(px);
+            char buf[512];
+            const char *want_q = nc_quantity_names[q];
+            CHECK(nc_image_read_attr(path, "navcam:quantity", buf, sizeof buf) == 0 && !strcmp(buf, want_q),
+                  "%s: navcam:quantity '%s' (%s)", name, buf, nc_errmsg());
+            CHECK(nc_image_read_attr(path, "navcam:units", buf, sizeof buf) == 0 &&
+                      !strcmp(buf, nc_quantity_units((enum nc_quantity)q)),
+                  "%s: navcam:units", name);
+            CHECK(nc_image_read_attr(path, "navcam:camera_position_m", buf, sizeof buf) == 0 &&
+                      nc_test_contains(buf, "-3000.1234567890"),
+                  "%s: camera position in full precision: '%s'", name, buf);
+            CHECK(nc_image_read_attr(path, "navcam:version", buf, sizeof buf) == 0, "%s: version", name);
+            CHECK(nc_image_read_attr(path, "navcam:quaternion_convention", buf, sizeof buf) == 0 &&
+                      nc_test_contains(buf, "Hamilton; rotates camera-frame vectors into the scene frame"),
+                  "%s: long value intact: '%s'", name, buf);
+            CHECK(nc_image_read_attr(path, "navcam:sun_direction_scene", buf, sizeof buf) == 0, "%s: sun", name);
+            if (e == 3)
+                CHECK(nc_image_read_attr(path, "navcam:preview_scale", buf, sizeof buf) == 0 &&
+                          fabs(atof(buf) - scale) <= 1e-8 * scale,
+                      "%s: preview scale in metadata '%s' vs %g", name, buf, scale);
+        }
+
+    /* NaN and Inf never reach a file. */
+    float bad[4] = {NAN, INFINITY, -INFINITY, 2.0f};
+    const char *p = nc_test_path("bad.exr");
+    CHECK(nc_image_write(p, bad, 2, 2, NULL, 0, NULL) == 0, "bad.exr");
+    float *px;
+    int w, h;
+    if (nc_image_read(p, &px, &w, &h) == 0) {
+        CHECK(px[0] == 0 && px[1] == 0 && px[2] == 0 && px[3] == 2.0f, "non-finite values replaced by 0");
+        free(px);
+    }
+    CHECK(nc_image_write(nc_test_path("x.bmp"), bad, 2, 2, NULL, 0, NULL) < 0 &&
+              nc_test_contains(nc_errmsg(), "unsupported output format"),
+          "unsupported extension: %s", nc_errmsg());
+    CHECK(nc_image_write("/nonexistent-dir/x.exr", bad, 2, 2, NULL, 0, NULL) < 0 &&
+              nc_test_contains(nc_errmsg(), "/nonexistent-dir/x.exr"),
+          "unwritable path names the file: %s", nc_errmsg());
+    nc_frame_free(&f);
+    nc_scene_free(&s);
+    return nc_test_end();
+}

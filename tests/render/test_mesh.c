@@ -1,0 +1,140 @@
+/* test_mesh.c - mesh loading: what must load (long comment headers, unused
+ * vertices, relative and slashed OBJ indices, PLY ASCII and binary) and what
+ * must fail with a clear message, never a crash. The meshes are made here. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "error.h"
+#include "mesh.h"
+#include "testutil.h"
+
+static const char *write_tmp(const char *name, const char *text)
+{
+    const char *p = nc_test_path(name);
+    nc_test_write(p, text);
+    return p;
+}
+
+static void expect_fail(const char *name, const char *text, const char *needle)
+{
+    const char *p = write_tmp(name, text);
+    struct nc_mesh m;
+    int rc = nc_mesh_load(p, 1.0, &m);
+    CHECK(rc < 0, "%s: should fail", name);
+    if (rc >= 0) {
+        nc_mesh_free(&m);
+        return;
+    }
+    CHECK(nc_test_contains(nc_errmsg(), needle), "%s: message '%s' lacks '%s'", name, nc_errmsg(), needle);
+    CHECK(nc_test_contains(nc_errmsg(), name), "%s: message '%s' does not name the file", name, nc_errmsg());
+    printf("ok  %-16s -> %s\n", name, nc_errmsg());
+}
+
+int main(void)
+{
+    /* A long comment header, unused vertices, normals, texture coordinates,
+     * slashed and negative indices. */
+    char obj[200000];
+    size_t n = 0;
+    for (int i = 0; i < 2000; i++)
+        n += (size_t)snprintf(obj + n, sizeof obj - n, "# header line %d of a long provenance comment\n", i);
+    snprintf(obj + n, sizeof obj - n,
+             "o tetra\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 9 9 9\nv 8 8 8\nvn 0 0 1\nvt 0 0\n"
+             "f 1 3 2\nf 1/1/1 2/1/1 4/1/1\nf 1//1 4//1 3//1\nf -5 -4 -3\ns off\n");
+    struct nc_mesh m;
+    int rc = nc_mesh_load(write_tmp("ok.obj", obj), 1000.0, &m);
+    CHECK(rc == 0, "ok.obj: %s", nc_errmsg());
+    if (rc == 0) {
+        CHECK(m.nv == 6 && m.nt == 4, "ok.obj: %zu vertices %zu triangles", m.nv, m.nt);
+        CHECK(m.v[3 * 1] == 1000.0, "km -> m scale");
+        CHECK(m.tri[9] == 1 && m.tri[10] == 2 && m.tri[11] == 3, "negative indices: %u %u %u", m.tri[9], m.tri[10],
+              m.tri[11]);
+        CHECK(fabs(nc_mesh_bounding_radius(&m) - 1000.0) < 1e-9, "bounding radius ignores unused vertices: %g",
+              nc_mesh_bounding_radius(&m));
+        nc_mesh_free(&m);
+    }
+    expect_fail("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", "quad.obj:5: face with 4 vertices");
+    expect_fail("range.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2 7\n", "range.obj:5: face index 7 out of range");
+    expect_fail("zero.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 0 1 2\n", "zero.obj:4: face index 0 out of range");
+    expect_fail("nan.obj", "v 0 0 0\nv nan 0 0\nv 1 1 0\nf 1 2 3\n", "nan.obj:2: vertex coordinate is not finite");
+    expect_fail("short.obj", "v 0 0\nf 1 1 1\n", "short.obj:1: vertex needs 3 numbers");
+    expect_fail("empty.obj", "# nothing here\n", "mesh has no triangles");
+    expect_fail("verts.obj", "v 0 0 0\nv 1 0 0\n", "mesh has no triangles");
+    expect_fail("garbage.obj", "f x y z\n", "garbage.obj:1: bad face index");
+    expect_fail("mesh.stl", "solid\n", "unknown mesh format");
+    rc = nc_mesh_load(nc_test_path("missing.obj"), 1.0, &m);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "missing.obj: cannot open mesh"), "missing: %s", nc_errmsg());
+
+    /* PLY, ASCII with an extra element and property, then binary little and
+     * big endian with double vertices and int indices. */
+    const char *ply = "ply\nformat ascii 1.0\ncomment made by test_mesh\nelement vertex 4\nproperty float x\n"
+                      "property float y\nproperty float z\nproperty uchar red\nelement face 2\n"
+                      "property list uchar int vertex_indices\nelement extra 1\nproperty int k\nend_header\n"
+                      "0 0 0 255\n1 0 0 0\n0 1 0 0\n0 0 1 0\n3 0 2 1\n3 0 1 3\n42\n";
+    rc = nc_mesh_load(write_tmp("a.ply", ply), 1.0, &m);
+    CHECK(rc == 0 && m.nv == 4 && m.nt == 2 && m.tri[5] == 3, "ascii ply: %s", nc_errmsg());
+    if (rc == 0)
+        nc_mesh_free(&m);
+    for (int be = 0; be < 2; be++) {
+        const char *name = be ? "be.ply" : "le.ply";
+        FILE *f = fopen(nc_test_path(name), "wb");
+        fprintf(f, "ply\nformat %s 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+                   "element face 1\nproperty list uchar uint vertex_indices\nend_header\n",
+                be ? "binary_big_endian" : "binary_little_endian");
+        for (int i = 0; i < 9; i++) {
+            double d = i == 4 ? 2.5 : (double)(i % 4 == 0);
+            unsigned char b[8];
+            memcpy(b, &d, 8);
+            if (be)
+                for (int k = 0; k < 4; k++) {
+                    unsigned char t = b[k];
+                    b[k] = b[7 - k];
+                    b[7 - k] = t;
+                }
+            fwrite(b, 1, 8, f);
+        }
+        unsigned char cnt = 3;
+        fwrite(&cnt, 1, 1, f);
+        for (unsigned i = 0; i < 3; i++) {
+            unsigned char b[4] = {0, 0, 0, 0};
+            b[be ? 3 : 0] = (unsigned char)i;
+            fwrite(b, 1, 4, f);
+        }
+        fclose(f);
+        rc = nc_mesh_load(nc_test_path(name), 1.0, &m);
+        CHECK(rc == 0, "%s: %s", name, nc_errmsg());
+        if (rc == 0) {
+            CHECK(m.nv == 3 && m.nt == 1 && m.v[4] == 2.5 && m.tri[2] == 2, "%s content", name);
+            nc_mesh_free(&m);
+        }
+    }
+    expect_fail("quad.ply",
+                "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
+                "4 0 1 2 3\n",
+                "has 4 vertices");
+    expect_fail("range.ply",
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n3 0 1 9\n",
+                "index 9 out of range");
+    expect_fail("trunc.ply",
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0\n",
+                "unexpected end of file");
+    expect_fail("nohdr.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", "no end_header");
+    expect_fail("notply.ply", "hello\n", "not a PLY file");
+
+    /* The procedural asteroid: closed, deterministic, the requested size. */
+    struct nc_asteroid_params ap = {.radii_m = nc_v3(300, 250, 200), .subdivisions = 4, .seed = 3, .craters = 50,
+                                    .lump_amplitude = 0.08};
+    struct nc_mesh a, b;
+    CHECK(nc_mesh_asteroid(&ap, &a) == 0 && nc_mesh_asteroid(&ap, &b) == 0, "asteroid");
+    CHECK(a.nt == 20u * 256 && a.nv == 10u * 256 + 2, "icosphere counts %zu %zu", a.nt, a.nv);
+    CHECK(!memcmp(a.v, b.v, a.nv * 3 * sizeof(double)), "asteroid deterministic");
+    double rb = nc_mesh_bounding_radius(&a);
+    CHECK(rb > 250 && rb < 420, "asteroid bounding radius %g", rb);
+    nc_mesh_free(&a);
+    nc_mesh_free(&b);
+    return nc_test_end();
+}

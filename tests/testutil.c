@@ -1,0 +1,84 @@
+/* testutil.c - see testutil.h. */
+#include "testutil.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "error.h"
+
+int nc_test_failed, nc_test_passed;
+
+const char *nc_test_tmp(void)
+{
+    static char dir[1024];
+    if (!dir[0]) {
+        const char *e = getenv("NC_TEST_TMP");
+        snprintf(dir, sizeof dir, "%s", e ? e : "/tmp/navcam_test");
+        char cmd[1100];
+        snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
+        if (system(cmd) != 0) {
+            fprintf(stderr, "cannot create %s\n", dir);
+            exit(2);
+        }
+    }
+    return dir;
+}
+
+const char *nc_test_path(const char *name)
+{
+    static char buf[8][1200];
+    static int k;
+    k = (k + 1) % 8;
+    snprintf(buf[k], sizeof buf[k], "%s/%s", nc_test_tmp(), name);
+    return buf[k];
+}
+
+void nc_test_write(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f || fputs(text, f) < 0 || fclose(f) != 0) {
+        fprintf(stderr, "cannot write %s\n", path);
+        exit(2);
+    }
+}
+
+int nc_test_scene_rc(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s)
+{
+    struct nc_cfg cfg;
+    nc_cfg_init(&cfg);
+    int rc = nc_cfg_load_string(&cfg, yaml, "test.yaml");
+    for (int i = 0; rc >= 0 && i < nsets; i++)
+        rc = nc_cfg_set(&cfg, sets[i]);
+    if (rc >= 0)
+        rc = nc_scene_from_config(&cfg, s);
+    nc_cfg_free(&cfg);
+    return rc;
+}
+
+void nc_test_scene(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s)
+{
+    if (nc_test_scene_rc(yaml, sets, nsets, s) < 0) {
+        fprintf(stderr, "scene: %s\n", nc_errmsg());
+        exit(2);
+    }
+}
+
+void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f)
+{
+    struct nc_renderer r;
+    if (nc_renderer_init(&r, s, threads) < 0 || nc_frame_alloc(f, s->camera.width_px, s->camera.height_px) < 0 ||
+        nc_render_frame(&r, s, f) < 0) {
+        fprintf(stderr, "render: %s\n", nc_errmsg());
+        exit(2);
+    }
+    nc_renderer_free(&r);
+}
+
+int nc_test_contains(const char *haystack, const char *needle) { return strstr(haystack, needle) != NULL; }
+
+int nc_test_end(void)
+{
+    printf("%d passed, %d failed\n", nc_test_passed, nc_test_failed);
+    return nc_test_failed ? 1 : 0;
+}

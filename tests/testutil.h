@@ -1,0 +1,39 @@
+/* testutil.h - minimal test helpers: non-fatal checks with messages, a
+ * per-test temporary directory, and scene construction from YAML text. */
+#ifndef NC_TESTUTIL_H
+#define NC_TESTUTIL_H
+
+#include <stdio.h>
+
+#include "render.h"
+#include "scene.h"
+
+extern int nc_test_failed, nc_test_passed;
+
+#define CHECK(cond, ...)                                                                                   \
+    do {                                                                                                   \
+        if (cond) {                                                                                        \
+            nc_test_passed++;                                                                              \
+        } else {                                                                                           \
+            nc_test_failed++;                                                                              \
+            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond);                      \
+            fprintf(stderr, __VA_ARGS__);                                                                  \
+            fputc('\n', stderr);                                                                           \
+        }                                                                                                  \
+    } while (0)
+
+/* Temporary directory of this test (created), and a path inside it. */
+const char *nc_test_tmp(void);
+const char *nc_test_path(const char *name);
+void nc_test_write(const char *path, const char *text);
+/* Scene from YAML text plus overrides; aborts the test on error. */
+void nc_test_scene(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s);
+/* Load YAML text + sets; returns the error code and leaves nc_errmsg(). */
+int nc_test_scene_rc(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s);
+/* Render the scene with the given thread count into a newly allocated frame. */
+void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f);
+int nc_test_contains(const char *haystack, const char *needle);
+/* Print "N passed, M failed" and return the exit status. */
+int nc_test_end(void);
+
+#endif
