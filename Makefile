@@ -20,15 +20,19 @@ build: deps
 demo: build
 	scripts/demo.sh $(BUILD)/navcam out
 
-# From scratch: a fresh build tree, warnings as errors, every ctest test.
+# From scratch: a fresh build tree, warnings as errors, every ctest test; then
+# the same tests again under AddressSanitizer and UndefinedBehaviorSanitizer.
 test: deps
-	rm -rf $(TESTBUILD)
+	rm -rf $(TESTBUILD) $(TESTBUILD)-asan
 	cmake -S . -B $(TESTBUILD) -DCMAKE_BUILD_TYPE=Release -DNAVCAM_WERROR=ON $(CMAKE_FLAGS)
 	cmake --build $(TESTBUILD) -j $(JOBS)
+	cmake -S . -B $(TESTBUILD)-asan -DCMAKE_BUILD_TYPE=Asan -DNAVCAM_WERROR=ON -DNAVCAM_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+	cmake --build $(TESTBUILD)-asan -j $(JOBS)
+	cd $(TESTBUILD)-asan && UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ctest --output-on-failure -j $(JOBS) --timeout 900
 	cd $(TESTBUILD) && ctest --output-on-failure -j $(JOBS) --timeout 600
 
 bench: build
 	$(BUILD)/bench_render
 
 clean:
-	rm -rf $(BUILD) $(TESTBUILD) out
+	rm -rf $(BUILD) $(TESTBUILD) $(TESTBUILD)-asan out

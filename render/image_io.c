@@ -97,7 +97,8 @@ int nc_image_write(const char *path, const float *px, int w, int h, const struct
         if (clean[i] > vmax)
             vmax = clean[i];
     }
-    memcpy(all, attrs, (size_t)nattrs * sizeof *all);
+    if (nattrs > 0)
+        memcpy(all, attrs, (size_t)nattrs * sizeof *all);
     int nall = nattrs;
     if (preview_scale)
         *preview_scale = 0;

@@ -16,7 +16,7 @@ static void lambert_eval(const double *p, size_t n, const struct nc_photometry *
 {
     const double k = p[0] / M_PI;
     for (size_t i = 0; i < n; i++)
-        r[i] = k * geo[i].mu0;
+        r[i] = k * geo[i].albedo_factor * geo[i].mu0;
 }
 
 static const struct nc_brdf_model lambert = {

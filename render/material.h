@@ -24,10 +24,12 @@ struct nc_brdf_param {
     const char *doc;
 };
 
-/* One photometric geometry: cosines of incidence, emission and phase angles.
- * mu0 > 0 and mu > 0 are guaranteed by the caller. */
+/* One photometric geometry: cosines of incidence, emission and phase angles
+ * (mu0 > 0 and mu > 0 are guaranteed by the caller), and the local factor on
+ * the model's albedo parameter (1 unless an albedo map says otherwise). */
 struct nc_photometry {
     double mu0, mu, cos_g;
+    double albedo_factor;
 };
 
 struct nc_brdf_model {

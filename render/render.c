@@ -80,7 +80,7 @@ struct job {
     const struct nc_scene *s;
     struct nc_rt *rt;
     struct nc_frame *f;
-    struct nc_mat3 cam_R;
+    struct nc_vec3 d00, ex, ey; /* scene-frame ray direction = d00 + x ex + y ey (unnormalised) */
     int tiles_x, tiles_y, n_strata;
     atomic_int next;
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
@@ -102,6 +102,7 @@ static void shade_tile(struct job *j, int tile)
     memset(hits, 0, sizeof hits);
 
     struct nc_ray16 ray, shadow;
+    struct nc_vec3 dir[NC_PACKET]; /* the camera rays in double precision */
     struct nc_hit16 hit;
     int occluded[NC_PACKET];
     double mu0[NC_PACKET], irr[NC_PACKET];
@@ -121,7 +122,12 @@ static void shade_tile(struct job *j, int tile)
                         ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)sidx)) / n - 0.5;
                         oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)sidx + 1)) / n - 0.5;
                     }
-                    struct nc_vec3 d = nc_v3_unit(nc_mat_mul_v(&j->cam_R, nc_camera_dir(c, px + ox, py + oy)));
+                    /* R * ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per frame. */
+                    double fx = px + ox, fy = py + oy;
+                    struct nc_vec3 d = nc_v3_unit(nc_v3(j->d00.x + fx * j->ex.x + fy * j->ey.x,
+                                                        j->d00.y + fx * j->ex.y + fy * j->ey.y,
+                                                        j->d00.z + fx * j->ex.z + fy * j->ey.z));
+                    dir[i] = d;
                     ray.ox[i] = ray.oy[i] = ray.oz[i] = 0.0f;
                     ray.dx[i] = (float)d.x;
                     ray.dy[i] = (float)d.y;
@@ -139,14 +145,15 @@ static void shade_tile(struct job *j, int tile)
                     shadow.valid[i] = 0;
                     if (hit.body[i] < 0)
                         continue;
-                    struct nc_vec3 d = nc_v3(ray.dx[i], ray.dy[i], ray.dz[i]);
-                    struct nc_vec3 nrm = nc_v3_unit(nc_v3(hit.nx[i], hit.ny[i], hit.nz[i]));
+                    struct nc_vec3 d = dir[i], nrm;
+                    double t = hit.t[i];
+                    if (!nc_rt_refine(j->rt, hit.body[i], d, &t, &nrm))
+                        nrm = nc_v3_unit(nc_v3(hit.nx[i], hit.ny[i], hit.nz[i]));
                     double mu = -nc_v3_dot(nrm, d);
                     if (mu < 0) { /* back face of a mesh with inconsistent winding */
                         nrm = nc_v3_scale(nrm, -1.0);
                         mu = -mu;
                     }
-                    double t = hit.t[i];
                     struct nc_vec3 p = nc_v3_scale(d, t);
                     struct nc_vec3 sdir = j->sun_dir;
                     irr[i] = j->sun_irr;
@@ -159,7 +166,7 @@ static void shade_tile(struct job *j, int tile)
                     hits[k]++;
                     if (!(mu0[i] > 0 && mu > 0))
                         continue;
-                    geo[i] = (struct nc_photometry){mu0[i], mu, -nc_v3_dot(sdir, d)};
+                    geo[i] = (struct nc_photometry){mu0[i], mu, -nc_v3_dot(sdir, d), 1.0};
                     /* Offset the origin off the surface by a few float ulps of the
                      * camera-relative coordinates; tnear stays 0. */
                     double eps = 4e-6 * t;
@@ -227,7 +234,10 @@ int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_f
     if (rc < 0)
         return rc;
     struct job j = {.r = r, .s = s, .rt = r->rt, .f = f};
-    j.cam_R = nc_quat_to_mat(c->attitude_q);
+    struct nc_mat3 R = nc_quat_to_mat(c->attitude_q);
+    j.d00 = nc_mat_mul_v(&R, nc_camera_dir(c, 0, 0));
+    j.ex = nc_mat_mul_v(&R, nc_v3(1.0 / c->fx_px, 0, 0));
+    j.ey = nc_mat_mul_v(&R, nc_v3(0, 1.0 / c->fy_px, 0));
     j.tiles_x = (c->width_px + TILE - 1) / TILE;
     j.tiles_y = (c->height_px + TILE - 1) / TILE;
     j.n_strata = (int)lround(sqrt((double)s->render.samples_per_pixel));

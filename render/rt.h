@@ -38,17 +38,23 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out);
 int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s);
 /* Closest hits; coherent = camera rays. */
 void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit, int coherent);
+/* For a hit on an analytic body, recompute range t and unit normal n (scene
+ * frame) in double precision for the exact camera-relative direction d (unit):
+ * the packet trace is float. Returns 1 if refined, 0 for meshes or when the
+ * double-precision ray misses (a grazing hit; the float answer stands). */
+int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 d, double *t, struct nc_vec3 *n);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
 
 /* For benchmarks: Embree alone on pre-built native packets. The packets are
  * converted once (untimed); nc_rt_batch_trace() then only resets each packet
- * and calls rtcIntersect16 (coherent) or rtcOccluded16, spread over `threads`
- * threads in chunks, and returns the wall time in ms. */
+ * and calls rtcIntersect16 (coherent) or rtcOccluded16 (or, with single, the
+ * same rays one by one through rtcIntersect1/rtcOccluded1), spread over
+ * `threads` threads in chunks, and returns the wall time in ms. */
 struct nc_rt_batch;
 int nc_rt_batch_create(const struct nc_ray16 *rays, size_t npackets, int occlusion, struct nc_rt_batch **out);
-double nc_rt_batch_trace(struct nc_rt *rt, struct nc_rt_batch *b, int threads);
+double nc_rt_batch_trace(struct nc_rt *rt, struct nc_rt_batch *b, int threads, int single);
 void nc_rt_batch_destroy(struct nc_rt_batch *b);
 void nc_rt_destroy(struct nc_rt *rt);
 

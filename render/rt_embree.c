@@ -30,6 +30,8 @@ struct rt_body {
     /* Analytic ellipsoid in anchor-relative coordinates. */
     double centre[3], radii[3];
     float rot[9]; /* body -> scene, row-major, for normals */
+    struct nc_mat3 R;        /* body -> scene, double */
+    struct nc_vec3 origin_rel; /* body origin relative to the camera, scene frame, metres */
 };
 
 struct nc_rt {
@@ -263,6 +265,8 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
         xfm[11] = (float)T.z;
         for (int k = 0; k < 9; k++)
             b->rot[k] = (float)R.m[k / 3][k % 3];
+        b->R = R;
+        b->origin_rel = nc_v3_sub(src->position_m, cam);
         rtcSetGeometryTransform(b->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(b->inst);
     }
@@ -319,6 +323,32 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
     }
 }
 
+int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 d, double *t, struct nc_vec3 *n)
+{
+    const struct rt_body *b = &rt->body[body];
+    if (!b->analytic)
+        return 0;
+    /* Body frame, body origin at zero: o = -R^T origin_rel, d' = R^T d. */
+    struct nc_vec3 o = nc_mat_tmul_v(&b->R, nc_v3_scale(b->origin_rel, -1.0)), db = nc_mat_tmul_v(&b->R, d);
+    const double *r = b->radii;
+    double op[3] = {o.x / r[0], o.y / r[1], o.z / r[2]}, dp[3] = {db.x / r[0], db.y / r[1], db.z / r[2]};
+    double A = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2];
+    double B = op[0] * dp[0] + op[1] * dp[1] + op[2] * dp[2];
+    /* C = |o'|^2 - 1 without cancellation for a camera close to the surface. */
+    double on = sqrt(op[0] * op[0] + op[1] * op[1] + op[2] * op[2]);
+    double C = (on - 1.0) * (on + 1.0), disc = B * B - A * C;
+    if (!(disc >= 0) || !(A > 0))
+        return 0;
+    double q = -(B + copysign(sqrt(disc), B)), t1 = q / A, t2 = q != 0 ? C / q : t1;
+    double tt = fmin(t1, t2) > 0 ? fmin(t1, t2) : fmax(t1, t2);
+    if (!(tt > 0))
+        return 0;
+    struct nc_vec3 p = nc_v3_add(o, nc_v3_scale(db, tt));
+    *t = tt;
+    *n = nc_v3_unit(nc_mat_mul_v(&b->R, nc_v3(p.x / (r[0] * r[0]), p.y / (r[1] * r[1]), p.z / (r[2] * r[2]))));
+    return 1;
+}
+
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded)
 {
     struct RTCRay16 r __attribute__((aligned(64)));
@@ -344,8 +374,34 @@ struct nc_rt_batch {
 struct batch_job {
     struct nc_rt *rt;
     struct nc_rt_batch *b;
+    int single;
     atomic_size_t next;
 };
+
+/* Lane k of a packet as a single ray. */
+static void lane_trace(struct nc_rt *rt, const struct RTCRayHit16 *p, int k, int occlusion,
+                       struct RTCIntersectContext *ctx)
+{
+    struct RTCRayHit r;
+    r.ray.org_x = p->ray.org_x[k];
+    r.ray.org_y = p->ray.org_y[k];
+    r.ray.org_z = p->ray.org_z[k];
+    r.ray.dir_x = p->ray.dir_x[k];
+    r.ray.dir_y = p->ray.dir_y[k];
+    r.ray.dir_z = p->ray.dir_z[k];
+    r.ray.tnear = p->ray.tnear[k];
+    r.ray.tfar = p->ray.tfar[k];
+    r.ray.time = 0;
+    r.ray.mask = 0xffffffffu;
+    r.ray.id = (unsigned)k;
+    r.ray.flags = 0;
+    r.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    r.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    if (occlusion)
+        rtcOccluded1(rt->top, ctx, &r.ray);
+    else
+        rtcIntersect1(rt->top, ctx, &r);
+}
 
 static void *batch_worker(void *arg)
 {
@@ -363,6 +419,12 @@ static void *batch_worker(void *arg)
             break;
         size_t end = start + chunk < b->n ? start + chunk : b->n;
         for (size_t i = start; i < end; i++) {
+            if (j->single) {
+                for (int k = 0; k < NC_PACKET; k++)
+                    if (b->valid[i][k])
+                        lane_trace(j->rt, &b->tmpl[i], k, b->occlusion, &ctx);
+                continue;
+            }
             rh = b->tmpl[i];
             if (b->occlusion)
                 rtcOccluded16(b->valid[i], j->rt->top, &ctx, &rh.ray);
@@ -397,9 +459,9 @@ int nc_rt_batch_create(const struct nc_ray16 *rays, size_t n, int occlusion, str
     return 0;
 }
 
-double nc_rt_batch_trace(struct nc_rt *rt, struct nc_rt_batch *b, int threads)
+double nc_rt_batch_trace(struct nc_rt *rt, struct nc_rt_batch *b, int threads, int single)
 {
-    struct batch_job j = {.rt = rt, .b = b};
+    struct batch_job j = {.rt = rt, .b = b, .single = single};
     atomic_init(&j.next, 0);
     pthread_t tid[64];
     int started = 0;

@@ -51,7 +51,8 @@ int main(void)
             if (e < 3)
                 CHECK(worst == 0, "%s: float values changed by up to %g", name, worst);
             else
-                CHECK(worst <= 0.5 / 65535 + 1e-9 && scale == vmax, "%s: preview error %g DN (scale %g, max %g)", name,
+                /* half a DN of rounding, plus the float32 of the read-back normalisation */
+                CHECK(worst <= 0.51 / 65535 && scale == vmax, "%s: preview error %g DN (scale %g, max %g)", name,
                       worst * 65535, scale, vmax);
             free(px);
             char buf[512];
