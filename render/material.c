@@ -1,33 +1,28 @@
-/* material.c - the reflectance model registry and the models themselves.
- * Hot path: eval() runs on every lit hit; keep it branch-light and finite. */
+/* material.c - the reflectance model registry, presets, and materials from
+ * configuration. The models themselves are in brdf.c. */
 #include "material.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "albedo_map.h"
 #include "error.h"
 
-/* Lambert: r = A mu0 / pi (notes/reflectance.md). */
-static const struct nc_brdf_param lambert_params[] = {
-    {"A", 0.1, 0.0, 1.0, "1", "Lambert albedo (bihemispherical reflectance)"},
+extern const struct nc_brdf_model nc_brdf_lambert, nc_brdf_lommel_seeliger, nc_brdf_hapke, nc_brdf_mcewen;
+
+const struct nc_brdf_model *const nc_brdf_models[] = {&nc_brdf_lambert, &nc_brdf_lommel_seeliger, &nc_brdf_hapke,
+                                                      &nc_brdf_mcewen, NULL};
+
+/* Parameter sets from shared/notes/reflectance.md. */
+const struct nc_brdf_preset nc_brdf_presets[] = {
+    {"comet_67p", "hapke", "w=0.055 b=0.456 c=1 B_S0=1 h_S=0.035 B_C0=0 theta_bar=16 phi=0",
+     "Davidsson, Buratti & Hicks 2022 (seed paper Table 1; b as a backward lobe)"},
+    {"moon", "hapke", "w=0.3854 b=0.2375 c=0.3253 B_S0=1.686 h_S=0.0672 B_C0=0 theta_bar=23.657 phi=0",
+     "Sato et al. 2014, median of the 643 nm parameter maps"},
+    {NULL, NULL, NULL, NULL},
 };
-
-static void lambert_eval(const double *p, size_t n, const struct nc_photometry *geo, double *r)
-{
-    const double k = p[0] / M_PI;
-    for (size_t i = 0; i < n; i++)
-        r[i] = k * geo[i].albedo_factor * geo[i].mu0;
-}
-
-static const struct nc_brdf_model lambert = {
-    .name = "lambert",
-    .description = "Lambertian surface, r = A mu0 / pi",
-    .params = lambert_params,
-    .nparams = 1,
-    .eval = lambert_eval,
-};
-
-const struct nc_brdf_model *const nc_brdf_models[] = {&lambert, NULL};
 
 const struct nc_brdf_model *nc_brdf_find(const char *name)
 {
@@ -37,11 +32,23 @@ const struct nc_brdf_model *nc_brdf_find(const char *name)
     return NULL;
 }
 
+const struct nc_brdf_preset *nc_brdf_preset_find(const char *name)
+{
+    for (int i = 0; nc_brdf_presets[i].name; i++)
+        if (strcmp(nc_brdf_presets[i].name, name) == 0)
+            return &nc_brdf_presets[i];
+    return NULL;
+}
+
 int nc_material_init(struct nc_material *m, const char *model)
 {
     const struct nc_brdf_model *md = nc_brdf_find(model);
-    if (!md)
-        return nc_error(NC_ERANGE, "unknown reflectance model '%s'", model);
+    if (!md) {
+        char list[256] = "";
+        for (int i = 0; nc_brdf_models[i]; i++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", nc_brdf_models[i]->name);
+        return nc_error(NC_ERANGE, "unknown reflectance model '%s' (expected one of: %s)", model, list);
+    }
     memset(m, 0, sizeof *m);
     m->model = md;
     for (int i = 0; i < md->nparams; i++)
@@ -61,7 +68,44 @@ int nc_material_set(struct nc_material *m, const char *key, double value)
         m->p[i] = value;
         return 0;
     }
-    return nc_error(NC_ERANGE, "%s: no parameter named '%s'", m->model->name, key);
+    char list[256] = "";
+    for (int i = 0; i < m->model->nparams; i++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", m->model->params[i].key);
+    return nc_error(NC_ERANGE, "%s: no parameter named '%s' (it has: %s)", m->model->name, key, list);
+}
+
+int nc_material_preset(struct nc_material *m, const char *name)
+{
+    const struct nc_brdf_preset *ps = nc_brdf_preset_find(name);
+    if (!ps) {
+        char list[256] = "";
+        for (int i = 0; nc_brdf_presets[i].name; i++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", nc_brdf_presets[i].name);
+        return nc_error(NC_ERANGE, "unknown preset '%s' (expected one of: %s)", name, list);
+    }
+    int rc = nc_material_init(m, ps->model);
+    char buf[512], *save = NULL;
+    snprintf(buf, sizeof buf, "%s", ps->keys);
+    for (char *tok = strtok_r(buf, " ", &save); tok && rc == 0; tok = strtok_r(NULL, " ", &save)) {
+        char *eq = strchr(tok, '=');
+        *eq = '\0';
+        rc = nc_material_set(m, tok, strtod(eq + 1, NULL));
+    }
+    return rc;
+}
+
+int nc_material_finish(struct nc_material *m)
+{
+    for (int i = 0; i < m->model->nparams; i++)
+        if (isnan(m->p[i]))
+            return nc_error(NC_ERANGE, "%s: parameter %s is required (%s, %s)", m->model->name, m->model->params[i].key,
+                            m->model->params[i].doc, m->model->params[i].unit);
+    char why[256];
+    if (m->model->check && m->model->check(m->p, why, sizeof why) < 0)
+        return nc_error(NC_ERANGE, "%s: %s", m->model->name, why);
+    if (m->model->prepare)
+        m->model->prepare(m->p, m->c);
+    return 0;
 }
 
 int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
@@ -71,16 +115,68 @@ int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
     for (; nc_brdf_models[n] && n < 7; n++)
         names[n] = nc_brdf_models[n]->name;
     names[n] = NULL;
-    int which = 0, rc;
-    if ((rc = nc_cfg_enum(map, "model", names, &which)) < 0)
-        return rc;
-    if (rc == 0)
-        return nc_cfg_missing(map, "model", "a reflectance model name, e.g. lambert");
-    nc_material_init(m, names[which]);
+    int which = 0, rc, hm, hp;
+    const char *preset = NULL;
+    char why[512];
+    if ((hm = nc_cfg_enum(map, "model", names, &which)) < 0)
+        return hm;
+    if ((hp = nc_cfg_string(map, "preset", &preset)) < 0)
+        return hp;
+    if (hp) {
+        if ((rc = nc_material_preset(m, preset)) < 0) {
+            snprintf(why, sizeof why, "%s", nc_errmsg());
+            return nc_cfg_error(nc_cfg_get(map, "preset"), "%s", why);
+        }
+        if (hm && strcmp(names[which], m->model->name) != 0)
+            return nc_cfg_error(nc_cfg_get(map, "model"), "preset '%s' is a %s material, not %s", preset,
+                                m->model->name, names[which]);
+    } else if (!hm) {
+        return nc_cfg_missing(map, "model", "a reflectance model (lambert, lommel_seeliger, hapke, mcewen) or a preset");
+    } else {
+        nc_material_init(m, names[which]);
+    }
     for (int i = 0; i < m->model->nparams; i++) {
         const struct nc_brdf_param *p = &m->model->params[i];
         if ((rc = nc_cfg_double(map, p->key, p->min, p->max, &m->p[i])) < 0)
             return rc;
     }
+    struct nc_cfg_node *am;
+    if ((rc = nc_cfg_map(map, "albedo_map", &am)) < 0)
+        return rc;
+    if (rc && (rc = nc_albedo_map_from_config(am, &m->albedo_map)) < 0)
+        return rc;
+    if ((rc = nc_material_finish(m)) < 0) {
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_cfg_error(map, "%s", why);
+    }
+    return 0;
+}
+
+void nc_material_free(struct nc_material *m)
+{
+    nc_albedo_map_free(m->albedo_map);
+    m->albedo_map = NULL;
+}
+
+int nc_material_eval_deg(const struct nc_material *m, double i, double e, double g, double out[4])
+{
+    const double tol = 1e-6; /* deg: the rounding of a phase angle computed from vectors */
+    if (!(i >= 0 && i <= 180) || !(e >= 0 && e <= 180) || !(g >= 0 && g <= 180))
+        return nc_error(NC_ERANGE, "angles must be within 0..180 deg (got i = %g, e = %g, g = %g)", i, e, g);
+    double gmin = fabs(i - e), gmax = fmin(i + e, 360.0 - i - e);
+    if (g < gmin - tol || g > gmax + tol)
+        return nc_error(NC_ERANGE, "phase angle g = %g deg cannot occur with i = %g and e = %g (it must be within %g..%g)",
+                        g, i, e, gmin, gmax);
+    out[0] = out[1] = out[2] = out[3] = 0.0;
+    if (i >= 90 || e >= 90)
+        return 0;
+    const double d2r = M_PI / 180.0;
+    struct nc_photometry geo = {cos(i * d2r), cos(e * d2r), cos(g * d2r), 1.0};
+    double r;
+    nc_material_eval(m, 1, &geo, &r);
+    out[0] = r;
+    out[1] = r / geo.mu0;
+    out[2] = M_PI * r;
+    out[3] = M_PI * r / geo.mu0;
     return 0;
 }

@@ -1,12 +1,13 @@
 /* material.h - surface reflectance models behind one interface.
  *
  * A model is one constant struct: a name, its parameter table (key, default,
- * physical range, unit) and an evaluator of the bidirectional reflectance
- * r (1/sr) over arrays of photometric geometries. Radiance = r * J, where J is
- * the solar irradiance on a surface facing the Sun (W m^-2). Conventions are
- * those of shared/notes/reflectance.md: BRDF = r / mu0, I/F = pi r.
- * The renderer calls models only through this interface; a new model is a new
- * entry in the registry and nothing else changes.
+ * physical range, unit), optional derived constants and cross-checks, and an
+ * evaluator of the bidirectional reflectance r (1/sr) over arrays of
+ * photometric geometries. Radiance = r * J, where J is the solar irradiance
+ * on a surface facing the Sun (W m^-2). Conventions are those of
+ * shared/notes/reflectance.md: BRDF = r / mu0, RADF = I/F = pi r,
+ * REFF = pi r / mu0. The renderer and `navcam brdf` reach models only through
+ * this interface; a new model is a new registry entry and nothing else.
  */
 #ifndef NC_MATERIAL_H
 #define NC_MATERIAL_H
@@ -16,16 +17,20 @@
 #include "config.h"
 
 #define NC_BRDF_MAX_PARAMS 12
+#define NC_BRDF_MAX_DERIVED 12
+
+struct nc_albedo_map;
 
 struct nc_brdf_param {
     const char *key;
-    double def, min, max;
+    double def; /* NAN: required, no default */
+    double min, max;
     const char *unit;
     const char *doc;
 };
 
 /* One photometric geometry: cosines of incidence, emission and phase angles
- * (mu0 > 0 and mu > 0 are guaranteed by the caller), and the local factor on
+ * (the caller guarantees 0 < mu0 <= 1 and 0 < mu <= 1), and the local factor on
  * the model's albedo parameter (1 unless an albedo map says otherwise). */
 struct nc_photometry {
     double mu0, mu, cos_g;
@@ -37,28 +42,59 @@ struct nc_brdf_model {
     const char *description;
     const struct nc_brdf_param *params;
     int nparams;
-    /* r (1/sr) for n geometries; p holds the parameters in table order. */
-    void (*eval)(const double *p, size_t n, const struct nc_photometry *geo, double *r);
+    int albedo_param; /* the parameter an albedo map scales */
+    int ncderived;
+    /* Derived constants from the parameters (may be NULL). */
+    void (*prepare)(const double *p, double *c);
+    /* Checks across parameters; fills why and returns < 0 (may be NULL). */
+    int (*check)(const double *p, char *why, size_t len);
+    /* r (1/sr) for n geometries; p in table order, c from prepare(). */
+    void (*eval)(const double *p, const double *c, size_t n, const struct nc_photometry *geo, double *r);
 };
 
 struct nc_material {
     const struct nc_brdf_model *model;
     double p[NC_BRDF_MAX_PARAMS];
+    double c[NC_BRDF_MAX_DERIVED];
+    struct nc_albedo_map *albedo_map; /* owned; NULL for none */
+};
+
+/* A named parameter set from the literature. */
+struct nc_brdf_preset {
+    const char *name;
+    const char *model;
+    const char *keys; /* "w=0.055 b=0.456 ..." */
+    const char *source;
 };
 
 extern const struct nc_brdf_model *const nc_brdf_models[];
+extern const struct nc_brdf_preset nc_brdf_presets[];
 
 const struct nc_brdf_model *nc_brdf_find(const char *name);
-/* Material with every parameter at its default. */
+const struct nc_brdf_preset *nc_brdf_preset_find(const char *name);
+/* Material with every parameter at its default (required ones NAN). */
 int nc_material_init(struct nc_material *m, const char *model);
+/* Apply a preset's model and parameters. */
+int nc_material_preset(struct nc_material *m, const char *preset);
 /* Set one parameter by key, checked against its range. */
 int nc_material_set(struct nc_material *m, const char *key, double value);
-/* Read "model: NAME" and the model's parameter keys from a config map. */
+/* All required parameters set, cross-checks pass; computes derived constants. */
+int nc_material_finish(struct nc_material *m);
+/* Read a material map: model or preset, the model's parameter keys, and an
+ * optional albedo_map. */
 int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m);
+void nc_material_free(struct nc_material *m);
+
+/* Photometric quantities of one geometry given in degrees: out = {r, BRDF,
+ * RADF, REFF}. i >= 90 or e >= 90 gives zeros. Returns < 0 (message naming
+ * the problem) for a geometry that cannot exist: any angle outside 0..180, or
+ * g outside |i - e| .. min(i + e, 360 - i - e) (1e-6 deg tolerance). */
+int nc_material_eval_deg(const struct nc_material *m, double i_deg, double e_deg, double g_deg, double out[4]);
+
 /* r (1/sr) of the material for n geometries. */
 static inline void nc_material_eval(const struct nc_material *m, size_t n, const struct nc_photometry *geo, double *r)
 {
-    m->model->eval(m->p, n, geo, r);
+    m->model->eval(m->p, m->c, n, geo, r);
 }
 
 #endif

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "albedo_map.h"
 #include "error.h"
 
 #define TILE 16 /* pixels; a tile is (TILE/4)^2 packets of 4x4 pixels */
@@ -81,6 +82,8 @@ struct job {
     struct nc_rt *rt;
     struct nc_frame *f;
     struct nc_vec3 d00, ex, ey; /* scene-frame ray direction = d00 + x ex + y ey (unnormalised) */
+    struct nc_mat3 body_R[NC_MAX_BODIES];      /* body -> scene */
+    struct nc_vec3 body_rel[NC_MAX_BODIES];    /* body origin - camera, scene frame, m */
     int tiles_x, tiles_y, n_strata;
     atomic_int next;
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
@@ -166,7 +169,14 @@ static void shade_tile(struct job *j, int tile)
                     hits[k]++;
                     if (!(mu0[i] > 0 && mu > 0))
                         continue;
-                    geo[i] = (struct nc_photometry){mu0[i], mu, -nc_v3_dot(sdir, d), 1.0};
+                    double factor = 1.0;
+                    const struct nc_albedo_map *am = s->body[hit.body[i]].material.albedo_map;
+                    if (am) {
+                        /* Body-fixed position of the hit, in double. */
+                        int bi = hit.body[i];
+                        factor = nc_albedo_map_factor(am, nc_mat_tmul_v(&j->body_R[bi], nc_v3_sub(p, j->body_rel[bi])));
+                    }
+                    geo[i] = (struct nc_photometry){mu0[i], mu, -nc_v3_dot(sdir, d), factor};
                     /* Offset the origin off the surface by a few float ulps of the
                      * camera-relative coordinates; tnear stays 0. */
                     double eps = 4e-6 * t;
@@ -186,16 +196,32 @@ static void shade_tile(struct job *j, int tile)
                 if (j->r->ray_hook)
                     j->r->ray_hook(j->r->ray_hook_user, 1, &shadow);
                 nc_rt_occluded16(j->rt, &shadow, occluded);
-                for (int i = 0; i < NC_PACKET; i++) {
-                    if (!shadow.valid[i] || occluded[i])
-                        continue;
-                    double r;
-                    nc_material_eval(&s->body[hit.body[i]].material, 1, &geo[i], &r);
-                    if (!(r >= 0 && r < INFINITY))
-                        r = 0; /* never let a model's NaN or Inf reach the frame */
-                    int k = (by + (i >> 2)) * TILE + bx + (i & 3);
-                    acc_L[k] += r * irr[i];
-                    acc_iof[k] += M_PI * r;
+                /* Sunlit lanes, evaluated in one batch per body (usually one). */
+                int todo[NC_PACKET], ntodo = 0;
+                for (int i = 0; i < NC_PACKET; i++)
+                    if (shadow.valid[i] && !occluded[i])
+                        todo[ntodo++] = i;
+                while (ntodo > 0) {
+                    int body = hit.body[todo[0]], lane[NC_PACKET], nl = 0, rest = 0;
+                    struct nc_photometry g[NC_PACKET];
+                    double r[NC_PACKET];
+                    for (int k = 0; k < ntodo; k++) {
+                        if (hit.body[todo[k]] == body) {
+                            lane[nl] = todo[k];
+                            g[nl++] = geo[todo[k]];
+                        } else {
+                            todo[rest++] = todo[k];
+                        }
+                    }
+                    ntodo = rest;
+                    nc_material_eval(&s->body[body].material, (size_t)nl, g, r);
+                    for (int k = 0; k < nl; k++) {
+                        int i = lane[k];
+                        double rk = r[k] >= 0 && r[k] < INFINITY ? r[k] : 0.0; /* no NaN/Inf into a frame */
+                        int o = (by + (i >> 2)) * TILE + bx + (i & 3);
+                        acc_L[o] += rk * irr[i];
+                        acc_iof[o] += M_PI * rk;
+                    }
                 }
             }
     }
@@ -234,6 +260,10 @@ int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_f
     if (rc < 0)
         return rc;
     struct job j = {.r = r, .s = s, .rt = r->rt, .f = f};
+    for (int b = 0; b < s->nbodies; b++) {
+        j.body_R[b] = nc_quat_to_mat(s->body[b].attitude_q);
+        j.body_rel[b] = nc_v3_sub(s->body[b].position_m, c->position_m);
+    }
     struct nc_mat3 R = nc_quat_to_mat(c->attitude_q);
     j.d00 = nc_mat_mul_v(&R, nc_camera_dir(c, 0, 0));
     j.ex = nc_mat_mul_v(&R, nc_v3(1.0 / c->fx_px, 0, 0));

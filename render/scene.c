@@ -145,11 +145,9 @@ static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body 
         return rc ? rc : nc_cfg_missing(item, "shape", "a map with 'type'");
     if ((rc = shape_from_config(sh, b)) < 0)
         return rc;
-    if ((rc = nc_cfg_map(item, "material", &mat)) < 0)
-        return rc;
-    if (rc == 0)
-        nc_material_init(&b->material, "lambert");
-    else if ((rc = nc_material_from_config(mat, &b->material)) < 0)
+    if ((rc = nc_cfg_map(item, "material", &mat)) <= 0)
+        return rc ? rc : nc_cfg_missing(item, "material", "a map with model (or preset) and parameters");
+    if ((rc = nc_material_from_config(mat, &b->material)) < 0)
         return rc;
     b->position_m = nc_v3(0, 0, 0);
     b->attitude_q = (struct nc_quat){1, 0, 0, 0};
@@ -277,8 +275,10 @@ int nc_scene_load(const char *path, const char *const *sets, int nsets, struct n
 
 void nc_scene_free(struct nc_scene *s)
 {
-    for (int i = 0; i < s->nbodies; i++)
+    for (int i = 0; i < s->nbodies; i++) {
         nc_mesh_free(&s->body[i].mesh);
+        nc_material_free(&s->body[i].material);
+    }
     s->nbodies = 0;
 }
 
