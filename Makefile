@@ -33,6 +33,7 @@ test: deps
 
 bench: build
 	$(BUILD)/bench_render
+	$(BUILD)/bench_brdf
 
 clean:
 	rm -rf $(BUILD) $(TESTBUILD) $(TESTBUILD)-asan out

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "material.h"
+#include "vmath.h"
 
 #define INV_PI (1.0 / M_PI)
 
@@ -81,9 +82,17 @@ static const struct nc_brdf_param mcewen_params[] = {
 
 static void mcewen_eval(const double *p, const double *c, size_t n, const struct nc_photometry *geo, double *r)
 {
+    double gv[16];
+    for (size_t base = 0; base < n; base += 16) {
+        size_t m = n - base < 16 ? n - base : 16;
+        for (size_t i = 0; i < m; i++)
+            gv[i] = geo[base + i].cos_g < -1 ? -1 : geo[base + i].cos_g > 1 ? 1 : geo[base + i].cos_g;
+        nc_vacos(gv, m);
+        for (size_t i = 0; i < m; i++)
+            r[base + i] = gv[i];
+    }
     for (size_t i = 0; i < n; i++) {
-        double cg = geo[i].cos_g < -1 ? -1 : geo[i].cos_g > 1 ? 1 : geo[i].cos_g;
-        double g = acos(cg) * (180.0 / M_PI);
+        double g = r[i] * (180.0 / M_PI);
         double L = 1.0 + g * (p[1] + g * (p[2] + g * p[3]));
         L = L < 0 ? 0 : L > 1 ? 1 : L;
         double mu0 = geo[i].mu0, mu = geo[i].mu;
@@ -117,7 +126,7 @@ static const struct nc_brdf_param hapke_params[] = {
 };
 
 /* Derived constants, computed once per parameter set. */
-enum { CK, CCHI, CTAN, CCOT, CCOT2, CR0, CSQRT1MW, NC_HAPKE_DERIVED };
+enum { CK, CCHI, CTAN, CCOT, CR0, NC_HAPKE_DERIVED };
 
 static void hapke_prepare(const double *p, double *c)
 {
@@ -133,9 +142,8 @@ static void hapke_prepare(const double *p, double *c)
     c[CTAN] = tan(tb);
     c[CCHI] = 1.0 / sqrt(1.0 + M_PI * c[CTAN] * c[CTAN]); /* eq. 25 */
     c[CCOT] = tb > 0 ? 1.0 / c[CTAN] : INFINITY;
-    c[CCOT2] = c[CCOT] * c[CCOT];
-    c[CSQRT1MW] = sqrt(1.0 - p[HW]);
-    c[CR0] = (1.0 - c[CSQRT1MW]) / (1.0 + c[CSQRT1MW]); /* eq. 17 */
+    double s = sqrt(1.0 - p[HW]);
+    c[CR0] = (1.0 - s) / (1.0 + s); /* eq. 17 */
 }
 
 static int hapke_check(const double *p, char *why, size_t len)
@@ -152,12 +160,13 @@ static int hapke_check(const double *p, char *why, size_t len)
 }
 
 /* Hapke 2002 approximation of Chandrasekhar's H function (= Hapke 2012 eq.
- * 8.56; seed eq. 16). H(0) = 1 is the limit of x ln((1+x)/x) -> 0. */
-static inline double hapke_H(double x, double w, double r0)
+ * 8.56; seed eq. 16), given L = ln((1 + x)/x). H(0) = 1 is the limit of
+ * x ln((1+x)/x) -> 0. */
+static inline double hapke_H(double x, double w, double r0, double L)
 {
     if (!(x > 0))
         return 1.0;
-    return 1.0 / (1.0 - w * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * log((1.0 + x) / x)));
+    return 1.0 / (1.0 - w * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * L));
 }
 
 /* Double Henyey-Greenstein, seed eq. 12: (1+c)/2 backward lobe peaks at g = 0.
@@ -180,75 +189,123 @@ static inline double hapke_BC(double x)
     return (1.0 + q) / (2.0 * (1.0 + x) * (1.0 + x));
 }
 
-static void hapke_eval(const double *p, const double *c, size_t n, const struct nc_photometry *geo, double *r)
+/* Hapke 2012 with IMSA (seed eqs. 7, 11-29; notes/reflectance.md):
+ *   r = K w/(4 pi) mu0e/(mu0e + mue) [p(g)(1 + B_S0 B_S) + H(mu0e/K) H(mue/K) - 1]
+ *       [1 + B_C0 B_C] S(i, e, psi)
+ * The two branches of the shadowing function (i <= e, eqs. 19-21, and e <= i,
+ * eqs. 22-24) are the same formulas with the roles of the two directions
+ * exchanged. Writing A for the direction nearer the normal (mu_A = max(mu0,
+ * mu)) and B for the other, both reduce to
+ *   r = K w/(4 pi) mu0 mu_Ae mu_Be chi [...] (1 + B_C0 B_C)
+ *       / ((mu_Ae + mu_Be) eta_B (eta_A (1 - f) + f chi mu_A)),
+ * one expression without a branch whose BRDF r/mu0 is symmetric in (mu0, mu)
+ * by construction: reciprocity holds exactly. (The mu0 of eq. 19, or the mu
+ * of eq. 22, is mu_A; the remaining mu0 is r's own.)
+ * The work is staged over up to HCHUNK geometries so that the acos, exp and
+ * log calls run as vector batches (vmath.h). */
+#define HCHUNK 16
+
+static void hapke_chunk(const double *p, const double *c, size_t n, const struct nc_photometry *geo, double *r)
 {
-    const double K = c[CK], chi = c[CCHI], tanb = c[CTAN], cotb = c[CCOT], cotb2 = c[CCOT2];
+    const double K = c[CK], chi = c[CCHI], tanb = c[CTAN], cotb = c[CCOT];
     const int rough = p[HTHETA] > 0;
+    double muA[HCHUNK], muB[HCHUNK], sA[HCHUNK], sB[HCHUNK], cpsi[HCHUNK], q[HCHUNK];
+    double ex[5 * HCHUNK], lg[2 * HCHUNK], xA[HCHUNK], xB[HCHUNK], S[HCHUNK], Sden[HCHUNK];
+
+    /* Stage 1: geometry, and the arguments of acos and exp. */
     for (size_t k = 0; k < n; k++) {
         const double mu0 = geo[k].mu0, mu = geo[k].mu;
+        muA[k] = mu0 > mu ? mu0 : mu;
+        muB[k] = mu0 > mu ? mu : mu0;
+        if (!rough)
+            continue;
+        sA[k] = sqrt(fmax(0.0, 1.0 - muA[k] * muA[k]));
+        sB[k] = sqrt(fmax(0.0, 1.0 - muB[k] * muB[k]));
+        const double cg = geo[k].cos_g < -1 ? -1 : geo[k].cos_g > 1 ? 1 : geo[k].cos_g;
+        /* psi from the law of cosines (eq. 30), psi = 0 on the backscatter
+         * side, and a = cot(theta_bar) cot(y) for y = A, B. At i = 0 or e = 0
+         * psi is undefined and every psi gives the same S, so take psi = 0
+         * there; cot(0) = infinity makes E1 = E2 = 0. */
+        double cp = 1.0, aA = INFINITY, aB = INFINITY;
+        if (sA[k] * sB[k] > 1e-300) {
+            const double inv = 1.0 / (sA[k] * sB[k]);
+            cp = (cg - muA[k] * muB[k]) * inv;
+            aA = cotb * muA[k] * sB[k] * inv;
+            aB = cotb * muB[k] * sA[k] * inv;
+        } else if (sB[k] > 0) {
+            aB = cotb * muB[k] / sB[k];
+        }
+        cpsi[k] = q[k] = cp < -1 ? -1 : cp > 1 ? 1 : cp;
+        ex[5 * k + 0] = -2.0 * sqrt((1.0 - cpsi[k]) / (1.0 + cpsi[k])); /* f, eq. 29: 0 at psi = 180 deg */
+        ex[5 * k + 1] = -2.0 * INV_PI * aA;                             /* E1, eq. 27 */
+        ex[5 * k + 2] = -2.0 * INV_PI * aB;
+        ex[5 * k + 3] = -INV_PI * aA * aA; /* E2, eq. 28 */
+        ex[5 * k + 4] = -INV_PI * aB * aB;
+    }
+    if (rough) {
+        nc_vacos(q, n);
+        nc_vexp(ex, 5 * n);
+    }
+
+    /* Stage 2: effective cosines, the shadowing factors, the H arguments. */
+    for (size_t k = 0; k < n; k++) {
+        double muAe = muA[k], muBe = muB[k];
+        S[k] = Sden[k] = 1.0;
+        if (rough) {
+            const double f = ex[5 * k], E1A = ex[5 * k + 1], E1B = ex[5 * k + 2], E2A = ex[5 * k + 3],
+                         E2B = ex[5 * k + 4];
+            const double s2 = 0.5 * (1.0 - cpsi[k]); /* sin^2(psi/2) */
+            /* eq. 26: eta(y) = chi [cos y + sin y tan(theta_bar) E2/(2 - E1)] */
+            const double gA = 2.0 - E1A, gB = 2.0 - E1B, ig = 1.0 / (gA * gB);
+            const double etaA = chi * (muA[k] + sA[k] * tanb * E2A * gB * ig);
+            const double etaB = chi * (muB[k] + sB[k] * tanb * E2B * gA * ig);
+            /* eqs. 20-21 (or 23-24 with the roles exchanged); the divisor
+             * vanishes only as both angles reach 90 deg with psi = 180 deg,
+             * where the roughness terms vanish with the cosines. */
+            const double dd = 2.0 - E1B - q[k] * INV_PI * E1A, inv = dd > 1e-12 ? 1.0 / dd : 0.0;
+            muAe = chi * (muA[k] + sA[k] * tanb * (cpsi[k] * E2B + s2 * E2A) * inv);
+            muBe = chi * (muB[k] + sB[k] * tanb * (E2B - s2 * E2A) * inv);
+            /* The effective cosines can dip below 0 at grazing geometries. */
+            muAe = muAe > 0 ? muAe : 0.0;
+            muBe = muBe > 0 ? muBe : 0.0;
+            S[k] = muAe * muBe * chi;
+            Sden[k] = etaB * (etaA * (1.0 - f) + f * chi * muA[k]);
+        }
+        S[k] /= muAe + muBe; /* with the mu0e/(mu0e + mue) of eq. 7 */
+        xA[k] = muAe / K;
+        xB[k] = muBe / K;
+        lg[2 * k] = xA[k] > 0 ? (1.0 + xA[k]) / xA[k] : 1.0;
+        lg[2 * k + 1] = xB[k] > 0 ? (1.0 + xB[k]) / xB[k] : 1.0;
+    }
+    nc_vlog(lg, 2 * n);
+
+    /* Stage 3: H, the phase function and the opposition effects. */
+    for (size_t k = 0; k < n; k++) {
+        if (!(S[k] > 0 && isfinite(S[k])) || !(Sden[k] > 0)) {
+            r[k] = 0.0;
+            continue;
+        }
         const double cg = geo[k].cos_g < -1 ? -1 : geo[k].cos_g > 1 ? 1 : geo[k].cos_g;
         double w = p[HW], r0 = c[CR0];
         if (geo[k].albedo_factor != 1.0) {
             w = scaled(w, geo[k].albedo_factor, 1.0);
-            double s = sqrt(1.0 - w);
-            r0 = (1.0 - s) / (1.0 + s);
+            double sq = sqrt(1.0 - w);
+            r0 = (1.0 - sq) / (1.0 + sq);
         }
-        /* tan(g/2) from cos g; infinite at g = 180 deg, where B_S, B_C -> 0. */
-        const double tg2 = sqrt((1.0 - cg) / (1.0 + cg));
-
-        double mu0e = mu0, mue = mu, S = 1.0;
-        if (rough) {
-            /* Hapke 1984 / 2012 shadowing, seed eqs. 19-29. */
-            const double si = sqrt(fmax(0.0, 1.0 - mu0 * mu0)), se = sqrt(fmax(0.0, 1.0 - mu * mu));
-            /* psi from the law of cosines (eq. 30), psi = 0 on the backscatter
-             * side; undefined at i = 0 or e = 0, where every psi gives the
-             * same S, so take psi = 0 there instead of dividing by zero. */
-            double cpsi = 1.0;
-            if (si * se > 1e-300)
-                cpsi = (cg - mu0 * mu) / (si * se);
-            cpsi = cpsi < -1 ? -1 : cpsi > 1 ? 1 : cpsi;
-            const double psi = acos(cpsi);
-            const double s2 = 0.5 * (1.0 - cpsi);                  /* sin^2(psi/2) */
-            const double f = exp(-2.0 * sqrt((1.0 - cpsi) / (1.0 + cpsi))); /* eq. 29; 0 at psi = 180 deg */
-            /* cot of i and e; infinite at normal incidence/emission, where
-             * E1 = E2 = 0 (eqs. 27-28). */
-            const double coti = si > 0 ? mu0 / si : INFINITY, cote = se > 0 ? mu / se : INFINITY;
-            const double E1i = exp(-2.0 * INV_PI * cotb * coti), E1e = exp(-2.0 * INV_PI * cotb * cote);
-            const double E2i = exp(-INV_PI * cotb2 * coti * coti), E2e = exp(-INV_PI * cotb2 * cote * cote);
-            const double etai = chi * (mu0 + si * tanb * E2i / (2.0 - E1i)); /* eq. 26 */
-            const double etae = chi * (mu + se * tanb * E2e / (2.0 - E1e));
-            const double q = psi * INV_PI;
-            if (mu0 >= mu) { /* i <= e: eqs. 19-21 */
-                double den = 2.0 - E1e - q * E1i;
-                /* den -> 0 only as i, e -> 90 deg with psi -> 180 deg, where the
-                 * roughness terms vanish with mu0 and mu. */
-                double a = den > 1e-12 ? 1.0 / den : 0.0;
-                mu0e = chi * (mu0 + si * tanb * (cpsi * E2e + s2 * E2i) * a);
-                mue = chi * (mu + se * tanb * (E2e - s2 * E2i) * a);
-                S = (mue / etae) * (mu0 / etai) * chi / (1.0 - f + f * chi * (mu0 / etai));
-            } else { /* e <= i: eqs. 22-24 */
-                double den = 2.0 - E1i - q * E1e;
-                double a = den > 1e-12 ? 1.0 / den : 0.0;
-                mu0e = chi * (mu0 + si * tanb * (E2i - s2 * E2e) * a);
-                mue = chi * (mu + se * tanb * (cpsi * E2i + s2 * E2e) * a);
-                S = (mue / etae) * (mu0 / etai) * chi / (1.0 - f + f * chi * (mu / etae));
-            }
-            /* The effective cosines can dip below 0 at grazing geometries. */
-            mu0e = mu0e > 0 ? mu0e : 0.0;
-            mue = mue > 0 ? mue : 0.0;
-            S = S > 0 ? S : 0.0;
-        }
-        const double sum = mu0e + mue;
-        if (!(sum > 0)) {
-            r[k] = 0.0;
-            continue;
-        }
-        const double Bs = p[HBS0] > 0 ? p[HBS0] / (1.0 + tg2 / p[HHS]) : 0.0;  /* eq. 13 */
+        const double tg2 = sqrt((1.0 - cg) / (1.0 + cg)); /* tan(g/2); infinite at g = 180 deg */
+        const double Bs = p[HBS0] > 0 ? p[HBS0] * p[HHS] / (p[HHS] + tg2) : 0.0;  /* eq. 13 */
         const double Bc = p[HBC0] > 0 ? p[HBC0] * hapke_BC(tg2 / p[HHC]) : 0.0; /* eq. 18 */
-        const double M = hapke_H(mu0e / K, w, r0) * hapke_H(mue / K, w, r0) - 1.0; /* eq. 14 */
+        const double M = hapke_H(xA[k], w, r0, lg[2 * k]) * hapke_H(xB[k], w, r0, lg[2 * k + 1]) - 1.0; /* eq. 14 */
+        const double bracket = (hapke_p(p[HB], p[HC], cg) * (1.0 + Bs) + M) * (1.0 + Bc);
         /* Hapke 2012 eq. 12.55 (IMSA): K both multiplies and divides the H arguments. */
-        r[k] = K * w * (0.25 * INV_PI) * (mu0e / sum) * (hapke_p(p[HB], p[HC], cg) * (1.0 + Bs) + M) * (1.0 + Bc) * S;
+        r[k] = K * w * (0.25 * INV_PI) * geo[k].mu0 * bracket * S[k] / Sden[k];
     }
+}
+
+static void hapke_eval(const double *p, const double *c, size_t n, const struct nc_photometry *geo, double *r)
+{
+    for (size_t base = 0; base < n; base += HCHUNK)
+        hapke_chunk(p, c, n - base < HCHUNK ? n - base : HCHUNK, geo + base, r + base);
 }
 
 const struct nc_brdf_model nc_brdf_hapke = {

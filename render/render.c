@@ -150,7 +150,12 @@ static void shade_tile(struct job *j, int tile)
                         continue;
                     struct nc_vec3 d = dir[i], nrm;
                     double t = hit.t[i];
-                    if (!nc_rt_refine(j->rt, hit.body[i], d, &t, &nrm))
+                    int exact = nc_rt_refine(j->rt, hit.body[i], d, &t, &nrm);
+                    if (exact < 0) { /* the float trace grazed a limb the exact shape misses */
+                        hit.body[i] = -1;
+                        continue;
+                    }
+                    if (exact == 0)
                         nrm = nc_v3_unit(nc_v3(hit.nx[i], hit.ny[i], hit.nz[i]));
                     double mu = -nc_v3_dot(nrm, d);
                     if (mu < 0) { /* back face of a mesh with inconsistent winding */

@@ -40,8 +40,9 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s);
 void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit, int coherent);
 /* For a hit on an analytic body, recompute range t and unit normal n (scene
  * frame) in double precision for the exact camera-relative direction d (unit):
- * the packet trace is float. Returns 1 if refined, 0 for meshes or when the
- * double-precision ray misses (a grazing hit; the float answer stands). */
+ * the packet trace is float. Returns 1 if refined, 0 for meshes (the float
+ * answer stands), and -1 when the exact ray misses the body: a float hit at
+ * the limb that is not there, to be treated as a miss. */
 int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 d, double *t, struct nc_vec3 *n);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);

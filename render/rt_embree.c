@@ -338,11 +338,11 @@ int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 d, double *t, 
     double on = sqrt(op[0] * op[0] + op[1] * op[1] + op[2] * op[2]);
     double C = (on - 1.0) * (on + 1.0), disc = B * B - A * C;
     if (!(disc >= 0) || !(A > 0))
-        return 0;
+        return -1;
     double q = -(B + copysign(sqrt(disc), B)), t1 = q / A, t2 = q != 0 ? C / q : t1;
     double tt = fmin(t1, t2) > 0 ? fmin(t1, t2) : fmax(t1, t2);
     if (!(tt > 0))
-        return 0;
+        return -1;
     struct nc_vec3 p = nc_v3_add(o, nc_v3_scale(db, tt));
     *t = tt;
     *n = nc_v3_unit(nc_mat_mul_v(&b->R, nc_v3(p.x / (r[0] * r[0]), p.y / (r[1] * r[1]), p.z / (r[2] * r[2]))));

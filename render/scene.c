@@ -10,7 +10,8 @@
 
 const char nc_default_scene_yaml[] =
     "# NavCam built-in default scene: a procedural cratered asteroid about 500 m\n"
-    "# across, seen by a narrow-angle navigation camera 6 km away at 40 deg phase.\n"
+    "# across, seen by a narrow-angle navigation camera 6 km away at 40 deg phase,\n"
+    "# with the Hapke 2012 regolith parameters of comet 67P (Davidsson et al. 2022).\n"
     "bodies:\n"
     "  - name: asteroid\n"
     "    shape:\n"
@@ -21,8 +22,7 @@ const char nc_default_scene_yaml[] =
     "      craters: 160\n"
     "      lump_amplitude: 0.08\n"
     "    material:\n"
-    "      model: lambert\n"
-    "      A: 0.05\n"
+    "      preset: comet_67p\n"
     "    position_m: [0, 0, 0]\n"
     "    attitude_q: [1, 0, 0, 0]\n"
     "sun:\n"

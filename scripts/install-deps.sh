@@ -4,6 +4,7 @@
 set -euo pipefail
 
 pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev libcfitsio-dev)
+case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
 
 missing=()
 for p in "${pkgs[@]}"; do

@@ -49,8 +49,8 @@ expect 0 "wrote" -- "$navcam" render "$tmp/scene.yaml" -o "$tmp/s.exr" "${small[
   --set camera.position_m=[0,-4000,0] --set bodies.0.material.A=0.2
 
 # Config errors: file, line, key and what was expected; exit 1.
-printf 'bodies:\n  - shape: {type: sphere, radius_m: 100}\nsun: {direction: [1, 0, 0]}\ncamera:\n  width_px: 32\n  height_px: 32\n  fx_px: 40\n  fy_px: 40\n  position_m: [0, 0, -500]\n  attitude_q: [1, 0, 0, 0]\n  shutter: global\n' > "$tmp/bad.yaml"
-expect 1 "$tmp/bad.yaml:11: camera.shutter: unknown key" -- "$navcam" render "$tmp/bad.yaml" -o "$tmp/b.exr"
+printf 'bodies:\n  - shape: {type: sphere, radius_m: 100}\n    material: {model: lambert, A: 0.1}\nsun: {direction: [1, 0, 0]}\ncamera:\n  width_px: 32\n  height_px: 32\n  fx_px: 40\n  fy_px: 40\n  position_m: [0, 0, -500]\n  attitude_q: [1, 0, 0, 0]\n  shutter: global\n' > "$tmp/bad.yaml"
+expect 1 "$tmp/bad.yaml:12: camera.shutter: unknown key" -- "$navcam" render "$tmp/bad.yaml" -o "$tmp/b.exr"
 expect 1 "--set camera.width_px=wide: camera.width_px: expected a whole number" -- \
   "$navcam" render -o "$tmp/b.exr" --set camera.width_px=wide
 expect 1 "nowhere.yaml: cannot open" -- "$navcam" render "$tmp/nowhere.yaml" -o "$tmp/b.exr"
@@ -58,6 +58,28 @@ printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' > "$tmp/quad.obj"
 expect 1 "quad.obj:5: face with 4 vertices" -- "$navcam" render -o "$tmp/b.exr" \
   --set "bodies.0.shape={type: mesh, file: $tmp/quad.obj, unit: m}"
 expect 1 "cannot write into directory '/nonexistent-dir'" -- "$navcam" render -o /nonexistent-dir/x.exr "${small[@]}"
+
+# navcam brdf: one geometry, standard input, errors.
+expect 0 "i_deg,e_deg,g_deg,r,brdf,radf,reff" -- "$navcam" brdf --model lambert --param A=0.5 --geometry 60,0,60
+expect 0 "60,0,60,0.079577471545947687,0.15915494309189535,0.25000000000000006,0.5" -- \
+  "$navcam" brdf --model lambert --param A=0.5 --geometry 60,0,60
+expect 0 "30,30,0,0.011936620731892153,0.013783222385544804,0.037500000000000006" -- "$navcam" brdf --model lommel_seeliger --param w=0.3 --geometry 30,30,0
+expect 0 "95,10,100,0,0,0,0" -- "$navcam" brdf --model hapke --param w=0.3 --geometry 95,10,100
+expect 0 "preset comet_67p" -- "$navcam" brdf --list
+expect 0 "theta_bar" -- "$navcam" brdf --help
+out=$(printf 'i,e,g\n30,30,0\n\n60,0,60\n' | "$navcam" brdf --preset moon --no-header)
+[ "$(printf '%s\n' "$out" | wc -l)" -eq 2 ] && ok || bad "brdf stdin: want 2 rows, got: $out"
+expect 1 "stdin:3: phase angle g = 100 deg cannot occur with i = 10 and e = 20" -- \
+  sh -c "printf '30,30,0\n0,0,0\n10,20,100\n' | '$navcam' brdf --model lambert --param A=0.1"
+expect 1 "stdin:2: expected \"i,e,g\"" -- sh -c "printf '30,30,0\n30;30;0\n' | '$navcam' brdf --model lambert --param A=0.1"
+expect 1 "parameter w must be in [0, 1], got 1.5" -- "$navcam" brdf --model hapke --param w=1.5 --geometry 0,0,0
+expect 1 "theta_bar must be in [0, 60]" -- "$navcam" brdf --model hapke --param w=0.5 --param theta_bar=70 --geometry 0,0,0
+expect 1 "phi must be in [0, 0.752]" -- "$navcam" brdf --model hapke --param w=0.5 --param phi=0.8 --geometry 0,0,0
+expect 1 "h_S must be > 0 when B_S0 > 0" -- "$navcam" brdf --model hapke --param w=0.5 --param B_S0=1 --param h_S=0 --geometry 0,0,0
+expect 1 "parameter w is required" -- "$navcam" brdf --model hapke --geometry 0,0,0
+expect 1 "no parameter named 'w'" -- "$navcam" brdf --model lambert --param w=0.5 --geometry 0,0,0
+expect 1 "angles must be within 0..180" -- "$navcam" brdf --model lambert --param A=0.5 --geometry 190,0,190
+expect 2 "give --model NAME or --preset NAME" -- "$navcam" brdf --geometry 0,0,0
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

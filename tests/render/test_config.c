@@ -100,6 +100,36 @@ int main(void)
         expect_error("--set bad index", NULL, NULL, sets, 1, "--set bodies.3", "not an index");
     }
 
+    /* Materials: presets, overrides of a preset, and their errors. */
+    {
+        const char *sets[] = {"bodies.0.material={preset: comet_67p, theta_bar: 20}"};
+        CHECK(nc_test_scene_rc(base, sets, 1, &s) == 0, "preset: %s", nc_errmsg());
+        CHECK(!strcmp(s.body[0].material.model->name, "hapke") && s.body[0].material.p[0] == 0.055 &&
+                  s.body[0].material.p[7] == 20,
+              "preset comet_67p with theta_bar override");
+        nc_scene_free(&s);
+    }
+    {
+        const char *sets[] = {"bodies.0.material={preset: vesta}"};
+        expect_error("unknown preset", NULL, NULL, sets, 1, "bodies[0].material.preset", "unknown preset 'vesta'");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={preset: moon, model: lambert}"};
+        expect_error("preset vs model", NULL, NULL, sets, 1, "bodies[0].material.model", "is a hapke material");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={model: hapke, b: 0.2}"};
+        expect_error("hapke without w", NULL, NULL, sets, 1, "bodies[0].material", "parameter w is required");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={model: hapke, w: 0.2, B_C0: 1, h_C: 0}"};
+        expect_error("h_C used but 0", NULL, NULL, sets, 1, "bodies[0].material", "h_C must be > 0 when B_C0 > 0");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={model: lommel_seeliger, w: 0.2, A: 0.1}"};
+        expect_error("key of another model", NULL, NULL, sets, 1, "bodies[0].material.A", "unknown key");
+    }
+
     /* Overrides: dotted paths into maps and lists; new keys; whole subtrees. */
     const char *sets[] = {"camera.position_m=[0,0,-7000]", "bodies.0.material.A=0.25", "bodies[0].position_m=[1,2,3]",
                           "sun={direction: [0, 1, 0], distance_au: 2}", "render.samples_per_pixel=9"};

@@ -1,6 +1,8 @@
-/* test_sphere.c - a Lambert sphere and a triaxial ellipsoid seen by a pinhole
+/* test_sphere.c - a sphere and a rotated triaxial ellipsoid seen by a pinhole
  * camera at finite distance agree per pixel with the exact ray-quadric image
- * computed here independently in double precision, at phase angles 0..150 deg. */
+ * computed here independently in double precision, at phase angles 0..150 deg:
+ * Lambert, and Hapke (where emission and phase angles matter too, so every
+ * hit's i, e and g must be right). */
 #include <math.h>
 #include <stdio.h>
 
@@ -46,7 +48,13 @@ static double exact(const struct nc_scene *s, double x, double y, double *mu_out
     struct nc_vec3 n = nc_v3_unit(nc_v3(p.x / (r[0] * r[0]), p.y / (r[1] * r[1]), p.z / (r[2] * r[2])));
     double mu0 = nc_v3_dot(n, s->sun.direction), mu = -nc_v3_dot(n, d);
     *mu_out = mu;
-    return mu0 > 0 ? s->body[0].material.p[0] / M_PI * mu0 * s->sun.irradiance_w_m2 : 0.0;
+    if (!(mu0 > 0 && mu > 0))
+        return 0.0;
+    /* The model through its own interface, at the exact i, e and g. */
+    struct nc_photometry geo = {mu0, mu, -nc_v3_dot(s->sun.direction, d), 1.0};
+    double refl;
+    nc_material_eval(&s->body[0].material, 1, &geo, &refl);
+    return refl * s->sun.irradiance_w_m2;
 }
 
 static void compare(const char *label, const struct nc_scene *s)
@@ -86,15 +94,18 @@ static void compare(const char *label, const struct nc_scene *s)
 int main(void)
 {
     const double phases_deg[] = {0, 30, 90, 150};
-    for (int shape = 0; shape < 2; shape++)
+    for (int shape = 0; shape < 4; shape++)
         for (size_t k = 0; k < sizeof phases_deg / sizeof phases_deg[0]; k++) {
             double g = phases_deg[k] * M_PI / 180;
             char sun[128], label[64];
             /* The Sun turns about the body y axis away from the camera direction (-z). */
             snprintf(sun, sizeof sun, "sun.direction=[%.17g, 0, %.17g]", sin(g), -cos(g));
-            const char *sets[4] = {sun};
+            const char *sets[5] = {sun};
             int nsets = 1;
-            if (shape == 1) {
+            if (shape >= 2) /* a model in which e and g matter: Hapke, rough, with opposition surge */
+                sets[nsets++] = shape == 2 ? "bodies.0.material={preset: comet_67p}"
+                                           : "bodies.0.material={preset: moon, B_C0: 0.5, h_C: 0.02}";
+            if (shape == 1 || shape == 3) {
                 sets[nsets++] = "bodies.0.shape.radii_m=[1300, 800, 600]";
                 /* A rotated body and an off-axis camera pose. */
                 sets[nsets++] = "bodies.0.attitude_q=[0.9238795325112867, 0.0, 0.3826834323650898, 0.0]";
@@ -102,7 +113,9 @@ int main(void)
             }
             struct nc_scene s;
             nc_test_scene(yaml, sets, nsets, &s);
-            snprintf(label, sizeof label, "%s, phase %3.0f deg", shape ? "ellipsoid" : "sphere", phases_deg[k]);
+            static const char *const names[] = {"Lambert sphere", "Lambert ellipsoid", "Hapke 67P sphere",
+                                                "Hapke Moon+CBOE ellipsoid"};
+            snprintf(label, sizeof label, "%s, phase %3.0f deg", names[shape], phases_deg[k]);
             compare(label, &s);
             nc_scene_free(&s);
         }

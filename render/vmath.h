@@ -1,0 +1,18 @@
+/* vmath.h - elementary functions over arrays, in place, for the batched
+ * reflectance models: the hot path of a Hapke render is its exp, log and
+ * acos calls. Implemented with SLEEF's AVX2 functions (1-ulp accuracy) where
+ * the CPU has AVX2 and FMA, else with libm; CMake picks the file
+ * (vmath_sleef.c on x86-64 with SLEEF, vmath_libm.c elsewhere). On one
+ * machine the choice never changes, so results are reproducible. */
+#ifndef NC_VMATH_H
+#define NC_VMATH_H
+
+#include <stddef.h>
+
+void nc_vexp(double *x, size_t n);
+void nc_vlog(double *x, size_t n);
+void nc_vacos(double *x, size_t n);
+/* Which implementation runs here, for logs and benchmarks. */
+const char *nc_vmath_impl(void);
+
+#endif

@@ -1,0 +1,24 @@
+/* vmath_libm.c - vmath.h with the C library: the portable fallback. */
+#include <math.h>
+
+#include "vmath.h"
+
+void nc_vexp(double *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        x[i] = exp(x[i]);
+}
+
+void nc_vlog(double *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        x[i] = log(x[i]);
+}
+
+void nc_vacos(double *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        x[i] = acos(x[i]);
+}
+
+const char *nc_vmath_impl(void) { return "libm"; }
