@@ -56,7 +56,7 @@ static const char render_help[] =
     "  -s, --set KEY=VALUE    override any configuration key by its dotted path;\n"
     "                         VALUE is YAML. Repeatable. Lists index by number:\n"
     "                           --set camera.position_m=[0,0,-5000]\n"
-    "                           --set bodies.0.material.A=0.12\n"
+    "                           --set bodies.0.material.w=0.07\n"
     "                           --set render.samples_per_pixel=16\n"
     "  -j, --threads N        render threads (default: render.threads, else all\n"
     "                         cores); the image does not depend on N\n"

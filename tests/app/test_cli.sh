@@ -46,7 +46,7 @@ done
 # A scene file plus overrides; the printed scene is itself a valid scene.
 "$navcam" scene > "$tmp/scene.yaml"
 expect 0 "wrote" -- "$navcam" render "$tmp/scene.yaml" -o "$tmp/s.exr" "${small[@]}" \
-  --set camera.position_m=[0,-4000,0] --set bodies.0.material.A=0.2
+  --set camera.position_m=[0,-4000,0] --set bodies.0.material.w=0.07
 
 # Config errors: file, line, key and what was expected; exit 1.
 printf 'bodies:\n  - shape: {type: sphere, radius_m: 100}\n    material: {model: lambert, A: 0.1}\nsun: {direction: [1, 0, 0]}\ncamera:\n  width_px: 32\n  height_px: 32\n  fx_px: 40\n  fy_px: 40\n  position_m: [0, 0, -500]\n  attitude_q: [1, 0, 0, 0]\n  shutter: global\n' > "$tmp/bad.yaml"
