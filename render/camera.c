@@ -1,6 +1,7 @@
 /* camera.c - reading the camera section of a scene configuration. */
 #include "camera.h"
 
+#include <math.h>
 #include <stdio.h>
 
 #include "error.h"
@@ -31,6 +32,7 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
             return nc_cfg_missing(map, hf ? "pixel_pitch_m" : "focal_length_m",
                                   "focal_length_m and pixel_pitch_m together (metres)");
         c->fx_px = c->fy_px = f / pitch;
+        c->focal_length_m = f;
     } else if (hfx || hfy) {
         if (!hfx || !hfy)
             return nc_cfg_missing(map, hfx ? "fy_px" : "fx_px", "fx_px and fy_px together (pixels)");
@@ -45,6 +47,29 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
         (rc = nc_cfg_double(map, "cy_px", -1e6, 1e6, &c->cy_px)) < 0)
         return rc;
 
+    struct nc_cfg_node *dist;
+    if ((rc = nc_cfg_map(map, "distortion", &dist)) < 0)
+        return rc;
+    if (rc) {
+        const char *keys[] = {"k1", "k2", "k3", "p1", "p2"};
+        double *vals[] = {&c->k1, &c->k2, &c->k3, &c->p1, &c->p2};
+        for (int i = 0; i < 5; i++)
+            if ((rc = nc_cfg_double(dist, keys[i], -100, 100, vals[i])) < 0)
+                return rc;
+        c->distorted = c->k1 != 0 || c->k2 != 0 || c->k3 != 0 || c->p1 != 0 || c->p2 != 0;
+        /* The inversion must be unique over the image: check the round trip at
+         * the corners and edge midpoints. */
+        const double pts[][2] = {{0, 0}, {c->width_px - 1.0, 0}, {0, c->height_px - 1.0},
+                                 {c->width_px - 1.0, c->height_px - 1.0}, {0.5 * c->width_px, 0}, {0, 0.5 * c->height_px}};
+        for (int i = 0; i < 6; i++) {
+            double x, y;
+            struct nc_vec3 d = nc_camera_ray(c, pts[i][0], pts[i][1]);
+            if (nc_camera_project(c, d, &x, &y) < 0 || fabs(x - pts[i][0]) > 1e-6 || fabs(y - pts[i][1]) > 1e-6)
+                return nc_cfg_error(dist, "this distortion cannot be inverted at pixel (%g, %g): the lens model folds "
+                                          "over inside the image",
+                                    pts[i][0], pts[i][1]);
+        }
+    }
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
     struct nc_vec3 target, up = nc_v3(0, 0, 1);
@@ -66,5 +91,53 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
     } else if (!hq) {
         return nc_cfg_missing(map, "attitude_q", "[w, x, y, z] camera-to-scene, or look_at_m");
     }
+    return 0;
+}
+
+/* Distort normalised coordinates (x, y) -> (xd, yd), with the Jacobian. */
+static void distort(const struct nc_camera *c, double x, double y, double *xd, double *yd, double J[2][2])
+{
+    double r2 = x * x + y * y, rad = 1 + r2 * (c->k1 + r2 * (c->k2 + r2 * c->k3));
+    double drad = c->k1 + r2 * (2 * c->k2 + 3 * c->k3 * r2); /* d rad / d r2 */
+    *xd = x * rad + 2 * c->p1 * x * y + c->p2 * (r2 + 2 * x * x);
+    *yd = y * rad + c->p1 * (r2 + 2 * y * y) + 2 * c->p2 * x * y;
+    if (J) {
+        J[0][0] = rad + 2 * x * x * drad + 2 * c->p1 * y + 6 * c->p2 * x;
+        J[0][1] = 2 * x * y * drad + 2 * c->p1 * x + 2 * c->p2 * y;
+        J[1][0] = 2 * x * y * drad + 2 * c->p1 * x + 2 * c->p2 * y;
+        J[1][1] = rad + 2 * y * y * drad + 6 * c->p1 * y + 2 * c->p2 * x;
+    }
+}
+
+struct nc_vec3 nc_camera_ray(const struct nc_camera *c, double px, double py)
+{
+    double xd = (px - c->cx_px) / c->fx_px, yd = (py - c->cy_px) / c->fy_px;
+    if (!c->distorted)
+        return nc_v3(xd, yd, 1.0);
+    /* Newton on distort(x, y) = (xd, yd), from the distorted point. */
+    double x = xd, y = yd;
+    for (int it = 0; it < 50; it++) {
+        double fx, fy, J[2][2];
+        distort(c, x, y, &fx, &fy, J);
+        double ex = fx - xd, ey = fy - yd, det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+        if (!(fabs(det) > 1e-300))
+            break;
+        double dx = (J[1][1] * ex - J[0][1] * ey) / det, dy = (J[0][0] * ey - J[1][0] * ex) / det;
+        x -= dx;
+        y -= dy;
+        if (fabs(dx) + fabs(dy) < 1e-15 * (1 + fabs(x) + fabs(y)))
+            break;
+    }
+    return nc_v3(x, y, 1.0);
+}
+
+int nc_camera_project(const struct nc_camera *c, struct nc_vec3 d, double *px, double *py)
+{
+    if (!(d.z > 0))
+        return -1;
+    double xd, yd;
+    distort(c, d.x / d.z, d.y / d.z, &xd, &yd, NULL);
+    *px = c->fx_px * xd + c->cx_px;
+    *py = c->fy_px * yd + c->cy_px;
     return 0;
 }

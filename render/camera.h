@@ -15,15 +15,31 @@
 struct nc_camera {
     int width_px, height_px;
     double fx_px, fy_px, cx_px, cy_px;
+    /* Brown-Conrady distortion on normalised coordinates (x, y) = (X/Z, Y/Z):
+     * r^2 = x^2 + y^2,
+     * x_d = x (1 + k1 r^2 + k2 r^4 + k3 r^6) + 2 p1 x y + p2 (r^2 + 2 x^2),
+     * y_d = y (1 + k1 r^2 + k2 r^4 + k3 r^6) + p1 (r^2 + 2 y^2) + 2 p2 x y,
+     * pixel = (fx x_d + cx, fy y_d + cy) (the OpenCV convention). */
+    double k1, k2, k3, p1, p2;
+    int distorted;
+    double focal_length_m; /* 0 when the camera is given by fx_px/fy_px */
     struct nc_vec3 position_m; /* scene frame */
     struct nc_quat attitude_q; /* camera -> scene */
 };
 
-/* Unnormalised direction, camera frame, through pixel coordinates (x, y). */
+/* Unnormalised direction, camera frame, through pixel coordinates (x, y) of
+ * the undistorted pinhole (no lens distortion applied). */
 static inline struct nc_vec3 nc_camera_dir(const struct nc_camera *c, double x, double y)
 {
     return nc_v3((x - c->cx_px) / c->fx_px, (y - c->cy_px) / c->fy_px, 1.0);
 }
+
+/* The ray (camera frame, unnormalised, z = 1) that the lens images onto
+ * pixel coordinates (x, y): the distortion is inverted exactly (Newton). */
+struct nc_vec3 nc_camera_ray(const struct nc_camera *c, double x, double y);
+/* Pixel coordinates of camera-frame direction d (d.z > 0); returns -1 when
+ * d is behind the camera. */
+int nc_camera_project(const struct nc_camera *c, struct nc_vec3 d, double *x, double *y);
 
 /* Read the "camera" section. */
 int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c);

@@ -82,6 +82,7 @@ struct job {
     struct nc_rt *rt;
     struct nc_frame *f;
     struct nc_vec3 d00, ex, ey; /* scene-frame ray direction = d00 + x ex + y ey (unnormalised) */
+    struct nc_mat3 cam_R;       /* camera -> scene */
     struct nc_mat3 body_R[NC_MAX_BODIES];      /* body -> scene */
     struct nc_vec3 body_rel[NC_MAX_BODIES];    /* body origin - camera, scene frame, m */
     int tiles_x, tiles_y, n_strata;
@@ -125,11 +126,14 @@ static void shade_tile(struct job *j, int tile)
                         ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)sidx)) / n - 0.5;
                         oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)sidx + 1)) / n - 0.5;
                     }
-                    /* R * ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per frame. */
                     double fx = px + ox, fy = py + oy;
-                    struct nc_vec3 d = nc_v3_unit(nc_v3(j->d00.x + fx * j->ex.x + fy * j->ey.x,
-                                                        j->d00.y + fx * j->ex.y + fy * j->ey.y,
-                                                        j->d00.z + fx * j->ex.z + fy * j->ey.z));
+                    struct nc_vec3 d;
+                    if (c->distorted) { /* the lens model, inverted exactly for this sample */
+                        d = nc_v3_unit(nc_mat_mul_v(&j->cam_R, nc_camera_ray(c, fx, fy)));
+                    } else { /* R ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per frame */
+                        d = nc_v3_unit(nc_v3(j->d00.x + fx * j->ex.x + fy * j->ey.x, j->d00.y + fx * j->ex.y + fy * j->ey.y,
+                                             j->d00.z + fx * j->ex.z + fy * j->ey.z));
+                    }
                     dir[i] = d;
                     ray.ox[i] = ray.oy[i] = ray.oz[i] = 0.0f;
                     ray.dx[i] = (float)d.x;
@@ -270,6 +274,7 @@ int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_f
         j.body_rel[b] = nc_v3_sub(s->body[b].position_m, c->position_m);
     }
     struct nc_mat3 R = nc_quat_to_mat(c->attitude_q);
+    j.cam_R = R;
     j.d00 = nc_mat_mul_v(&R, nc_camera_dir(c, 0, 0));
     j.ex = nc_mat_mul_v(&R, nc_v3(1.0 / c->fx_px, 0, 0));
     j.ey = nc_mat_mul_v(&R, nc_v3(0, 1.0 / c->fy_px, 0));
