@@ -14,6 +14,7 @@
 #include "frame_io.h"
 #include "image_io.h"
 #include "material.h"
+#include "camsys.h"
 #include "render.h"
 #include "scene.h"
 #include "version.h"
@@ -26,6 +27,7 @@ static const char main_help[] =
     "\n"
     "Commands:\n"
     "  render [SCENE.yaml] -o OUT   render one frame to an image file\n"
+    "  expose CAMERA.yaml -o OUT    frames of a uniform radiance field through the camera model\n"
     "  scene                        print the built-in default scene (a starting point)\n"
     "  brdf --model NAME ...        evaluate a reflectance model (CSV in, CSV out)\n"
     "\n"
@@ -50,9 +52,15 @@ static const char render_help[] =
     "                           .png             16-bit linear preview, 65535 = the\n"
     "                                            brightest pixel; the scale is in the\n"
     "                                            file's metadata (navcam:preview_scale)\n"
-    "  -q, --quantity Q       radiance  W m^-2 sr^-1 (default)\n"
-    "                         iof       I/F = pi * radiance / solar irradiance\n"
-    "                         range     distance camera-surface, m (0 = sky)\n"
+    "  -q, --quantity Q       radiance   W m^-2 sr^-1 (default)\n"
+    "                         iof        I/F = pi * radiance / solar irradiance\n"
+    "                         range      distance camera-surface, m (0 = sky)\n"
+    "                         electrons  noise-free photo-electrons through the optics\n"
+    "                                    and PSF: the ground truth of a DN frame\n"
+    "                         dn         the digitised frame: noise, full well, gain,\n"
+    "                                    bias, ADC (16-bit files; 8-bit for an 8-bit ADC)\n"
+    "  -e, --exposure T       exposure time in seconds (default: exposure.time_s)\n"
+    "  -f, --frame N          frame number: keys the noise (default 0)\n"
     "  -s, --set KEY=VALUE    override any configuration key by its dotted path;\n"
     "                         VALUE is YAML. Repeatable. Lists index by number:\n"
     "                           --set camera.position_m=[0,0,-5000]\n"
@@ -80,23 +88,63 @@ static int fail(const char *cmd)
     return 1;
 }
 
+/* Electrons (float) or a digitised frame of a rendered radiance image. */
+static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
+                              const struct nc_camsys *cs, double exposure, unsigned long long frame_no, double *scale)
+{
+    size_t n = (size_t)f->width_px * (size_t)f->height_px;
+    float *e = malloc(n * sizeof *e);
+    uint16_t *dn = malloc(n * sizeof *dn);
+    struct nc_image_attr attrs[32];
+    char text[32][200];
+    int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
+    int na = nc_frame_meta(s, q, attrs, text, 32);
+    na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 32 - na);
+    if (rc >= 0 && q == NC_Q_ELECTRONS)
+        rc = nc_image_write(out, e, f->width_px, f->height_px, attrs, na, scale);
+    else if (rc >= 0 && (rc = nc_camsys_digitise(cs, e, exposure, frame_no, dn)) >= 0)
+        rc = nc_image_write_dn(out, dn, f->width_px, f->height_px, cs->sensor.adc_bits, attrs, na);
+    free(e);
+    free(dn);
+    return rc;
+}
+
 static int cmd_render(int argc, char **argv)
 {
     static const struct option opts[] = {
         {"output", required_argument, NULL, 'o'}, {"quantity", required_argument, NULL, 'q'},
         {"set", required_argument, NULL, 's'},    {"threads", required_argument, NULL, 'j'},
+        {"exposure", required_argument, NULL, 'e'}, {"frame", required_argument, NULL, 'f'},
         {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
     };
     const char *out = NULL, *scene_path = NULL;
+    double exposure = -1;
+    unsigned long long frame_no = 0;
     const char **sets = calloc((size_t)argc, sizeof *sets);
     int nsets = 0, threads = 0, c;
     enum nc_quantity q = NC_Q_RADIANCE;
     if (!sets)
         return 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:q:s:j:h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:q:s:j:e:f:h", opts, NULL)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
+        case 'e':
+        case 'f': {
+            char *end;
+            double v = strtod(optarg, &end);
+            if (*end || !(v >= 0) || !isfinite(v) || (c == 'e' && v > 3600) || (c == 'f' && v != floor(v))) {
+                fprintf(stderr, "navcam render: --%s expects %s, got '%s'\n", c == 'e' ? "exposure" : "frame",
+                        c == 'e' ? "seconds in 0..3600" : "a whole number >= 0", optarg);
+                free(sets);
+                return 2;
+            }
+            if (c == 'e')
+                exposure = v;
+            else
+                frame_no = (unsigned long long)v;
+            break;
+        }
         case 's': sets[nsets++] = optarg; break;
         case 'j': {
             char *end;
@@ -142,10 +190,13 @@ static int cmd_render(int argc, char **argv)
         return 1;
     }
     struct nc_scene scene;
-    int rc = nc_scene_load(scene_path, sets, nsets, &scene);
+    struct nc_camsys cs;
+    int rc = nc_setup_load(scene_path, sets, nsets, &scene, &cs);
     free(sets);
     if (rc < 0)
         return fail("render");
+    if (exposure < 0)
+        exposure = cs.exposure_s;
     struct nc_renderer r;
     struct nc_frame f = {0};
     double t0 = now_ms();
@@ -158,8 +209,10 @@ static int cmd_render(int argc, char **argv)
     if (rc >= 0)
         rc = nc_render_frame(&r, &scene, &f);
     double t2 = now_ms(), scale = 0;
-    if (rc >= 0)
+    if (rc >= 0 && q <= NC_Q_RANGE)
         rc = nc_frame_write(out, &f, q, &scene, &scale);
+    else if (rc >= 0)
+        rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, &scale);
     if (rc >= 0) {
         printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d threads; scene setup %.1f ms, render %.1f ms\n", out,
                f.width_px, f.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
@@ -170,6 +223,7 @@ static int cmd_render(int argc, char **argv)
     nc_frame_free(&f);
     nc_renderer_free(&r);
     nc_scene_free(&scene);
+    nc_camsys_free(&cs);
     return rc < 0 ? fail("render") : 0;
 }
 
@@ -372,6 +426,140 @@ out:
     return rc;
 }
 
+static const char expose_help[] =
+    "Usage: navcam expose CAMERA.yaml --radiance L --exposure T [--frames N] [--dark] -o OUT\n"
+    "\n"
+    "Apply the camera model (optics, PSF, detector, ADC) to a uniform radiance field\n"
+    "and write N digitised frames: how a camera engineer checks a configuration and\n"
+    "characterises it (photon transfer, dark current, linearity).\n"
+    "\n"
+    "  CAMERA.yaml            camera (intrinsics), optics, sensor and exposure sections;\n"
+    "                         a whole scene file works too (its pose, bodies and Sun\n"
+    "                         are ignored)\n"
+    "  -L, --radiance L       uniform scene radiance, W m^-2 sr^-1\n"
+    "  -e, --exposure T       exposure time, seconds (default: exposure.time_s)\n"
+    "  -n, --frames N         number of frames (default 1), numbered from --first-frame\n"
+    "      --first-frame K    frame number of the first frame (keys the noise; default 0)\n"
+    "  -d, --dark             dark frames: no light (radiance 0)\n"
+    "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N), 16-bit unsigned;\n"
+    "                         .png/.tif/.exr: numbered files OUT_0000.ext, OUT_0001.ext, ...\n"
+    "  -s, --set KEY=VALUE    override a configuration key (repeatable)\n"
+    "  -h, --help             this help\n"
+    "\n"
+    "The noise of frame k depends only on the sensor seed and k: rerunning a command\n"
+    "reproduces its frames bit for bit.\n"
+    "Example:\n"
+    "  navcam expose configs/examples/navcam_camera.yaml -L 5 -e 0.002 -n 16 -o flat.fits\n";
+
+static int cmd_expose(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"radiance", required_argument, NULL, 'L'}, {"exposure", required_argument, NULL, 'e'},
+        {"frames", required_argument, NULL, 'n'},   {"first-frame", required_argument, NULL, 'F'},
+        {"dark", no_argument, NULL, 'd'},           {"output", required_argument, NULL, 'o'},
+        {"set", required_argument, NULL, 's'},      {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+    };
+    const char *out = NULL, *cam_path = NULL;
+    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+    double L = -1, T = -1, nframes = 1, first = 0;
+    int nsets = 0, dark = 0, c, rc = 2;
+    if (!sets)
+        return 1;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "L:e:n:do:s:h", opts, NULL)) != -1) {
+        char *end;
+        double v = 0;
+        if (c == 'L' || c == 'e' || c == 'n' || c == 'F') {
+            v = strtod(optarg, &end);
+            if (*end || !isfinite(v) || v < 0 || ((c == 'n' || c == 'F') && v != floor(v)) || (c == 'n' && (v < 1 || v > 100000))) {
+                fprintf(stderr, "navcam expose: bad value '%s' for --%s\n", optarg,
+                        c == 'L' ? "radiance" : c == 'e' ? "exposure" : c == 'n' ? "frames" : "first-frame");
+                goto out;
+            }
+        }
+        switch (c) {
+        case 'L': L = v; break;
+        case 'e': T = v; break;
+        case 'n': nframes = v; break;
+        case 'F': first = v; break;
+        case 'd': dark = 1; break;
+        case 'o': out = optarg; break;
+        case 's': sets[nsets++] = optarg; break;
+        case 'h': fputs(expose_help, stdout); rc = 0; goto out;
+        default: fputs("Try 'navcam expose --help'.\n", stderr); goto out;
+        }
+    }
+    if (optind < argc)
+        cam_path = argv[optind++];
+    if (!cam_path || optind < argc || !out || (L < 0 && !dark)) {
+        fprintf(stderr, "navcam expose: %s\nTry 'navcam expose --help'.\n",
+                !cam_path ? "missing CAMERA.yaml" : !out ? "missing -o OUT" : optind < argc ? "more than one camera file"
+                                                                                          : "missing --radiance L (or --dark)");
+        goto out;
+    }
+    if (!nc_image_format_ok(out, NULL)) {
+        fprintf(stderr, "navcam expose: %s: unsupported output format (use .fits, .png, .tif or .exr)\n", out);
+        goto out;
+    }
+    struct nc_camera geom;
+    struct nc_camsys cs;
+    rc = 1;
+    if (nc_camsys_load(cam_path, sets, nsets, &geom, &cs) < 0) {
+        fprintf(stderr, "navcam expose: %s\n", nc_errmsg());
+        goto out;
+    }
+    if (T < 0)
+        T = cs.exposure_s;
+    if (dark)
+        L = 0;
+    size_t n = (size_t)geom.width_px * (size_t)geom.height_px, nf = (size_t)nframes;
+    float *rad = malloc(n * sizeof *rad), *e = malloc(n * sizeof *e);
+    uint16_t *dn = malloc(n * nf * sizeof *dn);
+    int ok = rad && e && dn;
+    for (size_t i = 0; ok && i < n; i++)
+        rad[i] = (float)L;
+    ok = ok && nc_camsys_electrons(&cs, rad, T, e) >= 0;
+    int is_fits = strstr(out, ".fits") || strstr(out, ".fit") || strstr(out, ".fts");
+    struct nc_image_attr attrs[16];
+    char text[16][200], ltxt[64], ntxt[32];
+    snprintf(ltxt, sizeof ltxt, "%.17g", L);
+    snprintf(ntxt, sizeof ntxt, "%zu", nf);
+    for (size_t k = 0; ok && k < nf; k++) {
+        uint64_t fno = (uint64_t)first + k;
+        ok = nc_camsys_digitise(&cs, e, T, fno, dn + k * n) >= 0;
+        if (ok && !is_fits) {
+            char path[4200];
+            const char *dot = strrchr(out, '.');
+            snprintf(path, sizeof path, "%.*s_%04llu%s", (int)(dot - out), out, (unsigned long long)fno, dot);
+            int na = nc_camsys_meta(&cs, T, fno, attrs, text, 16);
+            attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
+            ok = nc_image_write_dn(path, dn + k * n, geom.width_px, geom.height_px, cs.sensor.adc_bits, attrs, na) >= 0;
+            if (ok)
+                printf("wrote %s\n", path);
+        }
+    }
+    if (ok && is_fits) {
+        int na = nc_camsys_meta(&cs, T, (uint64_t)first, attrs, text, 16);
+        attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
+        attrs[na++] = (struct nc_image_attr){"navcam:frames", ntxt};
+        ok = nc_image_write_dn_cube(out, dn, geom.width_px, geom.height_px, (int)nf, cs.sensor.adc_bits, attrs, na) >= 0;
+        if (ok)
+            printf("wrote %s: %zu frames of %dx%d, %d-bit, radiance %g W m^-2 sr^-1, exposure %g s\n", out, nf,
+                   geom.width_px, geom.height_px, cs.sensor.adc_bits, L, T);
+    }
+    if (!ok)
+        fprintf(stderr, "navcam expose: %s\n", nc_errmsg()[0] ? nc_errmsg() : "out of memory");
+    rc = ok ? 0 : 1;
+    free(rad);
+    free(e);
+    free(dn);
+    nc_camsys_free(&cs);
+out:
+    free(sets);
+    return rc;
+}
+
 static int cmd_scene(int argc, char **argv)
 {
     if (argc > 1 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
@@ -407,6 +595,8 @@ int main(int argc, char **argv)
         return cmd_scene(argc - 1, argv + 1);
     if (!strcmp(cmd, "brdf"))
         return cmd_brdf(argc - 1, argv + 1);
+    if (!strcmp(cmd, "expose"))
+        return cmd_expose(argc - 1, argv + 1);
     fprintf(stderr, "navcam: unknown command '%s'\n\n%s", cmd, main_help);
     return 2;
 }

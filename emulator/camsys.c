@@ -357,8 +357,9 @@ int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, doubl
     if (!tmp)
         return nc_error(-ENOMEM, "out of memory");
     for (size_t p = 0; p < n; p++) {
+        /* Far beyond any full well, charge is capped: a float must hold it. */
         double v = (double)radiance[p] * cs->response[p] * exposure_s;
-        tmp[p] = isfinite(v) && v > 0 ? (float)v : 0.0f;
+        tmp[p] = isfinite(v) && v > 0 ? (float)fmin(v, 1e30) : 0.0f;
     }
     if (tmp != electrons) {
         int rc = nc_psf_apply(&cs->optics.psf, tmp, electrons, cs->width_px, cs->height_px);

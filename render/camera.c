@@ -3,12 +3,14 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "error.h"
 
-int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
+int nc_camera_intrinsics_from_config(struct nc_cfg_node *map, struct nc_camera *c)
 {
     int rc;
+    memset(c, 0, sizeof *c);
     long w = 0, h = 0;
     if ((rc = nc_cfg_int(map, "width_px", 1, 16384, &w)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "width_px", "image width in pixels");
@@ -70,6 +72,14 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
                                     pts[i][0], pts[i][1]);
         }
     }
+    return 0;
+}
+
+int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
+{
+    int rc = nc_camera_intrinsics_from_config(map, c);
+    if (rc < 0)
+        return rc;
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
     struct nc_vec3 target, up = nc_v3(0, 0, 1);

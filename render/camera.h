@@ -41,7 +41,9 @@ struct nc_vec3 nc_camera_ray(const struct nc_camera *c, double x, double y);
  * d is behind the camera. */
 int nc_camera_project(const struct nc_camera *c, struct nc_vec3 d, double *x, double *y);
 
-/* Read the "camera" section. */
+/* Read the "camera" section: intrinsics, distortion and pose. */
 int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c);
+/* Intrinsics and distortion only (a camera without a pose: `navcam expose`). */
+int nc_camera_intrinsics_from_config(struct nc_cfg_node *map, struct nc_camera *c);
 
 #endif

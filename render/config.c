@@ -602,3 +602,10 @@ int nc_cfg_check_unused(struct nc_cfg *cfg)
         return 0;
     return nc_cfg_error(u, "unknown key (see docs/config.md for the keys this section takes)");
 }
+
+void nc_cfg_mark_used(struct nc_cfg_node *n)
+{
+    n->used = 1;
+    for (size_t i = 0; i < n->nchild; i++)
+        nc_cfg_mark_used(n->child[i]);
+}

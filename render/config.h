@@ -63,6 +63,9 @@ int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...) __attribu
 int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected);
 /* Dotted path of a node, e.g. "bodies[0].shape.radius_m". */
 void nc_cfg_path(const struct nc_cfg_node *node, char *buf, size_t len);
+/* Mark a node and everything below it as consumed (sections a reader
+ * deliberately ignores). */
+void nc_cfg_mark_used(struct nc_cfg_node *node);
 /* First node (depth-first, in file order) that no reader consumed: an error. */
 int nc_cfg_check_unused(struct nc_cfg *cfg);
 

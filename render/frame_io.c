@@ -8,11 +8,11 @@
 #include "image_io.h"
 #include "version.h"
 
-const char *const nc_quantity_names[] = {"radiance", "iof", "range", NULL};
+const char *const nc_quantity_names[] = {"radiance", "iof", "range", "electrons", "dn", NULL};
 
 const char *nc_quantity_units(enum nc_quantity q)
 {
-    static const char *const u[] = {"W m^-2 sr^-1", "1 (I/F)", "m"};
+    static const char *const u[] = {"W m^-2 sr^-1", "1 (I/F)", "m", "e-", "DN"};
     return u[q];
 }
 
@@ -23,32 +23,33 @@ int nc_quantity_parse(const char *name, enum nc_quantity *q)
             *q = (enum nc_quantity)i;
             return 0;
         }
-    return nc_error(NC_EUSAGE, "unknown quantity '%s' (expected radiance, iof or range)", name);
+    return nc_error(NC_EUSAGE, "unknown quantity '%s' (expected radiance, iof, range, electrons or dn)", name);
 }
 
-int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
-                   double *preview_scale)
+int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_attr *attrs, char (*v)[200], int max)
 {
     const struct nc_camera *c = &s->camera;
     const struct nc_body *b0 = &s->body[0];
-    char v[12][200];
     struct nc_vec3 sun_dir;
     double sun_irr;
+    if (max < 15)
+        return 0;
     nc_scene_sun_at(s, b0->position_m, &sun_dir, &sun_irr);
-    snprintf(v[0], sizeof v[0], "NavCam %s", NC_VERSION_STRING);
-    snprintf(v[1], sizeof v[1], "%s", nc_quantity_names[q]);
-    snprintf(v[2], sizeof v[2], "%s", nc_quantity_units(q));
-    snprintf(v[3], sizeof v[3], "[%.17g, %.17g, %.17g]", c->position_m.x, c->position_m.y, c->position_m.z);
-    snprintf(v[4], sizeof v[4], "[%.17g, %.17g, %.17g, %.17g]", c->attitude_q.w, c->attitude_q.x, c->attitude_q.y,
+    snprintf(v[0], 200, "NavCam %s", NC_VERSION_STRING);
+    snprintf(v[1], 200, "%s", nc_quantity_names[q]);
+    snprintf(v[2], 200, "%s", nc_quantity_units(q));
+    snprintf(v[3], 200, "[%.17g, %.17g, %.17g]", c->position_m.x, c->position_m.y, c->position_m.z);
+    snprintf(v[4], 200, "[%.17g, %.17g, %.17g, %.17g]", c->attitude_q.w, c->attitude_q.x, c->attitude_q.y,
              c->attitude_q.z);
-    snprintf(v[5], sizeof v[5], "[%.17g, %.17g, %.17g]", sun_dir.x, sun_dir.y, sun_dir.z);
-    snprintf(v[6], sizeof v[6], "%.17g", sun_irr);
-    snprintf(v[7], sizeof v[7], "[%.17g, %.17g, %.17g, %.17g]", c->fx_px, c->fy_px, c->cx_px, c->cy_px);
-    snprintf(v[8], sizeof v[8], "%d", s->render.samples_per_pixel);
-    snprintf(v[9], sizeof v[9], "[%.17g, %.17g, %.17g]", b0->position_m.x, b0->position_m.y, b0->position_m.z);
-    snprintf(v[10], sizeof v[10], "[%.17g, %.17g, %.17g, %.17g]", b0->attitude_q.w, b0->attitude_q.x,
-             b0->attitude_q.y, b0->attitude_q.z);
-    const struct nc_image_attr attrs[] = {
+    snprintf(v[5], 200, "[%.17g, %.17g, %.17g]", sun_dir.x, sun_dir.y, sun_dir.z);
+    snprintf(v[6], 200, "%.17g", sun_irr);
+    snprintf(v[7], 200, "[%.17g, %.17g, %.17g, %.17g]", c->fx_px, c->fy_px, c->cx_px, c->cy_px);
+    snprintf(v[8], 200, "%d", s->render.samples_per_pixel);
+    snprintf(v[9], 200, "[%.17g, %.17g, %.17g]", b0->position_m.x, b0->position_m.y, b0->position_m.z);
+    snprintf(v[10], 200, "[%.17g, %.17g, %.17g, %.17g]", b0->attitude_q.w, b0->attitude_q.x, b0->attitude_q.y,
+             b0->attitude_q.z);
+    snprintf(v[11], 200, "[%.17g, %.17g, %.17g, %.17g, %.17g]", c->k1, c->k2, c->k3, c->p1, c->p2);
+    const struct nc_image_attr a[] = {
         {"Software", v[0]},
         {"navcam:version", NC_VERSION_STRING},
         {"navcam:quantity", v[1]},
@@ -60,11 +61,24 @@ int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity 
         {"navcam:sun_direction_scene", v[5]},
         {"navcam:sun_irradiance_w_m2", v[6]},
         {"navcam:intrinsics_fx_fy_cx_cy_px", v[7]},
+        {"navcam:distortion_k1_k2_k3_p1_p2", v[11]},
         {"navcam:samples_per_pixel", v[8]},
         {"navcam:body0_position_m", v[9]},
         {"navcam:body0_attitude_q", v[10]},
     };
+    int n = (int)(sizeof a / sizeof a[0]);
+    memcpy(attrs, a, (size_t)n * sizeof a[0]);
+    return n;
+}
+
+int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
+                   double *preview_scale)
+{
+    if (q > NC_Q_RANGE)
+        return nc_error(NC_EUSAGE, "quantity %s needs the camera model", nc_quantity_names[q]);
+    struct nc_image_attr attrs[24];
+    char text[24][200];
+    int n = nc_frame_meta(s, q, attrs, text, 24);
     const float *px = q == NC_Q_RADIANCE ? f->radiance : q == NC_Q_IOF ? f->iof : f->range_m;
-    return nc_image_write(path, px, f->width_px, f->height_px, attrs, (int)(sizeof attrs / sizeof attrs[0]),
-                          preview_scale);
+    return nc_image_write(path, px, f->width_px, f->height_px, attrs, n, preview_scale);
 }

@@ -4,16 +4,23 @@
 #ifndef NC_FRAME_IO_H
 #define NC_FRAME_IO_H
 
+#include "image_io.h"
 #include "render.h"
 #include "scene.h"
 
-enum nc_quantity { NC_Q_RADIANCE, NC_Q_IOF, NC_Q_RANGE };
+/* radiance, iof and range come from the renderer; electrons (noise-free
+ * photo-electrons) and dn (a digitised frame) need the camera model. */
+enum nc_quantity { NC_Q_RADIANCE, NC_Q_IOF, NC_Q_RANGE, NC_Q_ELECTRONS, NC_Q_DN };
 
 extern const char *const nc_quantity_names[]; /* NULL-terminated, enum order */
 const char *nc_quantity_units(enum nc_quantity q);
 int nc_quantity_parse(const char *name, enum nc_quantity *q);
 
-/* Write one quantity of f to path (format from the extension). */
+/* The scene's metadata (pose, Sun, intrinsics, version, quantity and units):
+ * fills attrs (up to max, each value stored in text[i]) and returns the count. */
+int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_attr *attrs, char (*text)[200],
+                  int max);
+/* Write radiance, iof or range of f to path (format from the extension). */
 int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
                    double *preview_scale);
 

@@ -35,6 +35,15 @@ static const char *const fits_keys[][2] = {
     {"navcam:body0_position_m", "BODYPOS"},
     {"navcam:body0_attitude_q", "BODYQUAT"},
     {"navcam:preview_scale", "PRVSCALE"},
+    {"navcam:distortion_k1_k2_k3_p1_p2", "DISTORT"},
+    {"navcam:adc_bits", "ADCBITS"},
+    {"navcam:gain_e_per_dn", "GAINEDN"},
+    {"navcam:analog_gain_db", "AGAINDB"},
+    {"navcam:bias_dn", "BIASDN"},
+    {"navcam:exposure_s", "EXPTIME"},
+    {"navcam:frame", "FRAME"},
+    {"navcam:frames", "NFRAMES"},
+    {"navcam:radiance_w_m2_sr", "RADIANCE"},
     {"navcam:preview_rule", "PRVRULE"},
 };
 
@@ -58,14 +67,18 @@ static int fits_fail(const char *path, const char *op, int status)
     return nc_error(NC_EIMAGE, "%s: cfitsio %s: %s", path, op, msg);
 }
 
-int nc__fits_write(const char *path, const float *px, int w, int h, const struct nc_image_attr *attrs, int nattrs)
+int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w, int h, int depth,
+                   const struct nc_image_attr *attrs, int nattrs)
 {
     fitsfile *f = NULL;
     int status = 0;
     char fname[4200];
     snprintf(fname, sizeof fname, "!%s", path); /* '!' = overwrite */
-    long naxes[2] = {w, h};
-    if (fits_create_file(&f, fname, &status) || fits_create_img(f, FLOAT_IMG, 2, naxes, &status))
+    long naxes[3] = {w, h, depth};
+    /* Unsigned 16-bit is BITPIX 16 with BZERO 32768 (cfitsio's USHORT_IMG). */
+    int bitpix = type == NC__PX_FLOAT ? FLOAT_IMG : type == NC__PX_U16 ? USHORT_IMG : BYTE_IMG;
+    int dtype = type == NC__PX_FLOAT ? TFLOAT : type == NC__PX_U16 ? TUSHORT : TBYTE;
+    if (fits_create_file(&f, fname, &status) || fits_create_img(f, bitpix, depth > 1 ? 3 : 2, naxes, &status))
         goto fail;
     fits_write_key_longwarn(f, &status);
     for (int i = 0; i < nattrs && !status; i++) {
@@ -75,7 +88,7 @@ int nc__fits_write(const char *path, const float *px, int w, int h, const struct
     }
     fits_write_comment(f, "Row 1 is the top image row (y = 0, +Y down).", &status);
     fits_write_comment(f, "Each NavCam metadata card carries its attribute name as its comment.", &status);
-    if (status || fits_write_img(f, TFLOAT, 1, (LONGLONG)w * h, (void *)px, &status))
+    if (status || fits_write_img(f, dtype, 1, (LONGLONG)w * h * depth, (void *)px, &status))
         goto fail;
     if (fits_close_file(f, &status))
         return fits_fail(path, "close", status);
@@ -92,9 +105,9 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
 {
     fitsfile *f = NULL;
     int status = 0, naxis = 0;
-    long naxes[2] = {0, 0};
+    long naxes[3] = {0, 0, 1};
     if (fits_open_image(&f, path, READONLY, &status) || fits_get_img_dim(f, &naxis, &status) ||
-        fits_get_img_size(f, 2, naxes, &status)) {
+        fits_get_img_size(f, naxis > 3 ? 3 : naxis, naxes, &status)) {
         int rc = fits_fail(path, "open", status);
         status = 0;
         if (f)

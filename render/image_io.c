@@ -124,14 +124,73 @@ int nc_image_write(const char *path, const float *px, int w, int h, const struct
         goto out;
     }
     if (f == FMT_FITS)
-        rc = nc__fits_write(path, clean, w, h, all, nall);
+        rc = nc__fits_write(path, clean, NC__PX_FLOAT, w, h, 1, all, nall);
     else
-        rc = nc__oiio_write(path, f == FMT_PNG ? (const void *)dn : clean, w, h, f != FMT_PNG, all, nall, desc);
+        rc = nc__oiio_write(path, f == FMT_PNG ? (const void *)dn : clean, w, h, f == FMT_PNG ? NC__PX_U16 : NC__PX_FLOAT,
+                            all, nall, desc);
 out:
     free(clean);
     free(dn);
     free(all);
     free(desc);
+    return rc;
+}
+
+int nc_image_write_dn(const char *path, const uint16_t *dn, int w, int h, int bits, const struct nc_image_attr *attrs,
+                      int nattrs)
+{
+    enum fmt f = format_of(path);
+    if (f == FMT_NONE)
+        return nc_error(NC_EIMAGE, "%s: unsupported output format (use .png, .tif, .fits or .exr)", path);
+    size_t n = (size_t)w * (size_t)h;
+    char *desc = describe(attrs, nattrs);
+    void *buf = NULL;
+    int rc;
+    if (!desc)
+        return nc_error(-ENOMEM, "out of memory");
+    if (f == FMT_EXR) {
+        float *v = malloc((n ? n : 1) * sizeof *v);
+        if (v)
+            for (size_t i = 0; i < n; i++)
+                v[i] = dn[i];
+        buf = v;
+    } else if (bits <= 8) {
+        uint8_t *v = malloc(n ? n : 1);
+        if (v)
+            for (size_t i = 0; i < n; i++)
+                v[i] = (uint8_t)(dn[i] > 255 ? 255 : dn[i]);
+        buf = v;
+    }
+    if (!buf && (f == FMT_EXR || bits <= 8)) {
+        free(desc);
+        return nc_error(-ENOMEM, "out of memory");
+    }
+    enum nc__pixel t = f == FMT_EXR ? NC__PX_FLOAT : bits <= 8 ? NC__PX_U8 : NC__PX_U16;
+    const void *px = buf ? buf : (const void *)dn;
+    if (f == FMT_FITS)
+        rc = nc__fits_write(path, px, t, w, h, 1, attrs, nattrs);
+    else
+        rc = nc__oiio_write(path, px, w, h, t, attrs, nattrs, desc);
+    free(buf);
+    free(desc);
+    return rc;
+}
+
+int nc_image_write_dn_cube(const char *path, const uint16_t *dn, int w, int h, int nframes, int bits,
+                           const struct nc_image_attr *attrs, int nattrs)
+{
+    if (format_of(path) != FMT_FITS)
+        return nc_error(NC_EIMAGE, "%s: a cube of frames needs .fits (or write numbered files)", path);
+    size_t n = (size_t)w * (size_t)h * (size_t)nframes;
+    if (bits > 8)
+        return nc__fits_write(path, dn, NC__PX_U16, w, h, nframes, attrs, nattrs);
+    uint8_t *v = malloc(n ? n : 1);
+    if (!v)
+        return nc_error(-ENOMEM, "out of memory");
+    for (size_t i = 0; i < n; i++)
+        v[i] = (uint8_t)(dn[i] > 255 ? 255 : dn[i]);
+    int rc = nc__fits_write(path, v, NC__PX_U8, w, h, nframes, attrs, nattrs);
+    free(v);
     return rc;
 }
 

@@ -10,6 +10,7 @@
 #define NC_IMAGE_IO_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -26,7 +27,14 @@ int nc_image_format_ok(const char *path, int *is_float);
  * value that 65535 stands for in a 16-bit preview, 0 for float formats. */
 int nc_image_write(const char *path, const float *px, int width, int height, const struct nc_image_attr *attrs,
                    int nattrs, double *preview_scale);
-/* Read the first channel as float (caller frees *px). */
+/* Write digital numbers of an ADC with `bits` bits: 16-bit integers (8-bit
+ * for bits <= 8) in .png, .tif and .fits; exact float32 values in .exr. */
+int nc_image_write_dn(const char *path, const uint16_t *dn, int width, int height, int bits,
+                      const struct nc_image_attr *attrs, int nattrs);
+/* A FITS cube of nframes DN images (NAXIS3 = nframes). */
+int nc_image_write_dn_cube(const char *path, const uint16_t *dn, int width, int height, int nframes, int bits,
+                           const struct nc_image_attr *attrs, int nattrs);
+/* Read the first channel (first plane of a cube) as float (caller frees *px). */
 int nc_image_read(const char *path, float **px, int *width, int *height);
 /* Read one string attribute; 0 on success, negative if absent. */
 int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len);

@@ -9,16 +9,19 @@
 extern "C" {
 #endif
 
-/* px is float32 (is_float) or uint16 data; attrs go into the file as the
- * format allows; description is a JSON object of all attrs. */
-int nc__oiio_write(const char *path, const void *px, int width, int height, int is_float,
+enum nc__pixel { NC__PX_FLOAT, NC__PX_U16, NC__PX_U8 };
+
+/* attrs go into the file as the format allows; description is a JSON object
+ * of all attrs. */
+int nc__oiio_write(const char *path, const void *px, int width, int height, enum nc__pixel type,
                    const struct nc_image_attr *attrs, int nattrs, const char *description);
 int nc__oiio_read(const char *path, float **px, int *width, int *height);
 /* Attribute by name; "ImageDescription" included. */
 int nc__oiio_read_attr(const char *path, const char *name, char *buf, size_t len);
 
-int nc__fits_write(const char *path, const float *px, int width, int height, const struct nc_image_attr *attrs,
-                   int nattrs);
+/* depth > 1 writes a cube of depth planes. */
+int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int width, int height, int depth,
+                   const struct nc_image_attr *attrs, int nattrs);
 int nc__fits_read(const char *path, float **px, int *width, int *height);
 int nc__fits_read_attr(const char *path, const char *name, char *buf, size_t len);
 

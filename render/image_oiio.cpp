@@ -14,10 +14,11 @@ extern "C" {
 
 using namespace OIIO;
 
-extern "C" int nc__oiio_write(const char *path, const void *px, int w, int h, int is_float,
+extern "C" int nc__oiio_write(const char *path, const void *px, int w, int h, enum nc__pixel type,
                               const struct nc_image_attr *attrs, int nattrs, const char *description)
 {
-    ImageSpec spec(w, h, 1, is_float ? TypeDesc::FLOAT : TypeDesc::UINT16);
+    TypeDesc td = type == NC__PX_FLOAT ? TypeDesc::FLOAT : type == NC__PX_U16 ? TypeDesc::UINT16 : TypeDesc::UINT8;
+    ImageSpec spec(w, h, 1, td);
     spec.channelnames = {"Y"};
     spec.attribute("oiio:ColorSpace", "linear");
     for (int i = 0; i < nattrs; i++)
@@ -29,7 +30,7 @@ extern "C" int nc__oiio_write(const char *path, const void *px, int w, int h, in
         return nc_error(NC_EIMAGE, "%s: %s", path, OIIO::geterror().c_str());
     if (!out->open(path, spec))
         return nc_error(NC_EIMAGE, "%s: open for writing: %s", path, out->geterror().c_str());
-    if (!out->write_image(is_float ? TypeDesc::FLOAT : TypeDesc::UINT16, px)) {
+    if (!out->write_image(td, px)) {
         std::string e = out->geterror();
         out->close();
         return nc_error(NC_EIMAGE, "%s: write: %s", path, e.c_str());

@@ -224,6 +224,14 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
 
 int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s)
 {
+    int rc = nc_scene_read(cfg, s);
+    if (rc >= 0 && (rc = nc_cfg_check_unused(cfg)) < 0)
+        nc_scene_free(s);
+    return rc;
+}
+
+int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s)
+{
     memset(s, 0, sizeof *s);
     struct nc_cfg_node *root = cfg->root, *bodies, *sun, *cam, *rnd = NULL;
     int rc;
@@ -252,11 +260,17 @@ int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s)
         goto fail;
     if ((rc = nc_cfg_map(root, "render", &rnd)) < 0 || (rc = render_from_config(rnd, &s->render)) < 0)
         goto fail;
-    if ((rc = nc_cfg_check_unused(cfg)) < 0)
-        goto fail;
     return 0;
 fail:
     nc_scene_free(s);
+    return rc;
+}
+
+int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *sets, int nsets)
+{
+    int rc = path ? nc_cfg_load_file(cfg, path) : nc_cfg_load_string(cfg, nc_default_scene_yaml, "<built-in default scene>");
+    for (int i = 0; rc >= 0 && i < nsets; i++)
+        rc = nc_cfg_set(cfg, sets[i]);
     return rc;
 }
 
@@ -264,9 +278,7 @@ int nc_scene_load(const char *path, const char *const *sets, int nsets, struct n
 {
     struct nc_cfg cfg;
     nc_cfg_init(&cfg);
-    int rc = path ? nc_cfg_load_file(&cfg, path) : nc_cfg_load_string(&cfg, nc_default_scene_yaml, "<built-in default scene>");
-    for (int i = 0; rc >= 0 && i < nsets; i++)
-        rc = nc_cfg_set(&cfg, sets[i]);
+    int rc = nc_cfg_load_scene(&cfg, path, sets, nsets);
     if (rc >= 0)
         rc = nc_scene_from_config(&cfg, s);
     nc_cfg_free(&cfg);

@@ -60,6 +60,11 @@ extern const char nc_default_scene_yaml[];
 
 /* Build a scene from a loaded configuration; every key must be consumed. */
 int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s);
+/* The same without the unknown-key check, for callers that read further
+ * sections (optics, sensor, ...) and check afterwards. */
+int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s);
+/* Load file (NULL = built-in default scene) and apply overrides. */
+int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *sets, int nsets);
 /* Convenience: load file (NULL = built-in default), apply overrides, build. */
 int nc_scene_load(const char *path, const char *const *sets, int nsets, struct nc_scene *s);
 void nc_scene_free(struct nc_scene *s);
