@@ -206,17 +206,23 @@ static int cmd_render(int argc, char **argv)
     }
     double t1 = now_ms();
     rc = nc_frame_alloc(&f, scene.camera.width_px, scene.camera.height_px);
+    /* Motion during the exposure (camera and body rates) and a rolling
+     * shutter are integrated over the exposure window. */
+    struct nc_exposure ex = {.exposure_s = exposure, .rolling = cs.sensor.shutter == NC_SHUTTER_ROLLING,
+                             .line_time_s = cs.sensor.line_time_s};
+    int tsamples = 1;
     if (rc >= 0)
-        rc = nc_render_frame(&r, &scene, &f);
+        rc = nc_render_exposure(&r, &scene, &ex, &f, &tsamples);
     double t2 = now_ms(), scale = 0;
     if (rc >= 0 && q <= NC_Q_RANGE)
         rc = nc_frame_write(out, &f, q, &scene, &scale);
     else if (rc >= 0)
         rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, &scale);
     if (rc >= 0) {
-        printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d threads; scene setup %.1f ms, render %.1f ms\n", out,
-               f.width_px, f.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
-               r.threads, t1 - t0, t2 - t1);
+        printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene setup %.1f ms, "
+               "render %.1f ms\n",
+               out, f.width_px, f.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
+               tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
         if (scale > 0)
             printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));
     }

@@ -80,6 +80,9 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
     int rc = nc_camera_intrinsics_from_config(map, c);
     if (rc < 0)
         return rc;
+    if ((rc = nc_cfg_vec3(map, "velocity_m_s", &c->velocity_m_s)) < 0 ||
+        (rc = nc_cfg_vec3(map, "angular_velocity_rad_s", &c->angular_velocity_rad_s)) < 0)
+        return rc;
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
     struct nc_vec3 target, up = nc_v3(0, 0, 1);

@@ -25,6 +25,8 @@ struct nc_camera {
     double focal_length_m; /* 0 when the camera is given by fx_px/fy_px */
     struct nc_vec3 position_m; /* scene frame */
     struct nc_quat attitude_q; /* camera -> scene */
+    struct nc_vec3 velocity_m_s;         /* scene frame */
+    struct nc_vec3 angular_velocity_rad_s; /* camera frame (as gyros report) */
 };
 
 /* Unnormalised direction, camera frame, through pixel coordinates (x, y) of

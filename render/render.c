@@ -81,11 +81,17 @@ struct job {
     const struct nc_scene *s;
     struct nc_rt *rt;
     struct nc_frame *f;
-    struct nc_vec3 d00, ex, ey; /* scene-frame ray direction = d00 + x ex + y ey (unnormalised) */
-    struct nc_mat3 cam_R;       /* camera -> scene */
+    /* Per image row: the camera at that row's time (a rolling shutter exposes
+     * rows at different times): origin o relative to the frame's camera
+     * position, rotation R, and ray direction = d00 + x ex + y ey. */
+    struct row_cam {
+        struct nc_vec3 o, d00, ex, ey;
+        struct nc_mat3 R;
+    } *row;
     struct nc_mat3 body_R[NC_MAX_BODIES];      /* body -> scene */
     struct nc_vec3 body_rel[NC_MAX_BODIES];    /* body origin - camera, scene frame, m */
     int tiles_x, tiles_y, n_strata;
+    int tile_row_begin, tile_row_end; /* the rows of tiles to render */
     atomic_int next;
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
     struct nc_vec3 sun_dir;
@@ -106,7 +112,7 @@ static void shade_tile(struct job *j, int tile)
     memset(hits, 0, sizeof hits);
 
     struct nc_ray16 ray, shadow;
-    struct nc_vec3 dir[NC_PACKET]; /* the camera rays in double precision */
+    struct nc_vec3 dir[NC_PACKET], orig[NC_PACKET]; /* the camera rays in double precision */
     struct nc_hit16 hit;
     int occluded[NC_PACKET];
     double mu0[NC_PACKET], irr[NC_PACKET];
@@ -127,15 +133,20 @@ static void shade_tile(struct job *j, int tile)
                         oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)sidx + 1)) / n - 0.5;
                     }
                     double fx = px + ox, fy = py + oy;
+                    const struct row_cam *rc = &j->row[py < H ? py : H - 1];
                     struct nc_vec3 d;
                     if (c->distorted) { /* the lens model, inverted exactly for this sample */
-                        d = nc_v3_unit(nc_mat_mul_v(&j->cam_R, nc_camera_ray(c, fx, fy)));
-                    } else { /* R ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per frame */
-                        d = nc_v3_unit(nc_v3(j->d00.x + fx * j->ex.x + fy * j->ey.x, j->d00.y + fx * j->ex.y + fy * j->ey.y,
-                                             j->d00.z + fx * j->ex.z + fy * j->ey.z));
+                        d = nc_v3_unit(nc_mat_mul_v(&rc->R, nc_camera_ray(c, fx, fy)));
+                    } else { /* R ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per row */
+                        d = nc_v3_unit(nc_v3(rc->d00.x + fx * rc->ex.x + fy * rc->ey.x,
+                                             rc->d00.y + fx * rc->ex.y + fy * rc->ey.y,
+                                             rc->d00.z + fx * rc->ex.z + fy * rc->ey.z));
                     }
                     dir[i] = d;
-                    ray.ox[i] = ray.oy[i] = ray.oz[i] = 0.0f;
+                    orig[i] = rc->o;
+                    ray.ox[i] = (float)rc->o.x;
+                    ray.oy[i] = (float)rc->o.y;
+                    ray.oz[i] = (float)rc->o.z;
                     ray.dx[i] = (float)d.x;
                     ray.dy[i] = (float)d.y;
                     ray.dz[i] = (float)d.z;
@@ -154,7 +165,7 @@ static void shade_tile(struct job *j, int tile)
                         continue;
                     struct nc_vec3 d = dir[i], nrm;
                     double t = hit.t[i];
-                    int exact = nc_rt_refine(j->rt, hit.body[i], d, &t, &nrm);
+                    int exact = nc_rt_refine(j->rt, hit.body[i], orig[i], d, &t, &nrm);
                     if (exact < 0) { /* the float trace grazed a limb the exact shape misses */
                         hit.body[i] = -1;
                         continue;
@@ -166,7 +177,7 @@ static void shade_tile(struct job *j, int tile)
                         nrm = nc_v3_scale(nrm, -1.0);
                         mu = -mu;
                     }
-                    struct nc_vec3 p = nc_v3_scale(d, t);
+                    struct nc_vec3 p = nc_v3_add(orig[i], nc_v3_scale(d, t));
                     struct nc_vec3 sdir = j->sun_dir;
                     irr[i] = j->sun_irr;
                     if (s->sun.has_position)
@@ -249,17 +260,31 @@ static void shade_tile(struct job *j, int tile)
 static void *worker(void *arg)
 {
     struct job *j = arg;
-    const int ntiles = j->tiles_x * j->tiles_y;
+    const int ntiles = j->tiles_x * (j->tile_row_end - j->tile_row_begin);
     for (;;) {
         int t = atomic_fetch_add(&j->next, 1);
         if (t >= ntiles)
             break;
-        shade_tile(j, t);
+        shade_tile(j, t + j->tile_row_begin * j->tiles_x);
     }
     return NULL;
 }
 
 int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f)
+{
+    return nc_render_rows(r, s, f, 0, (s->camera.height_px + TILE - 1) / TILE);
+}
+
+int nc_render_tile_rows(const struct nc_scene *s) { return (s->camera.height_px + TILE - 1) / TILE; }
+
+int nc_render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
+                   int tile_row_end)
+{
+    return nc_render_rows_timed(r, s, f, tile_row_begin, tile_row_end, NULL);
+}
+
+int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
+                         int tile_row_end, const double *row_dt)
 {
     const struct nc_camera *c = &s->camera;
     if (f->width_px != c->width_px || f->height_px != c->height_px)
@@ -273,13 +298,27 @@ int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_f
         j.body_R[b] = nc_quat_to_mat(s->body[b].attitude_q);
         j.body_rel[b] = nc_v3_sub(s->body[b].position_m, c->position_m);
     }
-    struct nc_mat3 R = nc_quat_to_mat(c->attitude_q);
-    j.cam_R = R;
-    j.d00 = nc_mat_mul_v(&R, nc_camera_dir(c, 0, 0));
-    j.ex = nc_mat_mul_v(&R, nc_v3(1.0 / c->fx_px, 0, 0));
-    j.ey = nc_mat_mul_v(&R, nc_v3(0, 1.0 / c->fy_px, 0));
+    j.row = malloc((size_t)c->height_px * sizeof *j.row);
+    if (!j.row)
+        return nc_error(-ENOMEM, "out of memory");
+    for (int y = 0; y < c->height_px; y++) {
+        struct row_cam *rw = &j.row[y];
+        double dt = row_dt ? row_dt[y] : 0.0;
+        struct nc_quat q = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt) : c->attitude_q;
+        rw->R = nc_quat_to_mat(q);
+        rw->o = nc_v3_scale(c->velocity_m_s, dt);
+        rw->d00 = nc_mat_mul_v(&rw->R, nc_camera_dir(c, 0, 0));
+        rw->ex = nc_mat_mul_v(&rw->R, nc_v3(1.0 / c->fx_px, 0, 0));
+        rw->ey = nc_mat_mul_v(&rw->R, nc_v3(0, 1.0 / c->fy_px, 0));
+    }
     j.tiles_x = (c->width_px + TILE - 1) / TILE;
     j.tiles_y = (c->height_px + TILE - 1) / TILE;
+    j.tile_row_begin = tile_row_begin < 0 ? 0 : tile_row_begin;
+    j.tile_row_end = tile_row_end > j.tiles_y ? j.tiles_y : tile_row_end;
+    if (j.tile_row_end <= j.tile_row_begin) {
+        free(j.row);
+        return 0;
+    }
     j.n_strata = (int)lround(sqrt((double)s->render.samples_per_pixel));
     if (j.n_strata < 1)
         j.n_strata = 1;
@@ -298,5 +337,6 @@ int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_f
     worker(&j);
     for (int i = 0; i < started; i++)
         pthread_join(tid[i], NULL);
+    free(j.row);
     return 0;
 }

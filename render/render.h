@@ -35,6 +35,32 @@ void nc_frame_free(struct nc_frame *f);
 int nc_renderer_init(struct nc_renderer *r, const struct nc_scene *s, int threads);
 /* Render the scene's current poses into f (allocated to the camera size). */
 int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f);
+/* Only image rows [16 begin, 16 end): rows of 16-pixel tiles; other rows of f
+ * are left as they are. nc_render_tile_rows() is the number of tile rows. */
+int nc_render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
+                   int tile_row_end);
+int nc_render_tile_rows(const struct nc_scene *s);
+/* The same with each image row's camera row_dt[y] seconds after the scene's
+ * pose (camera rates; bodies stay at the scene's time). row_dt may be NULL. */
+int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
+                         int tile_row_end, const double *row_dt);
+
+/* An exposure: pose motion integrated over the exposure window. The scene's
+ * poses are those at mid-exposure (of the middle row, for a rolling shutter);
+ * camera and body rates (scene config) move them linearly in position and at
+ * constant angular rate in attitude. */
+struct nc_exposure {
+    double exposure_s;
+    int rolling;          /* rolling shutter: row y starts line_time_s after row y-1 */
+    double line_time_s;
+    int max_time_samples; /* 0: 256 */
+};
+/* Render f over the exposure, with as many time samples as the image motion
+ * needs (one per 0.5 px of motion, at least 1); *time_samples reports it. */
+int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex,
+                       struct nc_frame *f, int *time_samples);
+/* Image motion over the exposure, pixels (an upper bound from the rates). */
+double nc_render_motion_px(const struct nc_scene *s, double exposure_s);
 void nc_renderer_free(struct nc_renderer *r);
 
 #endif

@@ -39,11 +39,12 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s);
 /* Closest hits; coherent = camera rays. */
 void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit, int coherent);
 /* For a hit on an analytic body, recompute range t and unit normal n (scene
- * frame) in double precision for the exact camera-relative direction d (unit):
+ * frame) in double precision for the exact camera-relative ray origin + t d (d unit):
  * the packet trace is float. Returns 1 if refined, 0 for meshes (the float
  * answer stands), and -1 when the exact ray misses the body: a float hit at
  * the limb that is not there, to be treated as a miss. */
-int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 d, double *t, struct nc_vec3 *n);
+int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct nc_vec3 d, double *t,
+                 struct nc_vec3 *n);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);

@@ -323,13 +323,14 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
     }
 }
 
-int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 d, double *t, struct nc_vec3 *n)
+int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct nc_vec3 d, double *t,
+                 struct nc_vec3 *n)
 {
     const struct rt_body *b = &rt->body[body];
     if (!b->analytic)
         return 0;
-    /* Body frame, body origin at zero: o = -R^T origin_rel, d' = R^T d. */
-    struct nc_vec3 o = nc_mat_tmul_v(&b->R, nc_v3_scale(b->origin_rel, -1.0)), db = nc_mat_tmul_v(&b->R, d);
+    /* Body frame, body origin at zero: o = R^T (origin - origin_rel), d' = R^T d. */
+    struct nc_vec3 o = nc_mat_tmul_v(&b->R, nc_v3_sub(origin, b->origin_rel)), db = nc_mat_tmul_v(&b->R, d);
     const double *r = b->radii;
     double op[3] = {o.x / r[0], o.y / r[1], o.z / r[2]}, dp[3] = {db.x / r[0], db.y / r[1], db.z / r[2]};
     double A = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2];

@@ -152,7 +152,9 @@ static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body 
     b->position_m = nc_v3(0, 0, 0);
     b->attitude_q = (struct nc_quat){1, 0, 0, 0};
     if ((rc = nc_cfg_vec3(item, "position_m", &b->position_m)) < 0 ||
-        (rc = nc_cfg_quat(item, "attitude_q", &b->attitude_q)) < 0)
+        (rc = nc_cfg_quat(item, "attitude_q", &b->attitude_q)) < 0 ||
+        (rc = nc_cfg_vec3(item, "velocity_m_s", &b->velocity_m_s)) < 0 ||
+        (rc = nc_cfg_vec3(item, "angular_velocity_rad_s", &b->angular_velocity_rad_s)) < 0)
         return rc;
     return 0;
 }
@@ -307,4 +309,30 @@ void nc_scene_sun_at(const struct nc_scene *s, struct nc_vec3 p, struct nc_vec3 
     double r = nc_v3_norm(d), r0 = nc_v3_norm(s->sun.position_m);
     *dir = nc_v3_scale(d, 1.0 / r);
     *irradiance_w_m2 = s->sun.irradiance_w_m2 * (r0 / r) * (r0 / r);
+}
+
+struct nc_quat nc_quat_propagate(struct nc_quat q, struct nc_vec3 w, double dt)
+{
+    double a = nc_v3_norm(w) * dt;
+    if (a == 0)
+        return q;
+    struct nc_vec3 axis = nc_v3_unit(w);
+    double sh = sin(0.5 * a);
+    struct nc_quat d = {cos(0.5 * a), axis.x * sh, axis.y * sh, axis.z * sh};
+    struct nc_quat r = nc_quat_mul(q, d); /* rate in the body's own frame: right product */
+    double n = nc_quat_norm(r);
+    return (struct nc_quat){r.w / n, r.x / n, r.y / n, r.z / n};
+}
+
+void nc_scene_propagate(const struct nc_scene *s, double dt, struct nc_scene *out)
+{
+    *out = *s;
+    struct nc_camera *c = &out->camera;
+    c->position_m = nc_v3_add(c->position_m, nc_v3_scale(c->velocity_m_s, dt));
+    c->attitude_q = nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt);
+    for (int i = 0; i < out->nbodies; i++) {
+        struct nc_body *b = &out->body[i];
+        b->position_m = nc_v3_add(b->position_m, nc_v3_scale(b->velocity_m_s, dt));
+        b->attitude_q = nc_quat_propagate(b->attitude_q, b->angular_velocity_rad_s, dt);
+    }
 }

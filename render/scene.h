@@ -31,6 +31,8 @@ struct nc_body {
     struct nc_material material;
     struct nc_vec3 position_m; /* scene frame */
     struct nc_quat attitude_q; /* body-fixed -> scene */
+    struct nc_vec3 velocity_m_s;           /* scene frame */
+    struct nc_vec3 angular_velocity_rad_s; /* body-fixed frame */
 };
 
 struct nc_sun {
@@ -68,6 +70,13 @@ int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *s
 /* Convenience: load file (NULL = built-in default), apply overrides, build. */
 int nc_scene_load(const char *path, const char *const *sets, int nsets, struct nc_scene *s);
 void nc_scene_free(struct nc_scene *s);
+
+/* Poses dt seconds later: positions move with their velocities, attitudes
+ * turn at their angular rates. out shares s's meshes and materials (a shallow
+ * copy for rendering; never free it). */
+void nc_scene_propagate(const struct nc_scene *s, double dt, struct nc_scene *out);
+/* q turned by angular velocity w (expressed in q's own frame) for dt. */
+struct nc_quat nc_quat_propagate(struct nc_quat q, struct nc_vec3 w, double dt);
 
 /* Sun, in the scene frame, seen from scene point p: unit direction toward the
  * Sun and the solar irradiance there (W m^-2). */

@@ -1,0 +1,130 @@
+/* test_smear.c - motion during the exposure: a point moving a known number of
+ * pixels spreads into a streak of that length with its total signal
+ * conserved; a rolling shutter skews a vertical bar by the rate times the
+ * readout time; without motion neither changes the image. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h"
+
+/* A sphere 4 px across at 10 km (fx = 1000 px), lit from behind the camera. */
+static const char yaml[] =
+    "bodies:\n"
+    "  - shape: {type: sphere, radius_m: 20}\n"
+    "    material: {model: lambert, A: 1}\n"
+    "sun: {direction: [0, 0, -1]}\n"
+    "camera: {width_px: 96, height_px: 64, fx_px: 1000, fy_px: 1000,\n"
+    "         position_m: [0, 0, -10000], attitude_q: [1, 0, 0, 0]}\n"
+    "render: {samples_per_pixel: 64}\n";
+
+static double total(const struct nc_frame *f)
+{
+    double s = 0;
+    for (int i = 0; i < f->width_px * f->height_px; i++)
+        s += f->radiance[i];
+    return s;
+}
+
+static void extent(const struct nc_frame *f, double thresh, int *x0, int *x1, int *y0, int *y1)
+{
+    *x0 = *y0 = 1 << 30;
+    *x1 = *y1 = -1;
+    for (int y = 0; y < f->height_px; y++)
+        for (int x = 0; x < f->width_px; x++)
+            if (f->radiance[y * f->width_px + x] > thresh) {
+                *x0 = x < *x0 ? x : *x0;
+                *x1 = x > *x1 ? x : *x1;
+                *y0 = y < *y0 ? y : *y0;
+                *y1 = y > *y1 ? y : *y1;
+            }
+}
+
+static void render(const struct nc_scene *s, const struct nc_exposure *ex, struct nc_frame *f, int *k)
+{
+    struct nc_renderer r;
+    nc_renderer_init(&r, s, 2);
+    nc_frame_alloc(f, s->camera.width_px, s->camera.height_px);
+    CHECK(nc_render_exposure(&r, s, ex, f, k) == 0, "render");
+    nc_renderer_free(&r);
+}
+
+int main(void)
+{
+    struct nc_scene s;
+    nc_test_scene(yaml, NULL, 0, &s);
+    struct nc_exposure ex = {.exposure_s = 0.1};
+    struct nc_frame still, moving;
+    int k;
+    render(&s, &ex, &still, &k);
+    CHECK(k == 1, "no motion: one time sample, got %d", k);
+    /* Turning about the camera's y axis at 0.2 rad/s for 0.1 s moves the image
+     * by 0.02 rad * 1000 px = 20 px along x. */
+    s.camera.angular_velocity_rad_s = nc_v3(0, 0.2, 0);
+    render(&s, &ex, &moving, &k);
+    /* Analytic: a Lambert sphere at zero phase gives p J (R/D)^2, p = 2A/3;
+     * each pixel subtends 1/(fx fy) sr. */
+    double want = 2.0 / 3.0 * s.sun.irradiance_w_m2 * pow(20.0 / 10000.0, 2) * 1e6;
+    double s0 = total(&still), s1 = total(&moving);
+    int ax0, ax1, ay0, ay1, bx0, bx1, by0, by1;
+    extent(&still, 1e-9, &ax0, &ax1, &ay0, &ay1);
+    double peak = 0;
+    for (int i = 0; i < moving.width_px * moving.height_px; i++)
+        peak = fmax(peak, moving.radiance[i]);
+    extent(&moving, 0.05 * peak, &bx0, &bx1, &by0, &by1);
+    int still_w = ax1 - ax0 + 1, streak = bx1 - bx0 + 1;
+    printf("point: %d px wide still; moving 20 px in %d time samples: streak %d px (x %d..%d), rows %d..%d vs %d..%d; "
+           "total signal still/analytic %.5f, moving/analytic %.5f\n",
+           still_w, k, streak, bx0, bx1, by0, by1, ay0, ay1, s0 / want, s1 / want);
+    CHECK(k >= 40, "20 px of motion needs >= 40 time samples, got %d", k);
+    CHECK(abs(streak - (20 + still_w)) <= 1, "streak %d px, expected 20 + %d", streak, still_w);
+    CHECK(by0 >= ay0 && by1 <= ay1, "the streak left the point's rows");
+    CHECK(fabs(s0 / want - 1) < 0.01 && fabs(s1 / want - 1) < 0.01, "total signal still %.4f, moving %.4f of analytic",
+          s0 / want, s1 / want);
+    /* The pose is the mid-exposure pose: the streak is centred on the still point. */
+    CHECK(fabs(0.5 * (bx0 + bx1) - 0.5 * (ax0 + ax1)) <= 1.0, "streak centre %.1f vs still %.1f", 0.5 * (bx0 + bx1),
+          0.5 * (ax0 + ax1));
+    nc_frame_free(&still);
+    nc_frame_free(&moving);
+    nc_scene_free(&s);
+
+    /* Rolling shutter: a vertical bar (a prolate ellipsoid) and a camera turning
+     * about y: row y is exposed (y - 31.5) * line_time later than mid-frame, so
+     * the bar shears by 1 rad/s * 1e-4 s * 1000 px = 0.1 px per row, 6.3 px
+     * over the image. Without rotation the rolling shutter changes nothing. */
+    const char *bar[] = {"bodies.0.shape={type: ellipsoid, radii_m: [8, 400, 8]}", "render.samples_per_pixel=64"};
+    nc_test_scene(yaml, bar, 2, &s);
+    struct nc_exposure g = {.exposure_s = 1e-4}, rs = {.exposure_s = 1e-4, .rolling = 1, .line_time_s = 1e-4};
+    struct nc_frame fg, fr;
+    render(&s, &g, &fg, &k);
+    render(&s, &rs, &fr, &k);
+    CHECK(!memcmp(fg.radiance, fr.radiance, sizeof(float) * 96 * 64), "a still scene: rolling = global shutter");
+    nc_frame_free(&fr);
+    s.camera.angular_velocity_rad_s = nc_v3(0, 1.0, 0);
+    render(&s, &rs, &fr, &k);
+    /* Centroid of each row's signal, relative to the still bar's (which
+     * cancels the sampling pattern common to both). */
+    double cx[64];
+    for (int y = 0; y < 64; y++) {
+        double m = 0, mx = 0, m0 = 0, mx0 = 0;
+        for (int x = 0; x < 96; x++) {
+            m += fr.radiance[y * 96 + x];
+            mx += x * fr.radiance[y * 96 + x];
+            m0 += fg.radiance[y * 96 + x];
+            mx0 += x * fg.radiance[y * 96 + x];
+        }
+        cx[y] = m > 0 && m0 > 0 ? mx / m - mx0 / m0 : NAN;
+    }
+    /* Least-squares slope of the centroid over all rows. */
+    double sy = 0, sc = 0, syy = 0, syc = 0;
+    for (int y = 0; y < 64; y++)
+        sy += y, sc += cx[y], syy += (double)y * y, syc += y * cx[y];
+    double shear = (64 * syc - sy * sc) / (64 * syy - sy * sy), expect = -1.0 * 1e-4 * 1000;
+    printf("rolling shutter: bar centroid moves %.4f px per row (expected %.4f)\n", shear, expect);
+    CHECK(fabs(shear - expect) < 0.02 * fabs(expect), "rolling-shutter shear %.4f px/row, expected %.4f", shear, expect);
+    nc_frame_free(&fg);
+    nc_frame_free(&fr);
+    nc_scene_free(&s);
+    return nc_test_end();
+}
