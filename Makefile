@@ -34,6 +34,7 @@ test: deps
 bench: build
 	$(BUILD)/bench_render
 	$(BUILD)/bench_brdf
+	$(BUILD)/bench_sensor
 
 clean:
 	rm -rf $(BUILD) $(TESTBUILD) $(TESTBUILD)-asan out

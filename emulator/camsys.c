@@ -10,6 +10,7 @@
 
 #include "error.h"
 #include "rng.h"
+#include "vmath.h"
 
 /* Solar spectrum for tabulated passbands: a 5772 K black body (IAU 2015
  * nominal solar effective temperature), normalised to the total irradiance. */
@@ -357,9 +358,10 @@ int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, doubl
     if (!tmp)
         return nc_error(-ENOMEM, "out of memory");
     for (size_t p = 0; p < n; p++) {
-        /* Far beyond any full well, charge is capped: a float must hold it. */
+        /* Far beyond any full well, charge is capped: a float must hold it.
+         * NaN fails both comparisons and becomes 0. */
         double v = (double)radiance[p] * cs->response[p] * exposure_s;
-        tmp[p] = isfinite(v) && v > 0 ? (float)fmin(v, 1e30) : 0.0f;
+        tmp[p] = v > 0 ? (v < 1e30 ? (float)v : 1e30f) : 0.0f;
     }
     if (tmp != electrons) {
         int rc = nc_psf_apply(&cs->optics.psf, tmp, electrons, cs->width_px, cs->height_px);
@@ -369,12 +371,13 @@ int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, doubl
     return 0;
 }
 
-/* Exact Poisson by inversion (lambda < 32); the normal approximation above,
- * rounded to whole electrons. */
-static double poisson(double lambda, double u, double z)
+/* Exact Poisson by inversion for lambda < 32, given p0 = exp(-lambda) and a
+ * uniform u; above, the normal approximation with standard normal z, rounded
+ * to whole electrons (mean and variance exact, skewness < 0.18). */
+static inline double poisson(double lambda, double p0, double u, double z)
 {
     if (lambda < 32.0) {
-        double p = exp(-lambda), cdf = p;
+        double p = p0, cdf = p;
         int k = 0;
         while (u > cdf && k < 200) {
             k++;
@@ -383,7 +386,8 @@ static double poisson(double lambda, double u, double z)
         }
         return k;
     }
-    return fmax(0.0, floor(lambda + sqrt(lambda) * z + 0.5));
+    double v = lambda + sqrt(lambda) * z + 0.5;
+    return v > 0 ? (double)(int64_t)v : 0.0; /* floor for v > 0, no libm call */
 }
 
 /* Cosmic-ray charge for this frame, added into e (keyed by seed and frame). */
@@ -424,6 +428,47 @@ static void cosmic_rays(const struct nc_camsys *cs, double exposure_s, uint64_t 
     }
 }
 
+/* The ADC: round to nearest, clip to 0 .. top. */
+static inline uint16_t adc(double v, double top)
+{
+    v += 0.5;
+    if (!(v > 0))
+        return 0;
+    return v >= top ? (uint16_t)top : (uint16_t)(uint32_t)v;
+}
+
+/* The random numbers of one image row: for each pair of pixels one Philox
+ * call keyed by (seed, frame, pair), giving per pixel a uniform for exact
+ * low-count Poisson sampling and two standard normals (shot noise at high
+ * counts, read noise) through Box-Muller, evaluated as vector batches. */
+struct row_rng {
+    double *u, *lr, *ang, *s, *c; /* 2 per pixel each */
+};
+
+static void row_normals(const struct nc_camsys *cs, uint64_t frame, int y, int W, struct row_rng *b)
+{
+    const uint64_t seed = cs->sensor.seed;
+    const int pairs = (W + 1) / 2;
+    for (int k = 0; k < pairs; k++) {
+        double u[4];
+        nc_rng4(seed, NC_RNG_PIXEL_NOISE, frame, (uint32_t)((size_t)y * (size_t)pairs + (size_t)k), 0, u);
+        /* Box-Muller pair A = (u0, u1): the read-noise normals of both pixels.
+         * Pair B = (u2, u3): their shot-noise normals at high counts; at low
+         * counts u2 and u3 are instead the uniforms of exact Poisson sampling
+         * (then pair B is unused). No draw serves twice in one pixel. */
+        b->u[2 * k] = u[2];
+        b->u[2 * k + 1] = u[3];
+        b->lr[2 * k] = u[0];
+        b->lr[2 * k + 1] = u[2];
+        b->ang[2 * k] = 2.0 * u[1];
+        b->ang[2 * k + 1] = 2.0 * u[3];
+    }
+    nc_vlog(b->lr, (size_t)2 * pairs);
+    nc_vsincospi(b->ang, b->s, b->c, (size_t)2 * pairs);
+    for (int i = 0; i < 2 * pairs; i++)
+        b->lr[i] = sqrt(-2.0 * b->lr[i]);
+}
+
 int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, double exposure_s, uint64_t frame,
                        uint16_t *dn)
 {
@@ -431,31 +476,62 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
     const int W = cs->width_px, H = cs->height_px;
     const size_t n = (size_t)W * (size_t)H;
     const double fw = s->full_well_e, g = nc_camsys_dn_per_e(cs), top = ldexp(1.0, s->adc_bits) - 1.0;
-    double *e = malloc(n * sizeof *e), *rn = malloc(n * sizeof *rn);
-    if (!e || !rn) {
+    const int pairs = (W + 1) / 2, nb = 2 * pairs;
+    /* Charge and read-noise normals for the whole frame only when charge moves
+     * between pixels (cosmic rays, blooming); otherwise row by row. */
+    const int whole = s->blooming || s->cosmic_rate_cm2_s > 0;
+    double *e = whole ? malloc(n * sizeof *e) : NULL;
+    float *rn = whole ? malloc(n * sizeof *rn) : NULL;
+    double *buf = malloc((size_t)nb * 7 * sizeof *buf);
+    if (!buf || (whole && (!e || !rn))) {
         free(e);
         free(rn);
+        free(buf);
         return nc_error(-ENOMEM, "out of memory");
     }
-    /* Charge: response pattern, dark current, shot noise. */
-    for (size_t p = 0; p < n; p++) {
-        double lambda = (double)electrons[p] * cs->prnu_map[p] + (double)cs->dark_map[p] * exposure_s;
-        double u[4], z1, z2;
-        nc_rng4(s->seed, NC_RNG_PIXEL_NOISE, frame, (uint32_t)p, 0, u);
-        nc_normal2(u[2], u[3], &z1, &z2);
-        e[p] = s->shot_noise ? poisson(lambda, u[0], z1) : lambda;
-        rn[p] = z2;
+    struct row_rng b = {buf, buf + nb, buf + 2 * nb, buf + 3 * nb, buf + 4 * nb};
+    double *lam = buf + 5 * nb, *p0 = buf + 6 * nb;
+    for (int y = 0; y < H; y++) {
+        const size_t o = (size_t)y * (size_t)W;
+        row_normals(cs, frame, y, W, &b);
+        /* Charge: response pattern and dark current; exp(-lambda) for the
+         * low-count pixels in one batch. */
+        for (int x = 0; x < W; x++) {
+            lam[x] = (double)electrons[o + x] * cs->prnu_map[o + x] + (double)cs->dark_map[o + x] * exposure_s;
+            p0[x] = lam[x] < 40.0 ? -lam[x] : -40.0;
+        }
+        if (s->shot_noise)
+            nc_vexp(p0, (size_t)W);
+        for (int x = 0; x < W; x++) {
+            /* Even pixels take the cosines, odd pixels the sines. */
+            const int a = x & ~1, odd = x & 1;
+            double z2 = b.lr[a] * (odd ? b.s[a] : b.c[a]);             /* read noise, pair A */
+            double z1 = b.lr[a + 1] * (odd ? b.s[a + 1] : b.c[a + 1]); /* shot noise, pair B */
+            double q = s->shot_noise ? poisson(lam[x], p0[x], b.u[x], z1) : lam[x];
+            if (whole) {
+                e[o + x] = q;
+                rn[o + x] = (float)z2;
+                continue;
+            }
+            dn[o + x] = adc(s->bias_dn + ((q < fw ? q : fw) + s->read_noise_e * z2) * g, top);
+        }
     }
+    free(buf);
+    if (!whole)
+        return 0;
     if (s->cosmic_rate_cm2_s > 0)
         cosmic_rays(cs, exposure_s, frame, e);
     /* Full well: the excess is lost, or with blooming spills half up and half
      * down the column, cascading through saturated pixels. */
     if (s->blooming) {
+        double *up = malloc((size_t)H * sizeof *up);
+        if (!up) {
+            free(e);
+            free(rn);
+            return nc_error(-ENOMEM, "out of memory");
+        }
         for (int x = 0; x < W; x++) {
             double carry = 0;
-            double *up = malloc((size_t)H * sizeof *up);
-            if (!up)
-                continue;
             for (int y = 0; y < H; y++) {
                 double *v = &e[(size_t)y * W + x];
                 double ex = *v > fw ? *v - fw : 0;
@@ -478,15 +554,11 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
                     *v = fw;
                 }
             }
-            free(up);
         }
+        free(up);
     }
-    /* Read noise, gain, bias, ADC. */
-    for (size_t p = 0; p < n; p++) {
-        double q = fmin(e[p], fw) + s->read_noise_e * rn[p];
-        double v = floor(s->bias_dn + q * g + 0.5);
-        dn[p] = (uint16_t)(v < 0 ? 0 : v > top ? top : v);
-    }
+    for (size_t p = 0; p < n; p++)
+        dn[p] = adc(s->bias_dn + ((e[p] < fw ? e[p] : fw) + s->read_noise_e * rn[p]) * g, top);
     free(e);
     free(rn);
     return 0;

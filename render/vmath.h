@@ -12,6 +12,8 @@
 void nc_vexp(double *x, size_t n);
 void nc_vlog(double *x, size_t n);
 void nc_vacos(double *x, size_t n);
+/* s[i] = sin(pi x[i]), c[i] = cos(pi x[i]). */
+void nc_vsincospi(const double *x, double *s, double *c, size_t n);
 /* Which implementation runs here, for logs and benchmarks. */
 const char *nc_vmath_impl(void);
 

@@ -21,4 +21,12 @@ void nc_vacos(double *x, size_t n)
         x[i] = acos(x[i]);
 }
 
+void nc_vsincospi(const double *x, double *s, double *c, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        s[i] = sin(M_PI * x[i]);
+        c[i] = cos(M_PI * x[i]);
+    }
+}
+
 const char *nc_vmath_impl(void) { return "libm"; }

@@ -46,4 +46,33 @@ NC_VMATH_DEFINE(nc_vexp, Sleef_expd4_u10avx2, exp, 0.0)
 NC_VMATH_DEFINE(nc_vlog, Sleef_logd4_u10avx2, log, 1.0)
 NC_VMATH_DEFINE(nc_vacos, Sleef_acosd4_u10avx2, acos, 0.0)
 
+void nc_vsincospi(const double *x, double *s, double *c, size_t n)
+{
+    if (!avx2()) {
+        for (size_t i = 0; i < n; i++) {
+            s[i] = sin(M_PI * x[i]);
+            c[i] = cos(M_PI * x[i]);
+        }
+        return;
+    }
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        Sleef___m256d_2 r = Sleef_sincospid4_u05avx2(_mm256_loadu_pd(x + i));
+        _mm256_storeu_pd(s + i, r.x);
+        _mm256_storeu_pd(c + i, r.y);
+    }
+    if (i < n) {
+        double t[4] = {0, 0, 0, 0}, ts[4], tc[4];
+        for (size_t k = 0; i + k < n; k++)
+            t[k] = x[i + k];
+        Sleef___m256d_2 r = Sleef_sincospid4_u05avx2(_mm256_loadu_pd(t));
+        _mm256_storeu_pd(ts, r.x);
+        _mm256_storeu_pd(tc, r.y);
+        for (size_t k = 0; i + k < n; k++) {
+            s[i + k] = ts[k];
+            c[i + k] = tc[k];
+        }
+    }
+}
+
 const char *nc_vmath_impl(void) { return avx2() ? "SLEEF AVX2 (u10)" : "libm"; }

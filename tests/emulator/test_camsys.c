@@ -132,11 +132,16 @@ static void photon_transfer(void)
     /* Read noise from the dark temporal variance at zero exposure, less the
      * quantisation noise 1/12 DN^2. */
     double read_fit = sqrt(var_d[0] - 1.0 / 12.0) / Kfit;
-    /* Dark current: slope of the dark mean against exposure time. */
+    /* Dark current: slope of the dark mean against exposure time, over dark
+     * frames long enough to collect a measurable dark signal (0 to 20 s). */
     double tx = 0, ty = 0, txx = 0, txy = 0;
-    for (int j = 0; j < NT; j++)
-        tx += t[j], ty += mu_d[j], txx += t[j] * t[j], txy += t[j] * mu_d[j];
-    double dark_fit = (NT * txy - tx * ty) / (NT * txx - tx * tx) / Kfit;
+    memset(e, 0, sizeof e);
+    for (int j = 0; j < 11; j++) {
+        double td = 2.0 * j, m, v;
+        frame_pair_stats(&cs, e, td, 9000 + 2 * j, &m, &v);
+        tx += td, ty += m, txx += td * td, txy += td * m;
+    }
+    double dark_fit = (11 * txy - tx * ty) / (11 * txx - tx * tx) / Kfit;
     double sat_fit = saturation_capacity(Kfit);
     /* Linearity: mean (minus dark) against exposure, fitted between 5% and 95%
      * of saturation; the error up to 90% of full well. */
