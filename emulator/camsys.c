@@ -185,9 +185,9 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
     s->seed = 1;
     s->cosmic_track_px = 5;
     s->cosmic_e_per_px = 1000;
-    if (!m) {
+    if (!m) { /* an ideal noise-free sensor; without a known pitch, no radiometry */
         s->shot_noise = 0;
-        return s->pixel_pitch_m > 0 ? 0 : nc_error(NC_ECONFIG, "sensor.pixel_pitch_m is needed (the camera gives fx_px)");
+        return 0;
     }
     static const char *const bools[] = {"false", "true", NULL};
     int b;
@@ -353,6 +353,9 @@ double nc_camsys_dn_per_e(const struct nc_camsys *cs)
 
 int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, double exposure_s, float *electrons)
 {
+    if (!(cs->sensor.pixel_pitch_m > 0))
+        return nc_error(NC_ECONFIG, "electrons and DN need the pixel pitch: set camera.focal_length_m with "
+                                    "camera.pixel_pitch_m, or sensor.pixel_pitch_m");
     size_t n = (size_t)cs->width_px * (size_t)cs->height_px;
     float *tmp = cs->optics.psf.size > 1 ? malloc(n * sizeof *tmp) : electrons;
     if (!tmp)

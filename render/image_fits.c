@@ -10,6 +10,7 @@
  * Rows are written top row first: FITS row 1 is image row y = 0.
  */
 #include <ctype.h>
+#include <math.h>
 #include <errno.h>
 #include <fitsio.h>
 #include <stdio.h>
@@ -82,9 +83,18 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
         goto fail;
     fits_write_key_longwarn(f, &status);
     for (int i = 0; i < nattrs && !status; i++) {
-        char key[80];
+        char key[80], *end;
         fits_key(attrs[i].name, key, sizeof key);
-        fits_write_key_longstr(f, key, attrs[i].value, attrs[i].name, &status);
+        /* Numbers as FITS numbers (EXPTIME, ADCBITS, ...), the rest as strings. */
+        double v = strtod(attrs[i].value, &end);
+        if (end != attrs[i].value && !*end && isfinite(v)) {
+            if (v == floor(v) && fabs(v) < 1e15 && !strpbrk(attrs[i].value, ".eE"))
+                fits_write_key_lng(f, key, (LONGLONG)v, attrs[i].name, &status);
+            else
+                fits_write_key_dbl(f, key, v, -17, attrs[i].name, &status);
+        } else {
+            fits_write_key_longstr(f, key, attrs[i].value, attrs[i].name, &status);
+        }
     }
     fits_write_comment(f, "Row 1 is the top image row (y = 0, +Y down).", &status);
     fits_write_comment(f, "Each NavCam metadata card carries its attribute name as its comment.", &status);
@@ -143,12 +153,16 @@ int nc__fits_read_attr(const char *path, const char *name, char *buf, size_t len
     fits_key(name, key, sizeof key);
     if (fits_open_image(&f, path, READONLY, &status))
         return fits_fail(path, "open", status);
-    fits_read_key_longstr(f, key, &val, NULL, &status);
+    char raw[FLEN_VALUE];
     int rc = 0;
-    if (status)
+    if (fits_read_keyword(f, key, raw, NULL, &status)) {
         rc = nc_error(NC_EIMAGE, "%s: no keyword %s (%s)", path, key, name);
-    else
-        snprintf(buf, len, "%s", val);
+    } else if (raw[0] == '\'') {
+        fits_read_key_longstr(f, key, &val, NULL, &status);
+        snprintf(buf, len, "%s", status ? "" : val);
+    } else {
+        snprintf(buf, len, "%s", raw); /* a number, as written */
+    }
     if (val)
         fits_free_memory(val, &status);
     status = 0;

@@ -38,7 +38,31 @@ const char nc_default_scene_yaml[] =
     "  up: [0, 0, 1]\n"
     "render:\n"
     "  samples_per_pixel: 4\n"
-    "  seed: 1\n";
+    "  seed: 1\n"
+    "# A generic 1024x1024 navigation camera (configs/examples/navcam_camera.yaml\n"
+    "# explains each value): f/4 optics, 5.5 um pixels, 12-bit ADC.\n"
+    "optics:\n"
+    "  f_number: 4.0\n"
+    "  transmission: 0.9\n"
+    "  passband: {band_fraction: 0.45, wavelength_m: 6.0e-7}\n"
+    "  vignetting: cos4\n"
+    "  psf: {type: gaussian, sigma_px: 0.7}\n"
+    "sensor:\n"
+    "  qe: 0.6\n"
+    "  dark_current_e_s: 20\n"
+    "  dark_ref_temp_k: 293.15\n"
+    "  dark_doubling_k: 6.5\n"
+    "  temperature_k: 283.15\n"
+    "  dsnu_e_s: 2\n"
+    "  prnu: 0.01\n"
+    "  read_noise_e: 8\n"
+    "  full_well_e: 20000\n"
+    "  gain_e_per_dn: 5.0\n"
+    "  bias_dn: 64\n"
+    "  adc_bits: 12\n"
+    "  seed: 1\n"
+    "exposure:\n"
+    "  time_s: 0.002\n";
 
 static const char *const shape_names[] = {"sphere", "ellipsoid", "mesh", "asteroid", NULL};
 

@@ -81,5 +81,22 @@ expect 1 "no parameter named 'w'" -- "$navcam" brdf --model lambert --param w=0.
 expect 1 "angles must be within 0..180" -- "$navcam" brdf --model lambert --param A=0.5 --geometry 190,0,190
 expect 2 "give --model NAME or --preset NAME" -- "$navcam" brdf --geometry 0,0,0
 
+# The camera model: DN and electrons from a render; navcam expose.
+expect 0 "dn [DN]" -- "$navcam" render -o "$tmp/dn.png" -q dn "${small[@]}"
+expect 0 "electrons [e-]" -- "$navcam" render -o "$tmp/e.exr" -q electrons "${small[@]}" --exposure 0.001
+expect 0 "dn [DN]" -- "$navcam" render -o "$tmp/dn.fits" -q dn "${small[@]}" --frame 7
+expect 2 "--exposure expects" -- "$navcam" render -o "$tmp/x.png" -q dn --exposure -1
+cam="$tmp/cam.yaml"
+printf 'camera: {width_px: 64, height_px: 48, focal_length_m: 0.02, pixel_pitch_m: 1.0e-5}\noptics: {f_number: 4}\nsensor: {read_noise_e: 5, full_well_e: 10000, gain_e_per_dn: 2, bias_dn: 20, adc_bits: 12}\n' > "$cam"
+expect 0 "wrote $tmp/flat.fits: 4 frames of 64x48, 12-bit" -- "$navcam" expose "$cam" -L 3 -e 0.001 -n 4 -o "$tmp/flat.fits"
+expect 0 "wrote $tmp/dark_0005.png" -- "$navcam" expose "$cam" --dark -e 0.5 -n 2 --first-frame 4 -o "$tmp/dark.png"
+[ -s "$tmp/dark_0004.png" ] && ok || bad "dark_0004.png not written"
+# Same command, same frames: bit for bit.
+"$navcam" expose "$cam" -L 3 -e 0.001 -n 4 -o "$tmp/flat2.fits" >/dev/null
+cmp -s "$tmp/flat.fits" "$tmp/flat2.fits" && ok || bad "expose is not reproducible"
+expect 1 "cam.yaml:3: sensor.gain: unknown key" -- sh -c "sed 's/gain_e_per_dn/gain/' '$cam' > '$tmp/cam.yaml.bad' && mv '$tmp/cam.yaml.bad' '$tmp/cam2.yaml' && '$navcam' expose '$tmp/cam2.yaml' -L 1 -o '$tmp/x.fits' 2>&1 | sed 's/cam2/cam/'; exit 1"
+expect 2 "missing --radiance L (or --dark)" -- "$navcam" expose "$cam" -o "$tmp/x.fits"
+expect 0 "photon transfer" -- "$navcam" expose --help
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
