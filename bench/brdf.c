@@ -16,6 +16,7 @@
 #include "error.h"
 #include "material.h"
 #include "render.h"
+#include "camsys.h"
 #include "scene.h"
 
 static double now_ms(void)
@@ -47,11 +48,13 @@ static void setup(struct setup *x, const char *material, int threads)
 {
     const char *sets[] = {"bodies.0.shape.subdivisions=8", "render.samples_per_pixel=1",
                           "camera.position_m=[0, -2600, 0]", material};
-    if (nc_scene_load(NULL, sets, 4, &x->s) < 0 || nc_renderer_init(&x->r, &x->s, threads) < 0 ||
+    struct nc_camsys cs;
+    if (nc_setup_load(NULL, sets, 4, &x->s, &cs) < 0 || nc_renderer_init(&x->r, &x->s, threads) < 0 ||
         nc_frame_alloc(&x->f, x->s.camera.width_px, x->s.camera.height_px) < 0) {
         fprintf(stderr, "bench: %s\n", nc_errmsg());
         exit(1);
     }
+    nc_camsys_free(&cs); /* the scene's camera model is not needed here */
     nc_render_frame(&x->r, &x->s, &x->f); /* warm-up */
 }
 

@@ -420,8 +420,10 @@ static void cosmic_rays(const struct nc_camsys *cs, double exposure_s, uint64_t 
     for (long h = 0; h < hits; h++) {
         nc_rng4(s->seed, NC_RNG_COSMIC, frame, (uint32_t)h, 1, u);
         double x = u[0] * W, y = u[1] * H, a = 2 * M_PI * u[2], len = -s->cosmic_track_px * log(u[3]);
+        /* Charge per pixel of projected track; a track shorter than a pixel
+         * (near-normal incidence) still crosses the whole depth of one. */
         int steps = (int)ceil(len / 0.5) + 1;
-        double q = s->cosmic_e_per_px * (len > 0 ? len : 1.0) / steps;
+        double q = s->cosmic_e_per_px * (len > 1.0 ? len : 1.0) / steps;
         for (int k = 0; k < steps; k++) {
             double t = steps > 1 ? (double)k / (steps - 1) : 0.0;
             int px = (int)floor(x + t * len * cos(a)), py = (int)floor(y + t * len * sin(a));

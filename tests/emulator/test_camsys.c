@@ -304,8 +304,35 @@ static void shot_noise_statistics(void)
     nc_camsys_free(&cs);
 }
 
+/* Cosmic rays: the number of tracks follows rate x area x exposure. */
+static void cosmic_ray_rate(void)
+{
+    const char *sets[] = {"sensor={read_noise_e: 0, shot_noise: false, gain_e_per_dn: 1, full_well_e: 60000, seed: 5, "
+                          "cosmic_rays: {rate_cm2_s: 20, track_length_px: 0.01, e_per_px: 5000}}"};
+    struct nc_camera g;
+    struct nc_camsys cs;
+    load(sets, 1, &g, &cs);
+    static float e[W * H];
+    static uint16_t a[W * H];
+    memset(e, 0, sizeof e);
+    /* 256 x 256 x (10 um)^2 = 0.065536 cm^2; 20 /cm^2/s x 2 s: 2.62 tracks a
+     * frame; tracks this short deposit one pixel each. */
+    long hits = 0;
+    const int frames = 400;
+    for (int f = 0; f < frames; f++) {
+        nc_camsys_digitise(&cs, e, 2.0, (uint64_t)f, a);
+        for (int i = 0; i < W * H; i++)
+            hits += a[i] > 2500;
+    }
+    double want = 20 * 0.065536 * 2.0 * frames, sd = sqrt(want);
+    printf("cosmic rays: %ld hit pixels in %d frames, expected %.0f +- %.0f\n", hits, frames, want, sd);
+    CHECK(fabs(hits - want) < 4 * sd, "cosmic ray hits %ld, expected %.0f", hits, want);
+    nc_camsys_free(&cs);
+}
+
 int main(void)
 {
+    cosmic_ray_rate();
     photon_transfer();
     radiometry();
     shot_noise_statistics();

@@ -60,6 +60,26 @@ int main(void)
     }
     nc_frame_free(&f);
     nc_renderer_free(&r);
+    /* An exposure with motion smear and a rolling shutter: the same for any
+     * thread count too. */
+    s.camera.angular_velocity_rad_s = nc_v3(0.01, 0.2, -0.03);
+    s.body[0].angular_velocity_rad_s = nc_v3(0, 0, 0.01);
+    struct nc_exposure ex = {.exposure_s = 0.01, .rolling = 1, .line_time_s = 2e-5};
+    struct nc_frame e1, e3;
+    struct nc_renderer r1, r3;
+    int k1 = 0, k3 = 0;
+    nc_renderer_init(&r1, &s, 1);
+    nc_renderer_init(&r3, &s, 3);
+    nc_frame_alloc(&e1, s.camera.width_px, s.camera.height_px);
+    nc_frame_alloc(&e3, s.camera.width_px, s.camera.height_px);
+    nc_render_exposure(&r1, &s, &ex, &e1, &k1);
+    nc_render_exposure(&r3, &s, &ex, &e3, &k3);
+    CHECK(k1 > 1 && k1 == k3 && same(&e1, &e3), "smeared rolling-shutter exposure differs between 1 and 3 threads (%d, %d samples)",
+          k1, k3);
+    nc_frame_free(&e1);
+    nc_frame_free(&e3);
+    nc_renderer_free(&r1);
+    nc_renderer_free(&r3);
     nc_frame_free(&ref);
     nc_scene_free(&s);
     return nc_test_end();
