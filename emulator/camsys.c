@@ -302,7 +302,9 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
     cs->response = malloc(n * sizeof(float));
     cs->prnu_map = malloc(n * sizeof(float));
     cs->dark_map = malloc(n * sizeof(float));
-    if (!cs->response || !cs->prnu_map || !cs->dark_map) {
+    cs->scratch[0] = malloc(n * sizeof(float));
+    cs->scratch[1] = malloc(n * sizeof(float));
+    if (!cs->response || !cs->prnu_map || !cs->dark_map || !cs->scratch[0] || !cs->scratch[1]) {
         rc = nc_error(-ENOMEM, "out of memory");
         goto fail;
     }
@@ -340,6 +342,8 @@ void nc_camsys_free(struct nc_camsys *cs)
     free(cs->response);
     free(cs->prnu_map);
     free(cs->dark_map);
+    free(cs->scratch[0]);
+    free(cs->scratch[1]);
     free(cs->optics.vig_angle_rad);
     free(cs->optics.vig_factor);
     nc_psf_free(&cs->optics.psf);
@@ -357,20 +361,15 @@ int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, doubl
         return nc_error(NC_ECONFIG, "electrons and DN need the pixel pitch: set camera.focal_length_m with "
                                     "camera.pixel_pitch_m, or sensor.pixel_pitch_m");
     size_t n = (size_t)cs->width_px * (size_t)cs->height_px;
-    float *tmp = cs->optics.psf.size > 1 ? malloc(n * sizeof *tmp) : electrons;
-    if (!tmp)
-        return nc_error(-ENOMEM, "out of memory");
+    float *tmp = cs->optics.psf.size > 1 ? cs->scratch[0] : electrons;
     for (size_t p = 0; p < n; p++) {
         /* Far beyond any full well, charge is capped: a float must hold it.
          * NaN fails both comparisons and becomes 0. */
         double v = (double)radiance[p] * cs->response[p] * exposure_s;
         tmp[p] = v > 0 ? (v < 1e30 ? (float)v : 1e30f) : 0.0f;
     }
-    if (tmp != electrons) {
-        int rc = nc_psf_apply(&cs->optics.psf, tmp, electrons, cs->width_px, cs->height_px);
-        free(tmp);
-        return rc;
-    }
+    if (tmp != electrons)
+        return nc_psf_apply_scratch(&cs->optics.psf, tmp, electrons, cs->width_px, cs->height_px, cs->scratch[1]);
     return 0;
 }
 
@@ -443,35 +442,47 @@ static inline uint16_t adc(double v, double top)
 }
 
 /* The random numbers of one image row: for each pair of pixels one Philox
- * call keyed by (seed, frame, pair), giving per pixel a uniform for exact
- * low-count Poisson sampling and two standard normals (shot noise at high
- * counts, read noise) through Box-Muller, evaluated as vector batches. */
+ * call keyed by (seed, frame, pair) gives four 24-bit uniforms in (0, 1):
+ * Box-Muller pair A (u0, u1) gives both pixels' read-noise normals, pair B
+ * (u2, u3) their shot-noise normals at high counts; at low counts u2 and u3
+ * are instead the uniforms of exact Poisson sampling (pair B then unused). No
+ * draw serves twice in one pixel. Single precision and vector batches:
+ * plenty for noise, and the whole frame takes a few milliseconds. */
 struct row_rng {
-    double *u, *lr, *ang, *s, *c; /* 2 per pixel each */
+    uint32_t *w;                 /* 4 words per pair */
+    float *u, *lr, *ang, *s, *c; /* 2 per pixel each */
+    float *zr, *zs;              /* per pixel: read-noise and shot-noise normals */
 };
 
+__attribute__((target_clones("avx2", "default")))
 static void row_normals(const struct nc_camsys *cs, uint64_t frame, int y, int W, struct row_rng *b)
 {
-    const uint64_t seed = cs->sensor.seed;
     const int pairs = (W + 1) / 2;
+    nc_rng_words(cs->sensor.seed, NC_RNG_PIXEL_NOISE, frame, (uint32_t)((size_t)y * (size_t)pairs), 0,
+                 (size_t)pairs, b->w);
+    const float scale = 0x1.0p-24f;
     for (int k = 0; k < pairs; k++) {
-        double u[4];
-        nc_rng4(seed, NC_RNG_PIXEL_NOISE, frame, (uint32_t)((size_t)y * (size_t)pairs + (size_t)k), 0, u);
-        /* Box-Muller pair A = (u0, u1): the read-noise normals of both pixels.
-         * Pair B = (u2, u3): their shot-noise normals at high counts; at low
-         * counts u2 and u3 are instead the uniforms of exact Poisson sampling
-         * (then pair B is unused). No draw serves twice in one pixel. */
-        b->u[2 * k] = u[2];
-        b->u[2 * k + 1] = u[3];
-        b->lr[2 * k] = u[0];
-        b->lr[2 * k + 1] = u[2];
-        b->ang[2 * k] = 2.0 * u[1];
-        b->ang[2 * k + 1] = 2.0 * u[3];
+        const uint32_t *w = b->w + 4 * k;
+        float u0 = ((float)(w[0] >> 8) + 0.5f) * scale, u1 = ((float)(w[1] >> 8) + 0.5f) * scale;
+        float u2 = ((float)(w[2] >> 8) + 0.5f) * scale, u3 = ((float)(w[3] >> 8) + 0.5f) * scale;
+        b->u[2 * k] = u2;
+        b->u[2 * k + 1] = u3;
+        b->lr[2 * k] = u0;
+        b->lr[2 * k + 1] = u2;
+        b->ang[2 * k] = 2.0f * u1;
+        b->ang[2 * k + 1] = 2.0f * u3;
     }
-    nc_vlog(b->lr, (size_t)2 * pairs);
-    nc_vsincospi(b->ang, b->s, b->c, (size_t)2 * pairs);
+    nc_vlogf(b->lr, (size_t)2 * pairs);
+    nc_vsincospif(b->ang, b->s, b->c, (size_t)2 * pairs);
     for (int i = 0; i < 2 * pairs; i++)
-        b->lr[i] = sqrt(-2.0 * b->lr[i]);
+        b->lr[i] = sqrtf(-2.0f * b->lr[i]);
+    /* Even pixels take the cosines, odd pixels the sines. */
+    for (int k = 0; k < pairs; k++) {
+        b->zr[2 * k] = b->lr[2 * k] * b->c[2 * k];
+        b->zr[2 * k + 1] = b->lr[2 * k] * b->s[2 * k];
+        b->zs[2 * k] = b->lr[2 * k + 1] * b->c[2 * k + 1];
+        b->zs[2 * k + 1] = b->lr[2 * k + 1] * b->s[2 * k + 1];
+    }
 }
 
 int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, double exposure_s, uint64_t frame,
@@ -487,15 +498,19 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
     const int whole = s->blooming || s->cosmic_rate_cm2_s > 0;
     double *e = whole ? malloc(n * sizeof *e) : NULL;
     float *rn = whole ? malloc(n * sizeof *rn) : NULL;
-    double *buf = malloc((size_t)nb * 7 * sizeof *buf);
-    if (!buf || (whole && (!e || !rn))) {
+    float *buf = malloc((size_t)nb * 8 * sizeof *buf);
+    uint32_t *words = malloc((size_t)pairs * 4 * sizeof *words);
+    double *lam = malloc((size_t)nb * sizeof *lam);
+    if (!buf || !words || !lam || (whole && (!e || !rn))) {
         free(e);
         free(rn);
         free(buf);
+        free(words);
+        free(lam);
         return nc_error(-ENOMEM, "out of memory");
     }
-    struct row_rng b = {buf, buf + nb, buf + 2 * nb, buf + 3 * nb, buf + 4 * nb};
-    double *lam = buf + 5 * nb, *p0 = buf + 6 * nb;
+    struct row_rng b = {words, buf, buf + nb, buf + 2 * nb, buf + 3 * nb, buf + 4 * nb, buf + 6 * nb, buf + 7 * nb};
+    float *p0 = buf + 5 * nb;
     for (int y = 0; y < H; y++) {
         const size_t o = (size_t)y * (size_t)W;
         row_normals(cs, frame, y, W, &b);
@@ -503,16 +518,13 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
          * low-count pixels in one batch. */
         for (int x = 0; x < W; x++) {
             lam[x] = (double)electrons[o + x] * cs->prnu_map[o + x] + (double)cs->dark_map[o + x] * exposure_s;
-            p0[x] = lam[x] < 40.0 ? -lam[x] : -40.0;
+            p0[x] = lam[x] < 40.0 ? (float)-lam[x] : -40.0f;
         }
         if (s->shot_noise)
-            nc_vexp(p0, (size_t)W);
+            nc_vexpf(p0, (size_t)W);
         for (int x = 0; x < W; x++) {
-            /* Even pixels take the cosines, odd pixels the sines. */
-            const int a = x & ~1, odd = x & 1;
-            double z2 = b.lr[a] * (odd ? b.s[a] : b.c[a]);             /* read noise, pair A */
-            double z1 = b.lr[a + 1] * (odd ? b.s[a + 1] : b.c[a + 1]); /* shot noise, pair B */
-            double q = s->shot_noise ? poisson(lam[x], p0[x], b.u[x], z1) : lam[x];
+            const double z2 = b.zr[x];
+            double q = s->shot_noise ? poisson(lam[x], p0[x], b.u[x], b.zs[x]) : lam[x];
             if (whole) {
                 e[o + x] = q;
                 rn[o + x] = (float)z2;
@@ -522,6 +534,8 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
         }
     }
     free(buf);
+    free(words);
+    free(lam);
     if (!whole)
         return 0;
     if (s->cosmic_rate_cm2_s > 0)

@@ -77,6 +77,7 @@ struct nc_camsys {
     float *response;             /* e- per (W m^-2 sr^-1) per second, per pixel (optics, QE, vignetting) */
     float *prnu_map;             /* 1 + PRNU pattern */
     float *dark_map;             /* e-/s per pixel at the operating temperature */
+    float *scratch[2];           /* frame-sized work buffers: a camsys serves one thread at a time */
 };
 
 /* Read `optics`, `sensor` and `exposure` under root (each optional; defaults
@@ -102,8 +103,11 @@ int nc_psf_gaussian(double sigma_px, struct nc_psf *psf);
 int nc_psf_airy(double wavelength_m, double f_number, double pixel_pitch_m, struct nc_psf *psf);
 int nc_psf_image(const char *path, struct nc_psf *psf);
 /* out = in convolved with the kernel (same size; zero outside the image). Uses
- * FFTW above a kernel size threshold, direct summation below. */
+ * FFTW above a kernel size threshold, direct summation below. scratch, if not
+ * NULL, is a width*height work buffer (saves an allocation per frame). */
 int nc_psf_apply(const struct nc_psf *psf, const float *in, float *out, int width, int height);
+int nc_psf_apply_scratch(const struct nc_psf *psf, const float *in, float *out, int width, int height,
+                         float *scratch);
 void nc_psf_free(struct nc_psf *psf);
 
 #endif

@@ -22,6 +22,13 @@ static inline void nc_rng4(uint64_t seed, enum nc_rng_stream stream, uint64_t fr
         u[i] = ((double)r.v[i] + 0.5) * 0x1.0p-32;
 }
 
+/* Philox4x32-10 for `count` consecutive indices first .. first+count-1 (same
+ * seed, stream, frame, block): out[4*i + j] is word j of index first+i,
+ * bit-identical to nc_rng4's words (rng.c; a structure-of-arrays form the
+ * compiler vectorises, checked against Random123 by the tests). */
+void nc_rng_words(uint64_t seed, enum nc_rng_stream stream, uint64_t frame, uint32_t first, uint32_t block,
+                  size_t count, uint32_t *out);
+
 /* Two independent standard normals from two uniforms (Box-Muller). */
 static inline void nc_normal2(double u1, double u2, double *z1, double *z2)
 {

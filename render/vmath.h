@@ -14,6 +14,11 @@ void nc_vlog(double *x, size_t n);
 void nc_vacos(double *x, size_t n);
 /* s[i] = sin(pi x[i]), c[i] = cos(pi x[i]). */
 void nc_vsincospi(const double *x, double *s, double *c, size_t n);
+/* Single precision, for noise generation (SLEEF: 3.5 ulp log and sincospi,
+ * 1 ulp exp; 8 lanes). */
+void nc_vlogf(float *x, size_t n);
+void nc_vexpf(float *x, size_t n);
+void nc_vsincospif(const float *x, float *s, float *c, size_t n);
 /* Which implementation runs here, for logs and benchmarks. */
 const char *nc_vmath_impl(void);
 

@@ -29,4 +29,24 @@ void nc_vsincospi(const double *x, double *s, double *c, size_t n)
     }
 }
 
+void nc_vlogf(float *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        x[i] = logf(x[i]);
+}
+
+void nc_vexpf(float *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        x[i] = expf(x[i]);
+}
+
+void nc_vsincospif(const float *x, float *s, float *c, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        s[i] = sinf((float)M_PI * x[i]);
+        c[i] = cosf((float)M_PI * x[i]);
+    }
+}
+
 const char *nc_vmath_impl(void) { return "libm"; }

@@ -75,4 +75,57 @@ void nc_vsincospi(const double *x, double *s, double *c, size_t n)
     }
 }
 
+#define NC_VMATHF_DEFINE(name, sleef_fn, libm_fn, pad)                                                         \
+    void name(float *x, size_t n)                                                                              \
+    {                                                                                                          \
+        if (!avx2()) {                                                                                         \
+            for (size_t i = 0; i < n; i++)                                                                     \
+                x[i] = libm_fn(x[i]);                                                                          \
+            return;                                                                                            \
+        }                                                                                                      \
+        size_t i = 0;                                                                                          \
+        for (; i + 8 <= n; i += 8)                                                                             \
+            _mm256_storeu_ps(x + i, sleef_fn(_mm256_loadu_ps(x + i)));                                         \
+        if (i < n) {                                                                                           \
+            float t[8] = {pad, pad, pad, pad, pad, pad, pad, pad};                                             \
+            for (size_t k = 0; i + k < n; k++)                                                                 \
+                t[k] = x[i + k];                                                                               \
+            _mm256_storeu_ps(t, sleef_fn(_mm256_loadu_ps(t)));                                                 \
+            for (size_t k = 0; i + k < n; k++)                                                                 \
+                x[i + k] = t[k];                                                                               \
+        }                                                                                                      \
+    }
+
+NC_VMATHF_DEFINE(nc_vlogf, Sleef_logf8_u35avx2, logf, 1.0f)
+NC_VMATHF_DEFINE(nc_vexpf, Sleef_expf8_u10avx2, expf, 0.0f)
+
+void nc_vsincospif(const float *x, float *s, float *c, size_t n)
+{
+    if (!avx2()) {
+        for (size_t i = 0; i < n; i++) {
+            s[i] = sinf((float)M_PI * x[i]);
+            c[i] = cosf((float)M_PI * x[i]);
+        }
+        return;
+    }
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        Sleef___m256_2 r = Sleef_sincospif8_u35avx2(_mm256_loadu_ps(x + i));
+        _mm256_storeu_ps(s + i, r.x);
+        _mm256_storeu_ps(c + i, r.y);
+    }
+    if (i < n) {
+        float t[8] = {0}, ts[8], tc[8];
+        for (size_t k = 0; i + k < n; k++)
+            t[k] = x[i + k];
+        Sleef___m256_2 r = Sleef_sincospif8_u35avx2(_mm256_loadu_ps(t));
+        _mm256_storeu_ps(ts, r.x);
+        _mm256_storeu_ps(tc, r.y);
+        for (size_t k = 0; i + k < n; k++) {
+            s[i + k] = ts[k];
+            c[i + k] = tc[k];
+        }
+    }
+}
+
 const char *nc_vmath_impl(void) { return avx2() ? "SLEEF AVX2 (u10)" : "libm"; }
