@@ -355,6 +355,20 @@ double nc_camsys_dn_per_e(const struct nc_camsys *cs)
     return exp10(cs->sensor.analog_gain_db / 20.0) / cs->sensor.gain_e_per_dn;
 }
 
+/* Photo-electrons: radiance x response x exposure. Far beyond any full well,
+ * charge is capped so that a float holds it; NaN fails both comparisons and
+ * becomes 0. */
+__attribute__((target_clones("avx2", "default")))
+static void scale_row(const float *restrict radiance, const float *restrict response, double exposure_s, size_t n,
+                      float *restrict out)
+{
+    const float t = (float)exposure_s;
+    for (size_t p = 0; p < n; p++) {
+        float v = radiance[p] * response[p] * t;
+        out[p] = v > 0 ? (v < 1e30f ? v : 1e30f) : 0.0f;
+    }
+}
+
 int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, double exposure_s, float *electrons)
 {
     if (!(cs->sensor.pixel_pitch_m > 0))
@@ -362,12 +376,7 @@ int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, doubl
                                     "camera.pixel_pitch_m, or sensor.pixel_pitch_m");
     size_t n = (size_t)cs->width_px * (size_t)cs->height_px;
     float *tmp = cs->optics.psf.size > 1 ? cs->scratch[0] : electrons;
-    for (size_t p = 0; p < n; p++) {
-        /* Far beyond any full well, charge is capped: a float must hold it.
-         * NaN fails both comparisons and becomes 0. */
-        double v = (double)radiance[p] * cs->response[p] * exposure_s;
-        tmp[p] = v > 0 ? (v < 1e30 ? (float)v : 1e30f) : 0.0f;
-    }
+    scale_row(radiance, cs->response, exposure_s, n, tmp);
     if (tmp != electrons)
         return nc_psf_apply_scratch(&cs->optics.psf, tmp, electrons, cs->width_px, cs->height_px, cs->scratch[1]);
     return 0;
@@ -432,6 +441,33 @@ static void cosmic_rays(const struct nc_camsys *cs, double exposure_s, uint64_t 
     }
 }
 
+/* q[x]: electrons after shot noise, or -1 where exact inversion must decide
+ * (lambda < 32 and u > P(0)). Single precision (24-bit: whole electrons are
+ * exact below 16.7 M e-), selects and no branches, so that it vectorises. */
+__attribute__((target_clones("avx2", "default")))
+static void charge_row(const float *restrict lam, const float *restrict p0, const float *restrict u,
+                       const float *restrict zs, int W, int shot, float *restrict q)
+{
+    for (int x = 0; x < W; x++) {
+        float hi = floorf(lam[x] + sqrtf(lam[x]) * zs[x] + 0.5f);
+        hi = hi > 0 ? hi : 0.0f;
+        float lo = u[x] <= p0[x] ? 0.0f : -1.0f;
+        q[x] = !shot ? lam[x] : lam[x] >= 32.0f ? hi : lo;
+    }
+}
+
+/* DN = round(bias + (min(q, full well) + read noise z) g), clipped. */
+__attribute__((target_clones("avx2", "default")))
+static void digitise_row(const float *restrict q, const float *restrict zr, int W, float fw, float rn_e, float bias,
+                         float g, float top, uint16_t *restrict dn)
+{
+    for (int x = 0; x < W; x++) {
+        float v = floorf(bias + ((q[x] < fw ? q[x] : fw) + rn_e * zr[x]) * g + 0.5f);
+        v = v < 0 ? 0 : v > top ? top : v;
+        dn[x] = (uint16_t)(int32_t)v;
+    }
+}
+
 /* The ADC: round to nearest, clip to 0 .. top. */
 static inline uint16_t adc(double v, double top)
 {
@@ -458,13 +494,13 @@ __attribute__((target_clones("avx2", "default")))
 static void row_normals(const struct nc_camsys *cs, uint64_t frame, int y, int W, struct row_rng *b)
 {
     const int pairs = (W + 1) / 2;
+    uint32_t *const w[4] = {b->w, b->w + pairs, b->w + 2 * pairs, b->w + 3 * pairs};
     nc_rng_words(cs->sensor.seed, NC_RNG_PIXEL_NOISE, frame, (uint32_t)((size_t)y * (size_t)pairs), 0,
-                 (size_t)pairs, b->w);
+                 (size_t)pairs, w);
     const float scale = 0x1.0p-24f;
     for (int k = 0; k < pairs; k++) {
-        const uint32_t *w = b->w + 4 * k;
-        float u0 = ((float)(w[0] >> 8) + 0.5f) * scale, u1 = ((float)(w[1] >> 8) + 0.5f) * scale;
-        float u2 = ((float)(w[2] >> 8) + 0.5f) * scale, u3 = ((float)(w[3] >> 8) + 0.5f) * scale;
+        float u0 = ((float)(w[0][k] >> 8) + 0.5f) * scale, u1 = ((float)(w[1][k] >> 8) + 0.5f) * scale;
+        float u2 = ((float)(w[2][k] >> 8) + 0.5f) * scale, u3 = ((float)(w[3][k] >> 8) + 0.5f) * scale;
         b->u[2 * k] = u2;
         b->u[2 * k + 1] = u3;
         b->lr[2 * k] = u0;
@@ -500,7 +536,7 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
     float *rn = whole ? malloc(n * sizeof *rn) : NULL;
     float *buf = malloc((size_t)nb * 8 * sizeof *buf);
     uint32_t *words = malloc((size_t)pairs * 4 * sizeof *words);
-    double *lam = malloc((size_t)nb * sizeof *lam);
+    float *lam = malloc((size_t)nb * 2 * sizeof *lam), *q = lam + nb;
     if (!buf || !words || !lam || (whole && (!e || !rn))) {
         free(e);
         free(rn);
@@ -516,22 +552,28 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
         row_normals(cs, frame, y, W, &b);
         /* Charge: response pattern and dark current; exp(-lambda) for the
          * low-count pixels in one batch. */
+        const float t = (float)exposure_s;
         for (int x = 0; x < W; x++) {
-            lam[x] = (double)electrons[o + x] * cs->prnu_map[o + x] + (double)cs->dark_map[o + x] * exposure_s;
-            p0[x] = lam[x] < 40.0 ? (float)-lam[x] : -40.0f;
+            lam[x] = electrons[o + x] * cs->prnu_map[o + x] + cs->dark_map[o + x] * t;
+            p0[x] = lam[x] < 40.0f ? -lam[x] : -40.0f;
         }
         if (s->shot_noise)
             nc_vexpf(p0, (size_t)W);
-        for (int x = 0; x < W; x++) {
-            const double z2 = b.zr[x];
-            double q = s->shot_noise ? poisson(lam[x], p0[x], b.u[x], b.zs[x]) : lam[x];
-            if (whole) {
-                e[o + x] = q;
-                rn[o + x] = (float)z2;
-                continue;
+        /* Charge after shot noise, branch-free for the common cases: the
+         * normal approximation at >= 32 e-, and k = 0 at low counts when
+         * u <= P(0); the rest (low counts, k >= 1) by exact inversion below. */
+        charge_row(lam, p0, b.u, b.zs, W, s->shot_noise, q);
+        for (int x = 0; x < W; x++)
+            if (q[x] < 0)
+                q[x] = poisson(lam[x], p0[x], b.u[x], 0.0);
+        if (whole) {
+            for (int x = 0; x < W; x++) {
+                e[o + x] = q[x];
+                rn[o + x] = b.zr[x];
             }
-            dn[o + x] = adc(s->bias_dn + ((q < fw ? q : fw) + s->read_noise_e * z2) * g, top);
+            continue;
         }
+        digitise_row(q, b.zr, W, (float)fw, (float)s->read_noise_e, (float)s->bias_dn, (float)g, (float)top, dn + o);
     }
     free(buf);
     free(words);

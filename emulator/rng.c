@@ -39,26 +39,29 @@ __attribute__((target("avx2"))) static void philox8(uint32_t k0, uint32_t k1, __
 }
 
 __attribute__((target("avx2"))) static void words_avx2(uint64_t seed, uint32_t f0, uint32_t f1, uint32_t first,
-                                                       uint32_t block, size_t count, uint32_t *out)
+                                                       uint32_t block, size_t count, uint32_t *const out[4])
 {
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     for (size_t base = 0; base < count; base += 8) {
-        uint32_t idx[8], w[4][8];
-        for (int l = 0; l < 8; l++)
-            idx[l] = first + (uint32_t)(base + (size_t)l);
-        __m256i c[4] = {_mm256_loadu_si256((const __m256i *)idx), _mm256_set1_epi32((int)f0),
-                        _mm256_set1_epi32((int)f1), _mm256_set1_epi32((int)block)};
+        __m256i c[4] = {_mm256_add_epi32(_mm256_set1_epi32((int)(first + (uint32_t)base)), lane),
+                        _mm256_set1_epi32((int)f0), _mm256_set1_epi32((int)f1), _mm256_set1_epi32((int)block)};
         philox8((uint32_t)seed, (uint32_t)(seed >> 32), c);
-        for (int j = 0; j < 4; j++)
-            _mm256_storeu_si256((__m256i *)w[j], c[j]);
-        size_t m = count - base < 8 ? count - base : 8;
-        for (size_t l = 0; l < m; l++)
+        if (base + 8 <= count) {
             for (int j = 0; j < 4; j++)
-                out[4 * (base + l) + j] = w[j][l];
+                _mm256_storeu_si256((__m256i *)(out[j] + base), c[j]);
+        } else {
+            uint32_t w[4][8];
+            for (int j = 0; j < 4; j++)
+                _mm256_storeu_si256((__m256i *)w[j], c[j]);
+            for (size_t l = 0; base + l < count; l++)
+                for (int j = 0; j < 4; j++)
+                    out[j][base + l] = w[j][l];
+        }
     }
 }
 
 void nc_rng_words(uint64_t seed, enum nc_rng_stream stream, uint64_t frame, uint32_t first, uint32_t block,
-                  size_t count, uint32_t *out)
+                  size_t count, uint32_t *const out[4])
 {
     static int avx2 = -1;
     if (avx2 < 0) {
@@ -74,6 +77,7 @@ void nc_rng_words(uint64_t seed, enum nc_rng_stream stream, uint64_t frame, uint
     for (size_t i = 0; i < count; i++) {
         philox4x32_ctr_t c = {{first + (uint32_t)i, f0, f1, block}};
         philox4x32_ctr_t r = philox4x32(c, k);
-        memcpy(out + 4 * i, r.v, sizeof r.v);
+        for (int j = 0; j < 4; j++)
+            out[j][i] = r.v[j];
     }
 }

@@ -23,11 +23,11 @@ static inline void nc_rng4(uint64_t seed, enum nc_rng_stream stream, uint64_t fr
 }
 
 /* Philox4x32-10 for `count` consecutive indices first .. first+count-1 (same
- * seed, stream, frame, block): out[4*i + j] is word j of index first+i,
- * bit-identical to nc_rng4's words (rng.c; a structure-of-arrays form the
- * compiler vectorises, checked against Random123 by the tests). */
+ * seed, stream, frame, block): out[j][i] is word j of index first+i,
+ * bit-identical to nc_rng4's words (rng.c: eight counters per AVX2 register,
+ * checked against Random123 by the tests). */
 void nc_rng_words(uint64_t seed, enum nc_rng_stream stream, uint64_t frame, uint32_t first, uint32_t block,
-                  size_t count, uint32_t *out);
+                  size_t count, uint32_t *const out[4]);
 
 /* Two independent standard normals from two uniforms (Box-Muller). */
 static inline void nc_normal2(double u1, double u2, double *z1, double *z2)

@@ -11,7 +11,8 @@ int main(void)
     const uint64_t seeds[] = {0, 1, 42, 0xdeadbeefcafef00dull};
     const uint64_t frames[] = {0, 7, 1ull << 33};
     enum { N = 1000 };
-    static uint32_t w[4 * N];
+    static uint32_t w0[N], w1[N], w2[N], w3[N];
+    uint32_t *const w[4] = {w0, w1, w2, w3};
     long bad = 0, n = 0;
     for (int s = 0; s < 4; s++)
         for (int f = 0; f < 3; f++)
@@ -23,7 +24,7 @@ int main(void)
                                            (uint32_t)(frames[f] >> 32) ^ ((uint32_t)st << 28), 2u}};
                     philox4x32_ctr_t r = philox4x32(c, k);
                     for (int j = 0; j < 4; j++, n++)
-                        bad += r.v[j] != w[4 * i + j];
+                        bad += r.v[j] != w[j][i];
                 }
             }
     printf("batched Philox4x32-10: %ld of %ld words differ from Random123\n", bad, n);
