@@ -11,20 +11,8 @@
 #include <time.h>
 
 #include "camsys.h"
+#include "bench_util.h"
 #include "error.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 int main(int argc, char **argv)
 {
@@ -82,14 +70,12 @@ int main(int argc, char **argv)
         td[k] = c2 - b;
         tt[k] = c2 - a;
     }
-    qsort(te, (size_t)frames, sizeof *te, cmp);
-    qsort(td, (size_t)frames, sizeof *td, cmp);
-    qsort(tt, (size_t)frames, sizeof *tt, cmp);
+    double me = median(te, frames), md = median(td, frames), mt = median(tt, frames);
     printf("camera model, 1024x1024, 1 core, PSF %s (%dx%d kernel), median of %d frames:\n", psf, cs.optics.psf.size,
            cs.optics.psf.size, frames);
-    printf("  radiance -> electrons incl. PSF   %.2f ms\n", te[frames / 2]);
-    printf("  noise, full well, read noise, ADC %.2f ms\n", td[frames / 2]);
-    printf("sensor_ms=%.3f\n", tt[frames / 2]);
+    printf("  radiance -> electrons incl. PSF   %.2f ms\n", me);
+    printf("  noise, full well, read noise, ADC %.2f ms\n", md);
+    printf("sensor_ms=%.3f\n", mt);
     free(rad);
     free(e);
     free(dn);

@@ -19,10 +19,11 @@ static int avx2(void)
     return use_avx2;
 }
 
-/* Full 4-lane groups through SLEEF; the tail through a padded group, so a
- * value's result never depends on its position in the array. */
-#define NC_VMATH_DEFINE(name, sleef_fn, libm_fn, pad)                                                          \
-    void name(double *x, size_t n)                                                                             \
+/* Full groups of lanes through SLEEF; the tail through a padded group, so a
+ * value's result never depends on its position in the array. T is the
+ * element type, V the vector type, LANES its width, LD/ST its load and store. */
+#define NC_VMATH_DEFINE_T(name, T, V, LANES, LD, ST, sleef_fn, libm_fn, pad)                                 \
+    void name(T *x, size_t n)                                                                                  \
     {                                                                                                          \
         if (!avx2()) {                                                                                         \
             for (size_t i = 0; i < n; i++)                                                                     \
@@ -30,17 +31,21 @@ static int avx2(void)
             return;                                                                                            \
         }                                                                                                      \
         size_t i = 0;                                                                                          \
-        for (; i + 4 <= n; i += 4)                                                                             \
-            _mm256_storeu_pd(x + i, sleef_fn(_mm256_loadu_pd(x + i)));                                         \
+        for (; i + LANES <= n; i += LANES)                                                                     \
+            ST(x + i, sleef_fn(LD(x + i)));                                                                    \
         if (i < n) {                                                                                           \
-            double t[4] = {pad, pad, pad, pad};                                                                \
-            for (size_t k = 0; i + k < n; k++)                                                                 \
-                t[k] = x[i + k];                                                                               \
-            _mm256_storeu_pd(t, sleef_fn(_mm256_loadu_pd(t)));                                                 \
+            T t[LANES];                                                                                        \
+            for (size_t k = 0; k < LANES; k++)                                                                 \
+                t[k] = i + k < n ? x[i + k] : (pad);                                                           \
+            ST(t, sleef_fn(LD(t)));                                                                            \
             for (size_t k = 0; i + k < n; k++)                                                                 \
                 x[i + k] = t[k];                                                                               \
         }                                                                                                      \
     }
+#define NC_VMATH_DEFINE(name, fn, libm_fn, pad)                                                                \
+    NC_VMATH_DEFINE_T(name, double, __m256d, 4, _mm256_loadu_pd, _mm256_storeu_pd, fn, libm_fn, pad)
+#define NC_VMATHF_DEFINE(name, fn, libm_fn, pad)                                                               \
+    NC_VMATH_DEFINE_T(name, float, __m256, 8, _mm256_loadu_ps, _mm256_storeu_ps, fn, libm_fn, pad)
 
 NC_VMATH_DEFINE(nc_vexp, Sleef_expd4_u10avx2, exp, 0.0)
 NC_VMATH_DEFINE(nc_vlog, Sleef_logd4_u10avx2, log, 1.0)
@@ -74,27 +79,6 @@ void nc_vsincospi(const double *x, double *s, double *c, size_t n)
         }
     }
 }
-
-#define NC_VMATHF_DEFINE(name, sleef_fn, libm_fn, pad)                                                         \
-    void name(float *x, size_t n)                                                                              \
-    {                                                                                                          \
-        if (!avx2()) {                                                                                         \
-            for (size_t i = 0; i < n; i++)                                                                     \
-                x[i] = libm_fn(x[i]);                                                                          \
-            return;                                                                                            \
-        }                                                                                                      \
-        size_t i = 0;                                                                                          \
-        for (; i + 8 <= n; i += 8)                                                                             \
-            _mm256_storeu_ps(x + i, sleef_fn(_mm256_loadu_ps(x + i)));                                         \
-        if (i < n) {                                                                                           \
-            float t[8] = {pad, pad, pad, pad, pad, pad, pad, pad};                                             \
-            for (size_t k = 0; i + k < n; k++)                                                                 \
-                t[k] = x[i + k];                                                                               \
-            _mm256_storeu_ps(t, sleef_fn(_mm256_loadu_ps(t)));                                                 \
-            for (size_t k = 0; i + k < n; k++)                                                                 \
-                x[i + k] = t[k];                                                                               \
-        }                                                                                                      \
-    }
 
 NC_VMATHF_DEFINE(nc_vlogf, Sleef_logf8_u35avx2, logf, 1.0f)
 NC_VMATHF_DEFINE(nc_vexpf, Sleef_expf8_u10avx2, expf, 0.0f)
