@@ -382,23 +382,18 @@ int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, doubl
     return 0;
 }
 
-/* Exact Poisson by inversion for lambda < 32, given p0 = exp(-lambda) and a
- * uniform u; above, the normal approximation with standard normal z, rounded
- * to whole electrons (mean and variance exact, skewness < 0.18). */
-static inline double poisson(double lambda, double p0, double u, double z)
+/* Exact Poisson sampling by inversion (used below 32 e-), given
+ * p0 = exp(-lambda) and a uniform u: the smallest k with CDF(k) >= u. */
+static inline float poisson_inversion(double lambda, double p0, double u)
 {
-    if (lambda < 32.0) {
-        double p = p0, cdf = p;
-        int k = 0;
-        while (u > cdf && k < 200) {
-            k++;
-            p *= lambda / k;
-            cdf += p;
-        }
-        return k;
+    double p = p0, cdf = p;
+    int k = 0;
+    while (u > cdf && k < 200) {
+        k++;
+        p *= lambda / k;
+        cdf += p;
     }
-    double v = lambda + sqrt(lambda) * z + 0.5;
-    return v > 0 ? (double)(int64_t)v : 0.0; /* floor for v > 0, no libm call */
+    return (float)k;
 }
 
 /* Cosmic-ray charge for this frame, added into e (keyed by seed and frame). */
@@ -565,7 +560,7 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
         charge_row(lam, p0, b.u, b.zs, W, s->shot_noise, q);
         for (int x = 0; x < W; x++)
             if (q[x] < 0)
-                q[x] = poisson(lam[x], p0[x], b.u[x], 0.0);
+                q[x] = poisson_inversion(lam[x], p0[x], b.u[x]);
         if (whole) {
             for (int x = 0; x < W; x++) {
                 e[o + x] = q[x];

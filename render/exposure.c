@@ -75,7 +75,7 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
     int nb = ex->rolling ? bands : 1;
     for (int b = 0; b < nb && rc >= 0; b++) {
         int r0 = ex->rolling ? b : 0, r1 = ex->rolling ? b + 1 : bands;
-        int y0 = 16 * r0, y1 = 16 * r1 < H ? 16 * r1 : H;
+        int y0 = NC_TILE * r0, y1 = NC_TILE * r1 < H ? NC_TILE * r1 : H;
         double tc = ex->rolling ? (0.5 * (y0 + y1 - 1) - 0.5 * (H - 1)) * ex->line_time_s : 0.0;
         for (int y = 0; y < H; y++)
             row_dt[y] = ex->rolling ? (y - 0.5 * (H - 1)) * ex->line_time_s - tc : 0.0;

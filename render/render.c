@@ -14,7 +14,7 @@
 #include "albedo_map.h"
 #include "error.h"
 
-#define TILE 16 /* pixels; a tile is (TILE/4)^2 packets of 4x4 pixels */
+#define TILE NC_TILE
 
 int nc_frame_alloc(struct nc_frame *f, int w, int h)
 {

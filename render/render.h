@@ -11,6 +11,10 @@
 #include "rt.h"
 #include "scene.h"
 
+/* Tiles of NC_TILE x NC_TILE pixels are the unit of work (and of
+ * nc_render_rows); a tile is (NC_TILE/4)^2 ray packets of 4x4 pixels. */
+#define NC_TILE 16
+
 struct nc_frame {
     int width_px, height_px;
     float *radiance;  /* W m^-2 sr^-1, mean over the pixel's samples */
