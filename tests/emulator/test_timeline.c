@@ -1,0 +1,92 @@
+/* test_timeline.c - pose interpolation against analytic motion: a camera on
+ * a straight line at constant speed, turning at a constant rate about a fixed
+ * axis, sampled every 100 ms; interpolated at arbitrary instants, positions
+ * are exact (linear) and attitudes exact (slerp of a constant rotation).
+ * Extrapolation with the rates, staleness, time going backwards, overflow. */
+#include <math.h>
+#include <stdio.h>
+
+#include "scene.h"
+#include "testutil.h"
+#include "timeline.h"
+
+static const struct nc_vec3 V = {12.5, -3.0, 0.75}, W_AXIS = {0.267261241912424, 0.534522483824849, 0.801783725737273};
+static const double OMEGA = 0.3; /* rad/s */
+
+static struct nc_pose truth(double t)
+{
+    struct nc_pose p = {0};
+    p.t_ns = (int64_t)llround(t * 1e9);
+    p.cam_position_m = nc_v3_add(nc_v3(1e6, 2e6, -3e5), nc_v3_scale(V, t));
+    double h = 0.5 * OMEGA * t;
+    struct nc_quat r = {cos(h), W_AXIS.x * sin(h), W_AXIS.y * sin(h), W_AXIS.z * sin(h)};
+    p.cam_attitude_q = nc_quat_mul((struct nc_quat){0.9, 0.1, -0.3, 0.3}, r);
+    double n = nc_quat_norm(p.cam_attitude_q);
+    p.cam_attitude_q = (struct nc_quat){p.cam_attitude_q.w / n, p.cam_attitude_q.x / n, p.cam_attitude_q.y / n,
+                                        p.cam_attitude_q.z / n};
+    p.cam_velocity_m_s = V;
+    p.cam_angular_velocity_rad_s = nc_v3_scale(W_AXIS, OMEGA); /* body rate: right multiplication */
+    p.sun = nc_v3(1, 0, 0);
+    return p;
+}
+
+/* Rotation angle between two attitudes, well conditioned near zero. */
+static double qdiff(struct nc_quat a, struct nc_quat b)
+{
+    struct nc_quat d = nc_quat_mul(a, nc_quat_conj(b));
+    return 2 * atan2(sqrt(d.x * d.x + d.y * d.y + d.z * d.z), fabs(d.w));
+}
+
+int main(void)
+{
+    struct nc_timeline tl;
+    nc_timeline_init(&tl, 64, 50000000); /* 50 ms extrapolation limit */
+    struct nc_pose out;
+    CHECK(nc_timeline_at(&tl, 0, &out, NULL) == NC_POSE_NONE, "empty timeline");
+    for (int k = 0; k <= 20; k++) {
+        struct nc_pose p = truth(0.1 * k);
+        CHECK(nc_timeline_push(&tl, &p) == NC_REJECT_NONE, "push %d", k);
+    }
+    double worst_p = 0, worst_q = 0;
+    for (double t = 0.0; t <= 2.0; t += 0.00731) {
+        struct nc_pose want = truth(t);
+        int64_t gap;
+        CHECK(nc_timeline_at(&tl, want.t_ns, &out, &gap) == NC_POSE_INTERPOLATED && gap == 0, "inside at %g", t);
+        worst_p = fmax(worst_p, nc_v3_norm(nc_v3_sub(out.cam_position_m, want.cam_position_m)));
+        worst_q = fmax(worst_q, qdiff(out.cam_attitude_q, want.cam_attitude_q));
+    }
+    printf("interpolation: worst position error %.3g m at 2e6 m, worst attitude error %.3g rad\n", worst_p, worst_q);
+    CHECK(worst_p < 1e-8, "position error %.3g m", worst_p);
+    CHECK(worst_q < 1e-9, "attitude error %.3g rad", worst_q);
+    /* Extrapolation with the rates, exact for this motion, then stale. */
+    struct nc_pose want = truth(2.03);
+    int64_t gap;
+    CHECK(nc_timeline_at(&tl, want.t_ns, &out, &gap) == NC_POSE_EXTRAPOLATED && gap == 30000000, "30 ms ahead");
+    CHECK(nc_v3_norm(nc_v3_sub(out.cam_position_m, want.cam_position_m)) < 1e-8 &&
+              qdiff(out.cam_attitude_q, want.cam_attitude_q) < 1e-9,
+          "extrapolation with rates");
+    CHECK(nc_timeline_at(&tl, truth(2.2).t_ns, &out, &gap) == NC_POSE_STALE && gap == 200000000, "200 ms ahead is stale");
+    CHECK(nc_timeline_at(&tl, truth(-0.01).t_ns, &out, &gap) == NC_POSE_EXTRAPOLATED && gap == 10000000,
+          "before the oldest pose");
+    /* Time going backwards is rejected; the same time replaces. */
+    struct nc_pose old = truth(1.5);
+    CHECK(nc_timeline_push(&tl, &old) == NC_REJECT_TIME_BACKWARDS, "backwards");
+    struct nc_pose same = truth(2.0);
+    same.cam_position_m.x += 1;
+    CHECK(nc_timeline_push(&tl, &same) == NC_REJECT_NONE && tl.n == 21, "same time replaces");
+    nc_timeline_at(&tl, same.t_ns, &out, NULL);
+    CHECK(out.cam_position_m.x == same.cam_position_m.x, "replaced pose is used");
+    /* Overflow drops the oldest. */
+    for (int k = 21; k < 100; k++) {
+        struct nc_pose p = truth(0.1 * k);
+        nc_timeline_push(&tl, &p);
+    }
+    CHECK(tl.n == 64, "capacity %zu", tl.n);
+    CHECK(nc_timeline_at(&tl, truth(0.5).t_ns, &out, &gap) == NC_POSE_STALE, "dropped poses are gone");
+    /* Slerp takes the shorter arc between q and -q. */
+    struct nc_quat a = {1, 0, 0, 0}, b = {-cos(0.1), 0, 0, -sin(0.1)};
+    struct nc_quat mid = nc_quat_slerp(a, b, 0.5);
+    CHECK(fabs(qdiff(mid, (struct nc_quat){cos(0.05), 0, 0, sin(0.05)})) < 1e-12, "shorter arc");
+    nc_timeline_free(&tl);
+    return nc_test_end();
+}
