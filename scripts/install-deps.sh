@@ -3,7 +3,8 @@
 # Idempotent: packages already present are not touched and apt is not called at all.
 set -euo pipefail
 
-pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev libcfitsio-dev libfftw3-dev librandom123-dev zlib1g-dev)
+pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev libcfitsio-dev libfftw3-dev librandom123-dev zlib1g-dev
+      clang libclang-rt-14-dev)
 case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
 
 missing=()
