@@ -28,6 +28,9 @@ static const char main_help[] =
     "Commands:\n"
     "  render [SCENE.yaml] -o OUT   render one frame to an image file\n"
     "  expose CAMERA.yaml -o OUT    frames of a uniform radiance field through the camera model\n"
+    "  serve [SCENE.yaml]           run the camera emulator (poses in, frames out)\n"
+    "  replay TRAJ.csv              stream a trajectory to `navcam serve`\n"
+    "  pose send ...                send one pose or trigger to `navcam serve`\n"
     "  scene                        print the built-in default scene (a starting point)\n"
     "  brdf --model NAME ...        evaluate a reflectance model (CSV in, CSV out)\n"
     "\n"
@@ -74,6 +77,10 @@ static const char render_help[] =
     "[w, x, y, z] rotating camera (or body) frame vectors into the scene frame;\n"
     "camera +Z is the boresight, +X right and +Y down in the image.\n"
     "Pose, Sun, units and the NavCam version are written into the file's metadata.\n";
+
+int cmd_serve(int argc, char **argv);
+int cmd_replay(int argc, char **argv);
+int cmd_pose(int argc, char **argv);
 
 static double now_ms(void)
 {
@@ -603,6 +610,12 @@ int main(int argc, char **argv)
         return cmd_brdf(argc - 1, argv + 1);
     if (!strcmp(cmd, "expose"))
         return cmd_expose(argc - 1, argv + 1);
+    if (!strcmp(cmd, "serve"))
+        return cmd_serve(argc - 1, argv + 1);
+    if (!strcmp(cmd, "replay"))
+        return cmd_replay(argc - 1, argv + 1);
+    if (!strcmp(cmd, "pose"))
+        return cmd_pose(argc - 1, argv + 1);
     fprintf(stderr, "navcam: unknown command '%s'\n\n%s", cmd, main_help);
     return 2;
 }

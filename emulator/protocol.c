@@ -59,6 +59,8 @@ size_t nc_msg_size(enum nc_msg_type type, uint32_t flags)
             n += 6 * 8;
         if (flags & NC_MSG_BODY_RATES)
             n += 6 * 8;
+    } else if (type == NC_MSG_FRAME) {
+        n += 8 + 8 + 4 + 4; /* request time, frame number, status, reserved */
     } else {
         n += 8; /* a trigger carries its simulation time */
     }
@@ -112,6 +114,11 @@ size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap)
             p = put_vec(p, m->body_velocity_m_s);
             p = put_vec(p, m->body_angular_velocity_rad_s);
         }
+    } else if (m->type == NC_MSG_FRAME) {
+        put_u64(p, m->frame);
+        put_u32(p + 8, m->status);
+        put_u32(p + 12, 0);
+        p += 16;
     }
     if (m->flags & NC_MSG_EXPOSURE) {
         put_f64(p, m->exposure_s);
@@ -160,7 +167,7 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
     if (get_u16(buf + 4) != NC_PROTO_VERSION)
         return NC_REJECT_BAD_VERSION;
     uint16_t type = get_u16(buf + 6);
-    if (type != NC_MSG_POSE && type != NC_MSG_TRIGGER)
+    if (type != NC_MSG_POSE && type != NC_MSG_TRIGGER && type != NC_MSG_FRAME)
         return NC_REJECT_BAD_TYPE;
     uint32_t flags = get_u32(buf + 16);
     if (flags & ~NC_MSG_KNOWN_FLAGS)
@@ -199,6 +206,10 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
             p = get_vec(p, &m->body_velocity_m_s);
             p = get_vec(p, &m->body_angular_velocity_rad_s);
         }
+    } else if (type == NC_MSG_FRAME) {
+        m->frame = get_u64(p);
+        m->status = get_u32(p + 8);
+        p += 16;
     }
     if (flags & NC_MSG_EXPOSURE) {
         m->exposure_s = get_f64(p);

@@ -21,7 +21,10 @@
 #define NC_PROTO_MAX_BYTES 1024 /* any valid message is smaller */
 #define NC_PROTO_QUAT_TOL 1e-6  /* | |q| - 1 | allowed, then normalised */
 
-enum nc_msg_type { NC_MSG_POSE = 1, NC_MSG_TRIGGER = 2 };
+/* POSE and TRIGGER: simulator -> NavCam. FRAME: NavCam -> simulator over
+ * TCP, one per captured request, once the frame is with every output. */
+enum nc_msg_type { NC_MSG_POSE = 1, NC_MSG_TRIGGER = 2, NC_MSG_FRAME = 3 };
+enum nc_frame_status { NC_FRAME_DELIVERED = 0, NC_FRAME_DROPPED = 1 };
 
 enum nc_msg_flags {
     NC_MSG_SUN_POSITION = 1u << 0, /* sun vector is a position (m), else a direction */
@@ -73,6 +76,8 @@ struct nc_pose_msg {
     struct nc_vec3 body_velocity_m_s, body_angular_velocity_rad_s;
     double exposure_s;
     double gain_db;
+    uint64_t frame;    /* FRAME: frame number */
+    uint32_t status;   /* FRAME: enum nc_frame_status */
 };
 
 /* Bytes of an encoded message with these flags. */

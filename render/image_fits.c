@@ -45,6 +45,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:frame", "FRAME"},
     {"navcam:frames", "NFRAMES"},
     {"navcam:radiance_w_m2_sr", "RADIANCE"},
+    {"navcam:frame_record", "FRAMEREC"},
     {"navcam:preview_rule", "PRVRULE"},
 };
 

@@ -1,0 +1,106 @@
+/* output_file.c - the file output: numbered DN image files through
+ * OpenImageIO/cfitsio (image_io.h) and a JSON-lines sidecar with every
+ * frame's metadata. Options: directory (default "out"), pattern (a printf
+ * pattern for the frame number, default "frame_%06llu.png"), sidecar (default
+ * "frames.jsonl"; empty for none). */
+#include <errno.h>
+#include <libgen.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "error.h"
+#include "image_io.h"
+#include "output.h"
+
+struct file_out {
+    char dir[2048];
+    char pattern[256];
+    FILE *sidecar;
+    char sidecar_path[2300];
+};
+
+static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
+{
+    struct file_out *f = priv;
+    const char *dir = "out", *pattern = "frame_%06llu.png", *sidecar = "frames.jsonl";
+    int rc;
+    if ((rc = nc_cfg_string(opts, "directory", &dir)) < 0 || (rc = nc_cfg_string(opts, "pattern", &pattern)) < 0)
+        return rc;
+    struct nc_cfg_node *sc = nc_cfg_get(opts, "sidecar");
+    if (sc && sc->kind == NC_CFG_SCALAR)
+        sidecar = sc->value;
+    else if (sc)
+        return nc_cfg_error(sc, "expected a file name (or empty for no sidecar)");
+    /* The pattern must format exactly one unsigned long long. */
+    const char *pc = strchr(pattern, '%');
+    if (!pc || strstr(pc + 1, "%") || !strstr(pc, "llu") || strchr(pattern, '/'))
+        return nc_cfg_error(nc_cfg_get(opts, "pattern"),
+                            "expected a file name with one %%llu-style conversion, e.g. frame_%%06llu.png");
+    char probe[512];
+    snprintf(probe, sizeof probe, pattern, 0ULL);
+    if (!nc_image_format_ok(probe, NULL))
+        return nc_cfg_error(nc_cfg_get(opts, "pattern"), "unsupported image format (use .png, .tif, .fits or .exr)");
+    snprintf(f->dir, sizeof f->dir, "%s", dir);
+    snprintf(f->pattern, sizeof f->pattern, "%s", pattern);
+    if (mkdir(f->dir, 0777) < 0 && errno != EEXIST)
+        return nc_error(-errno, "file output: mkdir %s: %s", f->dir, strerror(errno));
+    if (sidecar[0]) {
+        snprintf(f->sidecar_path, sizeof f->sidecar_path, "%s/%s", f->dir, sidecar);
+        f->sidecar = fopen(f->sidecar_path, "w");
+        if (!f->sidecar)
+            return nc_error(-errno, "file output: %s: %s", f->sidecar_path, strerror(errno));
+    }
+    (void)ctx;
+    return 0;
+}
+
+static int file_submit(void *priv, const struct nc_frame_record *r)
+{
+    struct file_out *f = priv;
+    char name[512], path[2600], adc[16], fr[32], json[4096];
+    snprintf(name, sizeof name, f->pattern, (unsigned long long)r->frame);
+    snprintf(path, sizeof path, "%s/%s", f->dir, name);
+    snprintf(adc, sizeof adc, "%d", r->adc_bits);
+    snprintf(fr, sizeof fr, "%llu", (unsigned long long)r->frame);
+    int jl = nc_frame_record_json(r, json, sizeof json);
+    const struct nc_image_attr attrs[] = {
+        {"navcam:quantity", "dn"}, {"navcam:units", "DN"}, {"navcam:adc_bits", adc}, {"navcam:frame", fr},
+        {"navcam:frame_record", jl > 0 ? json : ""},
+    };
+    int rc = nc_image_write_dn(path, r->dn, r->width_px, r->height_px, r->adc_bits, attrs, 5);
+    if (rc < 0)
+        return rc;
+    if (f->sidecar && jl > 0) {
+        fprintf(f->sidecar, "%s\n", json);
+        fflush(f->sidecar); /* every line whole on disk when the frame is reported delivered */
+    }
+    return 0;
+}
+
+static int file_control(void *priv, const char *request, void *arg)
+{
+    struct file_out *f = priv;
+    if (!strcmp(request, "flush"))
+        return f->sidecar && fflush(f->sidecar) != 0 ? -errno : 0;
+    return NC_EUNSUPPORTED;
+}
+
+static void file_close(void *priv)
+{
+    struct file_out *f = priv;
+    if (f->sidecar)
+        fclose(f->sidecar);
+    f->sidecar = NULL;
+}
+
+const struct nc_output_driver nc_output_file = {
+    .name = "file",
+    .description = "numbered image files and a JSON-lines sidecar",
+    .caps = NC_OUTPUT_CAP_DN16,
+    .priv_size = sizeof(struct file_out),
+    .open = file_open,
+    .submit = file_submit,
+    .control = file_control,
+    .close = file_close,
+};

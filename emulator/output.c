@@ -1,0 +1,94 @@
+/* output.c - opening drivers by name, the frame record as JSON. */
+#include "output.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+
+const struct nc_output_driver *nc_output_find(const char *name)
+{
+    for (int i = 0; nc_output_drivers[i]; i++)
+        if (!strcmp(nc_output_drivers[i]->name, name))
+            return nc_output_drivers[i];
+    return NULL;
+}
+
+int nc_output_open(struct nc_output *o, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
+{
+    memset(o, 0, sizeof *o);
+    const char *name;
+    int rc = nc_cfg_string(opts, "driver", &name);
+    if (rc <= 0)
+        return rc ? rc : nc_cfg_missing(opts, "driver", "an output driver name");
+    o->drv = nc_output_find(name);
+    if (!o->drv) {
+        char list[256] = "";
+        for (int i = 0; nc_output_drivers[i]; i++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", nc_output_drivers[i]->name);
+        return nc_cfg_error(nc_cfg_get(opts, "driver"), "unknown output driver '%s' (this build has: %s)", name, list);
+    }
+    o->priv = calloc(1, o->drv->priv_size ? o->drv->priv_size : 1);
+    if (!o->priv)
+        return nc_error(-ENOMEM, "out of memory");
+    if ((rc = o->drv->open(o->priv, opts, ctx)) < 0) {
+        free(o->priv);
+        o->priv = NULL;
+    }
+    return rc;
+}
+
+int nc_output_submit(struct nc_output *o, const struct nc_frame_record *r)
+{
+    int rc = o->drv->submit(o->priv, r);
+    if (rc < 0)
+        o->failed++;
+    else
+        o->submitted++;
+    return rc;
+}
+
+int nc_output_control(struct nc_output *o, const char *request, void *arg)
+{
+    if (!o->drv->control)
+        return NC_EUNSUPPORTED;
+    return o->drv->control(o->priv, request, arg);
+}
+
+void nc_output_close(struct nc_output *o)
+{
+    if (o->drv && o->priv)
+        o->drv->close(o->priv);
+    free(o->priv);
+    memset(o, 0, sizeof *o);
+}
+
+static const char *const quality_names[] = {"interpolated", "extrapolated", "stale", "none"};
+
+int nc_frame_record_json(const struct nc_frame_record *r, char *buf, size_t len)
+{
+    const struct nc_pose *p = &r->pose;
+    int n = snprintf(
+        buf, len,
+        "{\"frame\": %llu, \"request_sequence\": %u, \"trigger_source\": \"%s\", "
+        "\"trigger_sim_ns\": %lld, \"exposure_start_sim_ns\": %lld, \"exposure_end_sim_ns\": %lld, "
+        "\"trigger_mono_ns\": %lld, \"exposure_start_mono_ns\": %lld, \"exposure_end_mono_ns\": %lld, "
+        "\"pose\": {\"t_ns\": %lld, \"quality\": \"%s\", \"gap_ns\": %lld, "
+        "\"camera_position_m\": [%.17g, %.17g, %.17g], \"camera_attitude_q\": [%.17g, %.17g, %.17g, %.17g], "
+        "\"sun\": [%.17g, %.17g, %.17g], \"sun_is_position\": %s, \"body\": %s, "
+        "\"body_position_m\": [%.17g, %.17g, %.17g], \"body_attitude_q\": [%.17g, %.17g, %.17g, %.17g]}, "
+        "\"exposure_s\": %.17g, \"gain_db\": %.17g, \"time_samples\": %d, \"render_ms\": %.3f, \"camera_ms\": %.3f, "
+        "\"width_px\": %d, \"height_px\": %d, \"adc_bits\": %d}",
+        (unsigned long long)r->frame, r->request_sequence, r->trigger_source, (long long)r->trigger_sim_ns,
+        (long long)r->exposure_start_sim_ns, (long long)r->exposure_end_sim_ns, (long long)r->trigger_mono_ns,
+        (long long)r->exposure_start_mono_ns, (long long)r->exposure_end_mono_ns, (long long)p->t_ns,
+        quality_names[r->pose_quality], (long long)r->pose_gap_ns, p->cam_position_m.x, p->cam_position_m.y,
+        p->cam_position_m.z, p->cam_attitude_q.w, p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z,
+        p->sun.x, p->sun.y, p->sun.z, p->sun_is_position ? "true" : "false", p->has_body ? "true" : "false",
+        p->body_position_m.x, p->body_position_m.y, p->body_position_m.z, p->body_attitude_q.w, p->body_attitude_q.x,
+        p->body_attitude_q.y, p->body_attitude_q.z, r->exposure_s, r->gain_db, r->time_samples, r->render_ms,
+        r->camera_ms, r->width_px, r->height_px, r->adc_bits);
+    return n >= 0 && (size_t)n < len ? n : -1;
+}
