@@ -58,15 +58,17 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
 static int file_submit(void *priv, const struct nc_frame_record *r)
 {
     struct file_out *f = priv;
-    char name[512], path[2600], adc[16], fr[32], json[4096];
+    char name[512], path[2600], adc[16], fr[32], json[4096], meta[4096];
     snprintf(name, sizeof name, f->pattern, (unsigned long long)r->frame);
     snprintf(path, sizeof path, "%s/%s", f->dir, name);
     snprintf(adc, sizeof adc, "%d", r->adc_bits);
     snprintf(fr, sizeof fr, "%llu", (unsigned long long)r->frame);
-    int jl = nc_frame_record_json(r, json, sizeof json);
+    /* The sidecar has the wall-clock times; the image only what a rerun
+     * reproduces, so that lock-step frame files are identical byte for byte. */
+    int jl = nc_frame_record_json(r, 1, json, sizeof json), ml = nc_frame_record_json(r, 0, meta, sizeof meta);
     const struct nc_image_attr attrs[] = {
         {"navcam:quantity", "dn"}, {"navcam:units", "DN"}, {"navcam:adc_bits", adc}, {"navcam:frame", fr},
-        {"navcam:frame_record", jl > 0 ? json : ""},
+        {"navcam:frame_record", ml > 0 ? meta : ""},
     };
     int rc = nc_image_write_dn(path, r->dn, r->width_px, r->height_px, r->adc_bits, attrs, 5);
     if (rc < 0)

@@ -67,28 +67,33 @@ void nc_output_close(struct nc_output *o)
 
 static const char *const quality_names[] = {"interpolated", "extrapolated", "stale", "none"};
 
-int nc_frame_record_json(const struct nc_frame_record *r, char *buf, size_t len)
+int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *buf, size_t len)
 {
     const struct nc_pose *p = &r->pose;
+    char mono[200] = "", ms[100] = "";
+    if (wall_clock) {
+        snprintf(mono, sizeof mono,
+                 "\"trigger_mono_ns\": %lld, \"exposure_start_mono_ns\": %lld, \"exposure_end_mono_ns\": %lld, ",
+                 (long long)r->trigger_mono_ns, (long long)r->exposure_start_mono_ns, (long long)r->exposure_end_mono_ns);
+        snprintf(ms, sizeof ms, "\"render_ms\": %.3f, \"camera_ms\": %.3f, ", r->render_ms, r->camera_ms);
+    }
     int n = snprintf(
         buf, len,
         "{\"frame\": %llu, \"request_sequence\": %u, \"trigger_source\": \"%s\", "
-        "\"trigger_sim_ns\": %lld, \"exposure_start_sim_ns\": %lld, \"exposure_end_sim_ns\": %lld, "
-        "\"trigger_mono_ns\": %lld, \"exposure_start_mono_ns\": %lld, \"exposure_end_mono_ns\": %lld, "
+        "\"trigger_sim_ns\": %lld, \"exposure_start_sim_ns\": %lld, \"exposure_end_sim_ns\": %lld, %s"
         "\"pose\": {\"t_ns\": %lld, \"quality\": \"%s\", \"gap_ns\": %lld, "
         "\"camera_position_m\": [%.17g, %.17g, %.17g], \"camera_attitude_q\": [%.17g, %.17g, %.17g, %.17g], "
         "\"sun\": [%.17g, %.17g, %.17g], \"sun_is_position\": %s, \"body\": %s, "
         "\"body_position_m\": [%.17g, %.17g, %.17g], \"body_attitude_q\": [%.17g, %.17g, %.17g, %.17g]}, "
-        "\"exposure_s\": %.17g, \"gain_db\": %.17g, \"time_samples\": %d, \"render_ms\": %.3f, \"camera_ms\": %.3f, "
+        "\"exposure_s\": %.17g, \"gain_db\": %.17g, \"time_samples\": %d, %s"
         "\"width_px\": %d, \"height_px\": %d, \"adc_bits\": %d}",
         (unsigned long long)r->frame, r->request_sequence, r->trigger_source, (long long)r->trigger_sim_ns,
-        (long long)r->exposure_start_sim_ns, (long long)r->exposure_end_sim_ns, (long long)r->trigger_mono_ns,
-        (long long)r->exposure_start_mono_ns, (long long)r->exposure_end_mono_ns, (long long)p->t_ns,
+        (long long)r->exposure_start_sim_ns, (long long)r->exposure_end_sim_ns, mono, (long long)p->t_ns,
         quality_names[r->pose_quality], (long long)r->pose_gap_ns, p->cam_position_m.x, p->cam_position_m.y,
         p->cam_position_m.z, p->cam_attitude_q.w, p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z,
         p->sun.x, p->sun.y, p->sun.z, p->sun_is_position ? "true" : "false", p->has_body ? "true" : "false",
         p->body_position_m.x, p->body_position_m.y, p->body_position_m.z, p->body_attitude_q.w, p->body_attitude_q.x,
-        p->body_attitude_q.y, p->body_attitude_q.z, r->exposure_s, r->gain_db, r->time_samples, r->render_ms,
-        r->camera_ms, r->width_px, r->height_px, r->adc_bits);
+        p->body_attitude_q.y, p->body_attitude_q.z, r->exposure_s, r->gain_db, r->time_samples, ms, r->width_px,
+        r->height_px, r->adc_bits);
     return n >= 0 && (size_t)n < len ? n : -1;
 }

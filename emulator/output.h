@@ -32,8 +32,10 @@ struct nc_frame_record {
 };
 
 /* One JSON object (no newline) describing a record; returns its length or a
- * negative value when len is too small. */
-int nc_frame_record_json(const struct nc_frame_record *r, char *buf, size_t len);
+ * negative value when len is too small. Without wall_clock the
+ * CLOCK_MONOTONIC times and the render and camera-model durations are left
+ * out: what remains is reproducible (lock-step runs give identical text). */
+int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *buf, size_t len);
 
 enum nc_output_caps {
     NC_OUTPUT_CAP_DN16 = 1u << 0, /* takes 16-bit DN frames */

@@ -609,13 +609,14 @@ static void *output_thread(void *arg)
         atomic_store(&e->output_idle, 0);
         struct slot *sl = &e->slots[e->shead];
         pthread_mutex_unlock(&e->slock);
+        /* Latency: pose (or trigger) received -> frame handed to the outputs. */
+        int64_t handed = mono_ns();
         for (int i = 0; i < e->nout; i++)
             if (nc_output_submit(&e->out[i], &sl->rec) < 0)
                 fprintf(stderr, "navcam serve: output %s: frame %llu: %s\n", e->out[i].drv->name,
                         (unsigned long long)sl->rec.frame, nc_errmsg());
-        int64_t now = mono_ns();
         pthread_mutex_lock(&e->stat_lock);
-        e->lat_ms[e->nlat % LAT_SAMPLES] = (now - sl->job.recv_mono_ns) * 1e-6;
+        e->lat_ms[e->nlat % LAT_SAMPLES] = (handed - sl->job.recv_mono_ns) * 1e-6;
         e->render_ms[e->nlat % LAT_SAMPLES] = sl->rec.render_ms + sl->rec.camera_ms;
         e->nlat++;
         pthread_mutex_unlock(&e->stat_lock);

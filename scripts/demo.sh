@@ -1,23 +1,31 @@
 #!/usr/bin/env bash
-# The main job on the built-in default scene: a short approach to a procedural
-# asteroid, from 16 km to 3 km, rendered to EXR (radiance, float32) and a PNG
-# preview per frame. No data download, no hardware.
+# The main job on the built-in default scene: `navcam serve` in lock-step,
+# fed by `navcam replay` with the built-in approach trajectory (16 km to 3 km,
+# 8 poses); frames (12-bit DN in 16-bit PNG) and their JSON-lines metadata
+# land under OUTDIR, then the emulator prints its statistics and stops.
+# No data download, no hardware.
 # Usage: scripts/demo.sh NAVCAM_BINARY OUTDIR
 set -euo pipefail
-navcam=${1:?usage: demo.sh NAVCAM OUTDIR}
+navcam=$(readlink -f "${1:?usage: demo.sh NAVCAM OUTDIR}")
 out=${2:?usage: demo.sh NAVCAM OUTDIR}
 mkdir -p "$out"
-frames=8
-for i in $(seq 0 $((frames - 1))); do
-  # Range shrinks geometrically; a slow lateral drift keeps the view alive.
-  pos=$(awk -v i="$i" -v n="$frames" 'BEGIN {
-    d = 16000 * exp(log(3000 / 16000) * i / (n - 1));
-    printf "[%.3f, %.3f, %.3f]", 0.08 * d, -d, 0.03 * d }')
-  f=$(printf "%s/approach_%03d" "$out" "$i")
-  "$navcam" render -o "$f.exr" --set "camera.position_m=$pos" >/dev/null
-  "$navcam" render -o "$f.png" --set "camera.position_m=$pos" | head -1
+udp=${NAVCAM_DEMO_UDP:-5750}
+tcp=${NAVCAM_DEMO_TCP:-5751}
+"$navcam" serve --set serve.mode=lockstep --set serve.udp_port="$udp" --set serve.tcp_port="$tcp" \
+  --set "outputs=[{driver: file, directory: $out}]" --max-frames 8 --stats-json "$out/stats.json" > /dev/null &
+serve=$!
+trap 'kill $serve 2>/dev/null || true' EXIT
+# Wait for the emulator to listen (it builds the scene first), then replay.
+for _ in $(seq 300); do
+  (exec 3<>"/dev/tcp/127.0.0.1/$tcp") 2>/dev/null && break
+  sleep 0.1
 done
+"$navcam" replay builtin:approach --lockstep --port "$tcp"
+wait $serve
+trap - EXIT
 echo
-echo "demo: $frames frames of the approach are in $out/:"
-echo "  approach_*.exr  radiance in W m^-2 sr^-1 (float32; pose, Sun and units in the metadata)"
-echo "  approach_*.png  16-bit linear previews (scale in the metadata: navcam:preview_scale)"
+echo "demo: the emulator rendered the approach in lock-step; in $out/:"
+echo "  frame_*.png    digitised frames (12-bit DN, 16-bit PNG; pose, exposure and"
+echo "                 camera metadata inside)"
+echo "  frames.jsonl   one line per frame: trigger and exposure times, the pose used"
+echo "  stats.json     the emulator's statistics"

@@ -4,7 +4,7 @@
 set -euo pipefail
 
 pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev libcfitsio-dev libfftw3-dev librandom123-dev zlib1g-dev
-      clang libclang-rt-14-dev)
+      clang libclang-rt-14-dev python3)
 case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
 
 missing=()
