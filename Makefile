@@ -35,6 +35,7 @@ bench: build
 	$(BUILD)/bench_render
 	$(BUILD)/bench_brdf
 	$(BUILD)/bench_sensor
+	$(BUILD)/bench_latency
 
 clean:
 	rm -rf $(BUILD) $(TESTBUILD) $(TESTBUILD)-asan out

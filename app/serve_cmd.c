@@ -11,7 +11,9 @@
 
 #include "error.h"
 #include "navcam/client.h"
+#include "output.h"
 #include "serve.h"
+#include "trigger.h"
 #include "vec.h"
 
 int cmd_serve(int argc, char **argv);
@@ -26,7 +28,10 @@ static const char serve_help[] =
     "  lockstep  every POSE with CAPTURE gets exactly one frame, in order, answered\n"
     "            with a FRAME message on TCP: reproducible closed loops\n"
     "  freerun   frames at serve.frame_rate_hz on the emulator's clock\n"
-    "  trigger   a frame per software trigger (TRIGGER or POSE with CAPTURE)\n"
+    "  trigger   a frame per accepted edge of serve.trigger (default: software\n"
+    "            triggers, TRIGGER or POSE with CAPTURE); e.g.\n"
+    "            --set 'serve.trigger={driver: timer, rate_hz: 20, activation:\n"
+    "            falling_edge, delay_s: 0.01, debounce_s: 0.001}'\n"
     "Listeners bind serve.bind (127.0.0.1) on serve.udp_port (5750) and\n"
     "serve.tcp_port (5751). SIGINT/SIGTERM: finish the frame in flight, flush the\n"
     "outputs, print statistics (a JSON summary on stdout), exit 0.\n"
@@ -41,6 +46,18 @@ static const char serve_help[] =
     "Example (lock-step, the built-in default scene, frames under out/):\n"
     "  navcam serve --set serve.mode=lockstep &\n"
     "  navcam replay builtin:approach --lockstep\n";
+
+/* The help text, then the drivers this build has (from the registries). */
+static void serve_usage(void)
+{
+    fputs(serve_help, stdout);
+    puts("\nOutput drivers (outputs: [{driver: NAME, ...}]):");
+    for (int i = 0; nc_output_drivers[i]; i++)
+        printf("  %-9s %s\n", nc_output_drivers[i]->name, nc_output_drivers[i]->description);
+    puts("Trigger drivers (serve.trigger: {driver: NAME, ...}; docs/emulator.md):");
+    for (int i = 0; nc_trigger_drivers[i]; i++)
+        printf("  %-9s %s\n", nc_trigger_drivers[i]->name, nc_trigger_drivers[i]->description);
+}
 
 int cmd_serve(int argc, char **argv)
 {
@@ -63,7 +80,7 @@ int cmd_serve(int argc, char **argv)
         case 't': o.max_seconds = atof(optarg); break;
         case 'J': o.stats_json_path = optarg; break;
         case 'j': o.threads = atoi(optarg); break;
-        case 'h': fputs(serve_help, stdout); free(sets); return 0;
+        case 'h': serve_usage(); free(sets); return 0;
         default: fputs("Try 'navcam serve --help'.\n", stderr); free(sets); return 2;
         }
     }

@@ -6,30 +6,21 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "driver.h"
 #include "error.h"
 
 const struct nc_output_driver *nc_output_find(const char *name)
 {
-    for (int i = 0; nc_output_drivers[i]; i++)
-        if (!strcmp(nc_output_drivers[i]->name, name))
-            return nc_output_drivers[i];
-    return NULL;
+    return nc__driver_find((const void *const *)nc_output_drivers, name);
 }
 
 int nc_output_open(struct nc_output *o, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
 {
     memset(o, 0, sizeof *o);
-    const char *name;
-    int rc = nc_cfg_string(opts, "driver", &name);
-    if (rc <= 0)
-        return rc ? rc : nc_cfg_missing(opts, "driver", "an output driver name");
-    o->drv = nc_output_find(name);
-    if (!o->drv) {
-        char list[256] = "";
-        for (int i = 0; nc_output_drivers[i]; i++)
-            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", nc_output_drivers[i]->name);
-        return nc_cfg_error(nc_cfg_get(opts, "driver"), "unknown output driver '%s' (this build has: %s)", name, list);
-    }
+    int rc;
+    o->drv = nc__driver_select(opts, "output driver", (const void *const *)nc_output_drivers, &rc);
+    if (!o->drv)
+        return rc;
     o->priv = calloc(1, o->drv->priv_size ? o->drv->priv_size : 1);
     if (!o->priv)
         return nc_error(-ENOMEM, "out of memory");

@@ -2,7 +2,9 @@
  *
  * net thread     poll(): UDP datagrams, TCP connections (length-prefixed);
  *                decodes, counts rejections, feeds the timeline, makes jobs.
- * timer thread   free-run: a job every 1/frame_rate on CLOCK_MONOTONIC.
+ * trigger        free-run and trigger modes: the trigger driver (trigger.h)
+ *                fires edges from its own thread (timer) or from the net
+ *                thread (software); accepted edges become jobs.
  * render thread  job -> pose at mid-exposure -> render -> camera model -> slot.
  * output thread  slot -> every output driver -> FRAME reply to the requester.
  * main thread    signals, limits, the periodic statistics line, shutdown.
@@ -33,6 +35,7 @@
 #include "protocol.h"
 #include "render.h"
 #include "timeline.h"
+#include "trigger.h"
 
 #define MAX_OUTPUTS 8
 #define MAX_CLIENTS 16
@@ -40,11 +43,15 @@
 
 enum mode { MODE_LOCKSTEP, MODE_FREERUN, MODE_TRIGGER };
 static const char *const mode_names[] = {"lockstep", "freerun", "trigger", NULL};
-enum drop_reason { DROP_QUEUE_FULL, DROP_STALE_POSE, DROP_NO_POSE, DROP_OUTPUT_BUSY, DROP_SHUTDOWN, DROP_COUNT };
-static const char *const drop_names[] = {"queue_full", "stale_pose", "no_pose", "output_busy", "shutdown"};
+/* DROP_IGNORED: a capture request the acquisition mode does not take (free-run,
+ * or a software trigger while the trigger source is a line). */
+enum drop_reason { DROP_QUEUE_FULL, DROP_STALE_POSE, DROP_NO_POSE, DROP_OUTPUT_BUSY, DROP_SHUTDOWN, DROP_IGNORED, DROP_COUNT };
+static const char *const drop_names[] = {"queue_full", "stale_pose", "no_pose", "output_busy", "shutdown", "ignored_request"};
 
 struct job {
-    int64_t trigger_sim_ns, mid_sim_ns, trigger_mono_ns, recv_mono_ns;
+    int64_t trigger_sim_ns, mid_sim_ns, trigger_mono_ns;
+    int64_t ready_mono_ns; /* the earliest a camera could read the frame out: the
+                            * request's arrival (lock-step) or the exposure's end */
     uint32_t sequence;
     int client;        /* TCP client slot to answer, or -1 */
     unsigned client_gen;
@@ -69,7 +76,8 @@ struct client {
 struct emu {
     /* configuration */
     enum mode mode;
-    double frame_rate_hz, trigger_delay_s, debounce_s, stats_interval_s;
+    double frame_rate_hz, stats_interval_s;
+    int64_t pose_wait_ns; /* triggered frames: wait this long past the exposure for a later pose */
     int queue_frames, drop_oldest, stale_render;
     char bind[64];
     int udp_port, tcp_port;
@@ -79,13 +87,14 @@ struct emu {
     struct nc_renderer renderer;
     struct nc_output out[MAX_OUTPUTS];
     int nout;
+    struct nc_trigger trig; /* free-run (timer) and trigger modes */
+    int have_trig;
     /* poses */
     struct nc_timeline tl;
     pthread_mutex_t tl_lock;
+    pthread_cond_t tl_cond; /* a pose arrived; CLOCK_MONOTONIC */
     int64_t sim_anchor_ns, mono_anchor_ns; /* the simulation clock follows the newest pose */
     int have_anchor;
-    int64_t last_trigger_sim_ns;
-    int have_trigger;
     /* jobs */
     struct job *jobs;
     int jhead, jcount;
@@ -106,7 +115,7 @@ struct emu {
     uint64_t next_frame;
     int64_t start_mono_ns;
     /* statistics */
-    atomic_ulong received, rejected[NC_REJECT_COUNT], dropped[DROP_COUNT], delivered, debounced, jobs_made;
+    atomic_ulong received, rejected[NC_REJECT_COUNT], dropped[DROP_COUNT], delivered, jobs_made;
     double lat_ms[LAT_SAMPLES], render_ms[LAT_SAMPLES];
     unsigned long nlat;
     pthread_mutex_t stat_lock;
@@ -123,6 +132,9 @@ static int64_t mono_ns(void)
     return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
 
+static void on_edge(void *sink, const struct nc_trigger_edge *edge);
+static void drop(struct emu *e, const struct job *j, enum drop_reason why);
+
 /* ---- configuration -------------------------------------------------------- */
 
 static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_dir)
@@ -132,7 +144,7 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
     e->frame_rate_hz = 10;
     e->queue_frames = 4;
     e->stats_interval_s = 5;
-    double max_extrap = 0.5;
+    double max_extrap = 0.5, pose_wait_s = 0;
     snprintf(e->bind, sizeof e->bind, "127.0.0.1");
     e->udp_port = 5750;
     e->tcp_port = 5751;
@@ -146,10 +158,9 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
         int d = 0, st = 0;
         if ((rc = nc_cfg_enum(sv, "mode", mode_names, &m)) < 0 ||
             (rc = nc_cfg_double(sv, "frame_rate_hz", 1e-3, 1000, &e->frame_rate_hz)) < 0 ||
-            (rc = nc_cfg_double(sv, "trigger_delay_s", 0, 10, &e->trigger_delay_s)) < 0 ||
-            (rc = nc_cfg_double(sv, "debounce_s", 0, 10, &e->debounce_s)) < 0 ||
             (rc = nc_cfg_double(sv, "stats_interval_s", 0, 3600, &e->stats_interval_s)) < 0 ||
             (rc = nc_cfg_double(sv, "max_extrapolation_s", 0, 3600, &max_extrap)) < 0 ||
+            (rc = nc_cfg_double(sv, "pose_wait_s", 0, 60, &pose_wait_s)) < 0 ||
             (rc = nc_cfg_enum(sv, "drop_policy", drops, &d)) < 0 || (rc = nc_cfg_enum(sv, "stale_pose", stale, &st)) < 0 ||
             (rc = nc_cfg_string(sv, "bind", &bind)) < 0)
             return rc;
@@ -171,6 +182,31 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
             e->tcp_port = (int)v;
     }
     e->mode = (enum mode)m;
+    e->pose_wait_ns = llround(pose_wait_s * 1e9);
+    /* The trigger source: free-run is the timer at frame_rate_hz; trigger
+     * mode takes serve.trigger (default: software). */
+    struct nc_cfg_node *tr = NULL;
+    if (sv && (rc = nc_cfg_map(sv, "trigger", &tr)) < 0)
+        return rc;
+    if (tr && e->mode != MODE_TRIGGER)
+        return nc_cfg_error(tr, "serve.trigger applies to mode: trigger (free-run runs at serve.frame_rate_hz; "
+                                "lock-step takes POSE messages with CAPTURE)");
+    if (!tr && e->mode != MODE_LOCKSTEP) {
+        char set[128];
+        if (e->mode == MODE_FREERUN)
+            snprintf(set, sizeof set, "serve.trigger={driver: timer, rate_hz: %.17g}", e->frame_rate_hz);
+        else
+            snprintf(set, sizeof set, "serve.trigger={driver: software}");
+        if ((rc = nc_cfg_set(cfg, set)) < 0 || (rc = nc_cfg_map(cfg->root, "serve", &sv)) < 0 ||
+            (rc = nc_cfg_map(sv, "trigger", &tr)) < 0)
+            return rc;
+    }
+    if (tr) {
+        struct nc_trigger_ctx tc = {.fire = on_edge, .sink = e};
+        if ((rc = nc_trigger_open(&e->trig, tr, &tc)) < 0)
+            return rc;
+        e->have_trig = 1;
+    }
     if ((rc = nc_timeline_init(&e->tl, 4096, (int64_t)llround(max_extrap * 1e9))) < 0)
         return rc;
     struct nc_output_ctx ctx = {e->scene.camera.width_px, e->scene.camera.height_px, e->cs.sensor.adc_bits, config_dir};
@@ -221,18 +257,11 @@ static int64_t sim_now(struct emu *e, int64_t mono)
     return e->have_anchor ? e->sim_anchor_ns + (mono - e->mono_anchor_ns) : 0;
 }
 
-/* A trigger at simulation time t: debounce, delay, exposure window. */
-static void trigger(struct emu *e, int64_t t_sim, int64_t mono, int64_t recv_mono, uint32_t seq, int client,
+/* A frame request at simulation time t (gated already): the exposure window. */
+static void trigger(struct emu *e, int64_t t_sim, int64_t mono, uint32_t seq, int client,
                     unsigned gen, const char *source, const struct nc_pose_msg *m)
 {
-    if (e->mode != MODE_LOCKSTEP && e->debounce_s > 0 && e->have_trigger &&
-        t_sim - e->last_trigger_sim_ns < (int64_t)(e->debounce_s * 1e9)) {
-        atomic_fetch_add(&e->debounced, 1);
-        return;
-    }
-    e->have_trigger = 1;
-    e->last_trigger_sim_ns = t_sim;
-    struct job j = {.trigger_sim_ns = t_sim, .trigger_mono_ns = mono, .recv_mono_ns = recv_mono, .sequence = seq,
+    struct job j = {.trigger_sim_ns = t_sim, .trigger_mono_ns = mono, .ready_mono_ns = mono, .sequence = seq,
                     .client = client, .client_gen = gen, .source = source, .exposure_s = e->cs.exposure_s,
                     .gain_db = e->cs.sensor.analog_gain_db};
     if (m && (m->flags & NC_MSG_EXPOSURE))
@@ -242,8 +271,40 @@ static void trigger(struct emu *e, int64_t t_sim, int64_t mono, int64_t recv_mon
     /* Lock-step exposes around the requested pose; triggers start the
      * exposure a delay after the trigger. */
     j.mid_sim_ns = e->mode == MODE_LOCKSTEP ? t_sim
-                                            : t_sim + (int64_t)llround((e->trigger_delay_s + 0.5 * j.exposure_s) * 1e9);
+                                            : t_sim + e->trig.gate.delay_ns + llround(0.5 * j.exposure_s * 1e9);
+    if (e->mode != MODE_LOCKSTEP)
+        j.ready_mono_ns = mono + (j.mid_sim_ns - t_sim) + llround(0.5 * j.exposure_s * 1e9);
     push_job(e, &j);
+}
+
+/* A software request, as the software trigger driver passes it back. */
+struct sw_request {
+    const struct nc_pose_msg *m;
+    int client;
+    unsigned gen;
+};
+
+/* Every edge of the trigger driver: the gate, then a job. Line edges carry
+ * CLOCK_MONOTONIC times; the simulation time follows the newest pose. */
+static void on_edge(void *sink, const struct nc_trigger_edge *edge)
+{
+    struct emu *e = sink;
+    if (!nc_trigger_accept(&e->trig, edge))
+        return;
+    const struct sw_request *rq = edge->request;
+    if (rq) {
+        trigger(e, rq->m->sim_time_ns, edge->mono_ns, rq->m->sequence, rq->client, rq->gen,
+                e->trig.drv->name, rq->m);
+        return;
+    }
+    pthread_mutex_lock(&e->tl_lock);
+    int have = e->have_anchor;
+    int64_t t = sim_now(e, edge->mono_ns);
+    pthread_mutex_unlock(&e->tl_lock);
+    if (have)
+        trigger(e, t, edge->mono_ns, 0, -1, 0, e->trig.drv->name, NULL);
+    else
+        atomic_fetch_add(&e->dropped[DROP_NO_POSE], 1);
 }
 
 /* ---- network ---------------------------------------------------------------- */
@@ -280,18 +341,27 @@ static void handle_message(struct emu *e, const uint8_t *buf, size_t len, int cl
             e->sim_anchor_ns = m.sim_time_ns;
             e->mono_anchor_ns = now;
             e->have_anchor = 1;
+            pthread_cond_broadcast(&e->tl_cond);
         }
         pthread_mutex_unlock(&e->tl_lock);
         if (r != NC_REJECT_NONE) {
             log_reject(e, r, from);
             return;
         }
-        if ((m.flags & NC_MSG_CAPTURE) && e->mode == MODE_LOCKSTEP)
-            trigger(e, m.sim_time_ns, now, now, m.sequence, client, gen, "lockstep", &m);
-        else if ((m.flags & NC_MSG_CAPTURE) && e->mode == MODE_TRIGGER)
-            trigger(e, m.sim_time_ns, now, now, m.sequence, client, gen, "software", &m);
-    } else if (m.type == NC_MSG_TRIGGER && (m.flags & NC_MSG_CAPTURE) && e->mode != MODE_FREERUN) {
-        trigger(e, m.sim_time_ns, now, now, m.sequence, client, gen, "software", &m);
+        if (!(m.flags & NC_MSG_CAPTURE))
+            return;
+    } else if (!(m.flags & NC_MSG_CAPTURE)) {
+        return; /* a TRIGGER without CAPTURE asks for nothing */
+    }
+    if (m.type == NC_MSG_POSE && e->mode == MODE_LOCKSTEP) {
+        trigger(e, m.sim_time_ns, now, m.sequence, client, gen, "lockstep", &m);
+    } else if (e->have_trig && (e->trig.drv->caps & NC_TRIGGER_CAP_COMMAND)) {
+        struct sw_request rq = {&m, client, gen};
+        struct nc_trigger_edge edge = {.mono_ns = now, .request = &rq};
+        nc_trigger_control(&e->trig, "fire", &edge);
+    } else {
+        struct job j = {.trigger_sim_ns = m.sim_time_ns, .sequence = m.sequence, .client = client, .client_gen = gen};
+        drop(e, &j, DROP_IGNORED);
     }
 }
 
@@ -417,33 +487,6 @@ static void *net_thread(void *arg)
     return NULL;
 }
 
-/* ---- timer (free-run) ------------------------------------------------------- */
-
-static void *timer_thread(void *arg)
-{
-    struct emu *e = arg;
-    const int64_t period = (int64_t)llround(1e9 / e->frame_rate_hz);
-    int64_t next = mono_ns() + period;
-    while (atomic_load(&e->stop) == 0) {
-        struct timespec ts = {(time_t)(next / 1000000000), (long)(next % 1000000000)};
-        if (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) != 0)
-            continue;
-        if (atomic_load(&e->stop))
-            break;
-        int64_t now = mono_ns();
-        pthread_mutex_lock(&e->tl_lock);
-        int64_t t = sim_now(e, now);
-        int have = e->have_anchor;
-        pthread_mutex_unlock(&e->tl_lock);
-        if (have)
-            trigger(e, t, next, now, 0, -1, 0, "timer", NULL);
-        else
-            atomic_fetch_add(&e->dropped[DROP_NO_POSE], 1);
-        next += period; /* no drift: deadlines on a fixed grid */
-    }
-    return NULL;
-}
-
 /* ---- render ------------------------------------------------------------------ */
 
 static void reply(struct emu *e, const struct job *j, uint64_t frame, uint32_t status)
@@ -525,10 +568,33 @@ static void *render_thread(void *arg)
             drop(e, &j, DROP_SHUTDOWN);
             continue;
         }
+        /* Triggered frames: the exposure ends before the frame is made, as
+         * in a camera, so real-time pose streams have caught up by then. */
+        while (atomic_load(&e->stop) < 2) {
+            int64_t wait = j.ready_mono_ns - mono_ns();
+            if (wait <= 0)
+                break;
+            struct timespec ts = {0, (long)(wait < 50000000 ? wait : 50000000)};
+            nanosleep(&ts, NULL);
+        }
+        if (atomic_load(&e->stop) >= 2) {
+            drop(e, &j, DROP_SHUTDOWN);
+            continue;
+        }
         /* The pose at mid-exposure. */
         struct nc_pose pose;
         int64_t gap = 0;
         pthread_mutex_lock(&e->tl_lock);
+        /* serve.pose_wait_s: give a pose stream that lags the clock a moment
+         * to pass mid-exposure, so the pose is interpolated. */
+        int64_t deadline = j.ready_mono_ns + e->pose_wait_ns;
+        while (e->mode != MODE_LOCKSTEP && atomic_load(&e->stop) < 2 && e->sim_anchor_ns < j.mid_sim_ns) {
+            int64_t now = mono_ns(), until = deadline < now + 50000000 ? deadline : now + 50000000;
+            if (now >= deadline)
+                break;
+            struct timespec ts = {(time_t)(until / 1000000000), (long)(until % 1000000000)};
+            pthread_cond_timedwait(&e->tl_cond, &e->tl_lock, &ts);
+        }
         enum nc_pose_quality q = nc_timeline_at(&e->tl, j.mid_sim_ns, &pose, &gap);
         pthread_mutex_unlock(&e->tl_lock);
         if (q == NC_POSE_NONE) {
@@ -609,14 +675,15 @@ static void *output_thread(void *arg)
         atomic_store(&e->output_idle, 0);
         struct slot *sl = &e->slots[e->shead];
         pthread_mutex_unlock(&e->slock);
-        /* Latency: pose (or trigger) received -> frame handed to the outputs. */
+        /* Latency: pose received (lock-step) or exposure end (triggered) ->
+         * frame handed to the outputs. */
         int64_t handed = mono_ns();
         for (int i = 0; i < e->nout; i++)
             if (nc_output_submit(&e->out[i], &sl->rec) < 0)
                 fprintf(stderr, "navcam serve: output %s: frame %llu: %s\n", e->out[i].drv->name,
                         (unsigned long long)sl->rec.frame, nc_errmsg());
         pthread_mutex_lock(&e->stat_lock);
-        e->lat_ms[e->nlat % LAT_SAMPLES] = (handed - sl->job.recv_mono_ns) * 1e-6;
+        e->lat_ms[e->nlat % LAT_SAMPLES] = (handed - sl->job.ready_mono_ns) * 1e-6;
         e->render_ms[e->nlat % LAT_SAMPLES] = sl->rec.render_ms + sl->rec.camera_ms;
         e->nlat++;
         pthread_mutex_unlock(&e->stat_lock);
@@ -695,9 +762,18 @@ static void stats_json(struct emu *e, double elapsed_s, FILE *f)
     fprintf(f, "}, \"dropped\": {");
     for (int i = 0; i < DROP_COUNT; i++)
         fprintf(f, "%s\"%s\": %lu", i ? ", " : "", drop_names[i], atomic_load(&e->dropped[i]));
-    fprintf(f, "}, \"debounced\": %lu, \"latency_p50_ms\": %.3f, \"latency_p99_ms\": %.3f, \"render_camera_p50_ms\": %.3f, "
+    fprintf(f, "}, ");
+    if (e->have_trig) {
+        pthread_mutex_lock(&e->trig.lock);
+        struct nc_trigger_gate g = e->trig.gate;
+        pthread_mutex_unlock(&e->trig.lock);
+        fprintf(f, "\"trigger\": {\"driver\": \"%s\", \"edges\": %lu, \"wrong_edge\": %lu, \"debounced\": %lu, "
+                   "\"accepted\": %lu}, ",
+                e->trig.drv->name, g.edges, g.wrong_edge, g.debounced, g.accepted);
+    }
+    fprintf(f, "\"latency_p50_ms\": %.3f, \"latency_p99_ms\": %.3f, \"render_camera_p50_ms\": %.3f, "
                "\"overhead_p99_ms\": %.3f, \"outputs\": [",
-            atomic_load(&e->debounced), l50, l99, r50, o99);
+            l50, l99, r50, o99);
     for (int i = 0; i < e->nout; i++)
         fprintf(f, "%s{\"driver\": \"%s\", \"submitted\": %lu, \"failed\": %lu}", i ? ", " : "", e->out[i].drv->name,
                 e->out[i].submitted, e->out[i].failed);
@@ -743,7 +819,7 @@ int nc_serve(const struct nc_serve_options *opt)
             rc = nc_error(-ENOMEM, "out of memory");
     if (rc >= 0 && (!e->jobs || !e->slots))
         rc = nc_error(-ENOMEM, "out of memory");
-    pthread_t tnet, ttimer, trender, tout;
+    pthread_t tnet, trender, tout;
     int started = 0;
     if (rc >= 0) {
         pthread_mutex_init(&e->tl_lock, NULL);
@@ -752,6 +828,11 @@ int nc_serve(const struct nc_serve_options *opt)
         pthread_mutex_init(&e->client_lock, NULL);
         pthread_mutex_init(&e->stat_lock, NULL);
         pthread_cond_init(&e->jcond, NULL);
+        pthread_condattr_t ca;
+        pthread_condattr_init(&ca);
+        pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+        pthread_cond_init(&e->tl_cond, &ca);
+        pthread_condattr_destroy(&ca);
         pthread_cond_init(&e->scond, NULL);
         struct sigaction sa = {.sa_handler = on_signal};
         sigemptyset(&sa.sa_mask);
@@ -761,21 +842,22 @@ int nc_serve(const struct nc_serve_options *opt)
         pthread_create(&tout, NULL, output_thread, e);
         pthread_create(&trender, NULL, render_thread, e);
         pthread_create(&tnet, NULL, net_thread, e);
-        if (e->mode == MODE_FREERUN)
-            pthread_create(&ttimer, NULL, timer_thread, e);
         started = 1;
-        fprintf(stderr, "navcam serve: %s mode, %dx%d, UDP %s:%d, TCP %s:%d, %d output%s; SIGINT or SIGTERM stops\n",
-                mode_names[e->mode], e->scene.camera.width_px, e->scene.camera.height_px, e->bind, e->udp_port, e->bind,
+        if (e->have_trig)
+            rc = nc_trigger_start(&e->trig);
+        fprintf(stderr, "navcam serve: %s mode%s%s%s, %dx%d, UDP %s:%d, TCP %s:%d, %d output%s; SIGINT or SIGTERM stops\n",
+                mode_names[e->mode], e->have_trig ? " (" : "", e->have_trig ? e->trig.drv->name : "",
+                e->have_trig ? " trigger)" : "", e->scene.camera.width_px, e->scene.camera.height_px, e->bind, e->udp_port, e->bind,
                 e->tcp_port, e->nout, e->nout == 1 ? "" : "s");
     }
     double next_stats = e->stats_interval_s;
-    while (started && !got_signal) {
+    while (started && rc >= 0 && !got_signal) {
         struct timespec ts = {0, 20000000};
         nanosleep(&ts, NULL);
         double el = (mono_ns() - e->start_mono_ns) * 1e-9;
         unsigned long done = atomic_load(&e->delivered);
         for (int i = 0; i < DROP_COUNT; i++)
-            done += atomic_load(&e->dropped[i]);
+            done += i == DROP_IGNORED ? 0 : atomic_load(&e->dropped[i]);
         if ((opt->max_frames > 0 && (long)done >= opt->max_frames) || (opt->max_seconds > 0 && el >= opt->max_seconds))
             break;
         if (e->stats_interval_s > 0 && el >= next_stats) {
@@ -787,8 +869,8 @@ int nc_serve(const struct nc_serve_options *opt)
         /* Stop input, finish the frame in flight, drop what is queued, flush. */
         atomic_store(&e->stop, 1);
         pthread_join(tnet, NULL);
-        if (e->mode == MODE_FREERUN)
-            pthread_join(ttimer, NULL);
+        if (e->have_trig)
+            nc_trigger_stop(&e->trig);
         atomic_store(&e->stop, 2);
         pthread_mutex_lock(&e->jlock);
         pthread_cond_broadcast(&e->jcond);
@@ -814,6 +896,8 @@ int nc_serve(const struct nc_serve_options *opt)
     }
     for (int i = 0; i < e->nout; i++)
         nc_output_close(&e->out[i]);
+    if (e->have_trig)
+        nc_trigger_close(&e->trig);
     for (int i = 0; i < MAX_CLIENTS; i++)
         if (started && e->clients[i].fd >= 0)
             close(e->clients[i].fd);

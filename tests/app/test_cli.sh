@@ -28,6 +28,13 @@ expect 0 "--quantity" -- "$navcam" render --help
 expect 0 "--set KEY=VALUE" -- "$navcam" render --help
 expect 2 "Usage: navcam" -- "$navcam"
 expect 2 "unknown command 'paint'" -- "$navcam" paint
+# serve: the drivers this build has, and trigger configuration errors.
+expect 0 "timer     a pulse train" -- "$navcam" serve --help
+expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer)" -- \
+  "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
+expect 1 "serve.trigger applies to mode: trigger" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
+expect 1 "serve.trigger.activation" -- "$navcam" serve --set serve.mode=trigger \
+  --set "serve.trigger={driver: timer, activation: sideways}"
 expect 2 "missing -o OUT" -- "$navcam" render
 expect 2 "unsupported output format" -- "$navcam" render -o "$tmp/x.bmp"
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux

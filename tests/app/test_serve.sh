@@ -2,7 +2,9 @@
 # test_serve.sh - `navcam serve` through its real interfaces on loopback:
 # lock-step reproducibility (same trajectory twice: identical frames and
 # metadata), every rejection reason counted while serving goes on, free-run
-# frame rate, drop policy under overload, clean shutdown on SIGTERM.
+# frame rate, drop policy under overload, clean shutdown on SIGTERM, the
+# timer trigger (activation edge, delay) with the pose used checked against
+# the analytic motion, software triggers and requests a mode does not take.
 # Usage: test_serve.sh NAVCAM SOURCE_DIR TMPDIR
 set -u
 navcam=$(readlink -f "$1") src=$(readlink -f "$2") tmp=$3
@@ -134,6 +136,64 @@ s = json.load(open(sys.argv[1] + "/stats.json"))
 print(f"overload: delivered {s['frames_delivered']}, dropped {s['dropped']}, messages {s['messages']}")
 assert s["dropped"]["queue_full"] > 0 and s["frames_delivered"] > 0
 assert s["messages"] == 60  # pose input never blocked
+PY
+
+# 5. Trigger mode, timer source: 20 Hz pulses 5 ms wide, exposing 10 ms after
+# each falling edge; poses (10 Hz, straight line at 10 m/s) are waited for, so
+# the pose used at mid-exposure is interpolated and exact. A software trigger
+# meanwhile is answered "dropped" and counted as an ignored request.
+start timer 8 --set serve.mode=trigger --set serve.pose_wait_s=0.5 \
+  --set "serve.trigger={driver: timer, rate_hz: 20, pulse_width_s: 0.005, activation: falling_edge, delay_s: 0.01}"
+"$navcam" replay "$tmp/traj.csv" --port "$udp" > /dev/null 2>&1
+"$navcam" pose send --tcp --port "$tcp" --trigger --time 7 > "$tmp/timer/sw.out" 2>&1
+stop
+grep -q "dropped" "$tmp/timer/sw.out" && ok || bad "software trigger in timer mode: $(cat "$tmp/timer/sw.out")"
+python3 - "$tmp/timer" <<'PY' && ok || bad "timer trigger"
+import json, sys
+d = sys.argv[1]
+rows = [json.loads(l) for l in open(d + "/frames/frames.jsonl")]
+s = json.load(open(d + "/stats.json"))
+tr = s["trigger"]
+print(f"timer trigger: {len(rows)} frames, trigger {tr}, ignored {s['dropped']['ignored_request']}")
+assert len(rows) >= 60, len(rows)
+assert tr["driver"] == "timer" and abs(tr["wrong_edge"] - tr["accepted"]) <= 1 and tr["debounced"] == 0
+assert tr["edges"] == tr["wrong_edge"] + tr["accepted"]
+assert s["dropped"]["ignored_request"] == 1
+worst = 0
+for a, b in zip(rows, rows[1:]):
+    dt = b["trigger_mono_ns"] - a["trigger_mono_ns"]
+    assert dt % 50_000_000 == 0 and dt > 0, dt  # falling edges on the 50 ms grid
+for r in rows:
+    assert r["trigger_source"] == "timer"
+    assert r["exposure_start_sim_ns"] - r["trigger_sim_ns"] == 10_000_000
+    assert r["exposure_end_sim_ns"] - r["exposure_start_sim_ns"] == round(r["exposure_s"] * 1e9)
+    p = r["pose"]
+    assert p["t_ns"] == (r["exposure_start_sim_ns"] + r["exposure_end_sim_ns"]) // 2
+    if p["t_ns"] > 5.9e9:
+        continue  # past the trajectory's last pose
+    assert p["quality"] == "interpolated", p
+    x, y, z = p["camera_position_m"]
+    err = abs(y - (-6000 + 10 * p["t_ns"] * 1e-9))
+    worst = max(worst, err)
+    assert abs(x) < 1e-9 and abs(z) < 1e-9 and err < 1e-6, (p, err)
+print(f"pose at mid-exposure vs the analytic line: worst {worst:.3g} m")
+PY
+
+# 6. Trigger mode, software source (the default): TRIGGER messages and POSE
+# with CAPTURE each give one frame at the requested simulation time.
+start software 10 --set serve.mode=trigger --set serve.max_extrapolation_s=10
+"$navcam" pose send --port "$udp" --time 1 --position 0,-6000,0 > /dev/null 2>&1
+"$navcam" pose send --tcp --port "$tcp" --capture --time 2 --position 0,-5990,0 > "$tmp/software/a.out" 2>&1
+"$navcam" pose send --tcp --port "$tcp" --trigger --time 2.5 > "$tmp/software/b.out" 2>&1
+stop
+grep -q delivered "$tmp/software/a.out" && grep -q delivered "$tmp/software/b.out" && ok \
+  || bad "software triggers: $(cat "$tmp/software/a.out" "$tmp/software/b.out")"
+python3 - "$tmp/software" <<'PY' && ok || bad "software trigger metadata"
+import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1] + "/frames/frames.jsonl")]
+assert [r["trigger_source"] for r in rows] == ["software", "software"], rows
+assert [r["trigger_sim_ns"] for r in rows] == [2_000_000_000, 2_500_000_000]
+print("software trigger: 2 frames at 2.0 s and 2.5 s")
 PY
 
 echo "$pass passed, $fail failed"

@@ -1,0 +1,122 @@
+/* trigger_timer.c - the timer trigger: a pulse train on CLOCK_MONOTONIC, a
+ * rising edge every 1/rate_hz and a falling edge pulse_width_s later, on a
+ * fixed grid (no drift). Free-run mode uses it at serve.frame_rate_hz. The
+ * edge times are the grid times, as a hardware timestamp would be. */
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <string.h>
+#include <time.h>
+
+#include "error.h"
+#include "trigger.h"
+
+struct timer {
+    struct nc_trigger_ctx ctx;
+    int64_t period_ns, width_ns;
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t cond; /* on CLOCK_MONOTONIC, so that stop() wakes the sleeper */
+    int stop, running;
+};
+
+static int64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx)
+{
+    struct timer *t = priv;
+    double rate_hz = 10, width_s = -1;
+    int rc;
+    if ((rc = nc_cfg_double(opts, "rate_hz", 1e-3, 10000, &rate_hz)) < 0 ||
+        (rc = nc_cfg_double(opts, "pulse_width_s", 1e-6, 1000, &width_s)) < 0)
+        return rc;
+    t->ctx = *ctx;
+    t->period_ns = llround(1e9 / rate_hz);
+    /* Default pulse: 1 ms, or half the period when that is shorter. */
+    t->width_ns = width_s > 0 ? llround(width_s * 1e9) : (t->period_ns / 2 < 1000000 ? t->period_ns / 2 : 1000000);
+    if (t->width_ns >= t->period_ns)
+        return nc_cfg_error(nc_cfg_get(opts, "pulse_width_s"), "pulse_width_s must be shorter than the period 1/rate_hz = %g s",
+                            t->period_ns * 1e-9);
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&t->cond, &ca);
+    pthread_condattr_destroy(&ca);
+    pthread_mutex_init(&t->lock, NULL);
+    return 0;
+}
+
+/* Sleep until an absolute CLOCK_MONOTONIC time; 0 when stopped first. */
+static int sleep_until(struct timer *t, int64_t at)
+{
+    struct timespec ts = {(time_t)(at / 1000000000), (long)(at % 1000000000)};
+    pthread_mutex_lock(&t->lock);
+    while (!t->stop && pthread_cond_timedwait(&t->cond, &t->lock, &ts) != ETIMEDOUT)
+        ;
+    int go = !t->stop;
+    pthread_mutex_unlock(&t->lock);
+    return go;
+}
+
+static void *timer_thread(void *arg)
+{
+    struct timer *t = arg;
+    for (int64_t next = now_ns() + t->period_ns;; next += t->period_ns) {
+        struct nc_trigger_edge rise = {.mono_ns = next, .rising = 1};
+        struct nc_trigger_edge fall = {.mono_ns = next + t->width_ns, .rising = 0};
+        if (!sleep_until(t, rise.mono_ns))
+            break;
+        t->ctx.fire(t->ctx.sink, &rise);
+        if (!sleep_until(t, fall.mono_ns))
+            break;
+        t->ctx.fire(t->ctx.sink, &fall);
+    }
+    return NULL;
+}
+
+static int timer_start(void *priv)
+{
+    struct timer *t = priv;
+    int err = pthread_create(&t->thread, NULL, timer_thread, t);
+    if (err)
+        return nc_error(-err, "timer trigger: cannot start its thread: %s", strerror(err));
+    t->running = 1;
+    return 0;
+}
+
+static void timer_stop(void *priv)
+{
+    struct timer *t = priv;
+    if (!t->running)
+        return;
+    pthread_mutex_lock(&t->lock);
+    t->stop = 1;
+    pthread_cond_broadcast(&t->cond);
+    pthread_mutex_unlock(&t->lock);
+    pthread_join(t->thread, NULL);
+    t->running = 0;
+}
+
+static void timer_close(void *priv)
+{
+    struct timer *t = priv;
+    timer_stop(t);
+    pthread_cond_destroy(&t->cond);
+    pthread_mutex_destroy(&t->lock);
+}
+
+const struct nc_trigger_driver nc_trigger_timer = {
+    .name = "timer",
+    .description = "a pulse train: rate_hz (10), pulse_width_s (1 ms or half the period)",
+    .caps = NC_TRIGGER_CAP_LINE,
+    .priv_size = sizeof(struct timer),
+    .open = timer_open,
+    .start = timer_start,
+    .stop = timer_stop,
+    .close = timer_close,
+};

@@ -1,0 +1,174 @@
+/* test_trigger.c - the trigger gate (activation edge, lock-out debounce,
+ * commands) on hand-made edge sequences, and the timer trigger driver
+ * through the registry: edges alternate, lie exactly on the period grid with
+ * the configured pulse width, and stop() returns at once even between edges
+ * many seconds apart. Configuration errors name the key. */
+#include <stdatomic.h>
+#include <string.h>
+#include <time.h>
+
+#include "config.h"
+#include "error.h"
+#include "testutil.h"
+#include "trigger.h"
+
+#define MS 1000000LL
+
+static int64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int gate_run(enum nc_trigger_activation act, int64_t debounce_ns, const struct nc_trigger_edge *e, int n,
+                    int *accepted)
+{
+    struct nc_trigger_gate g = {.activation = act, .debounce_ns = debounce_ns};
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (nc_trigger_gate_accept(&g, &e[i]))
+            accepted[k++] = i;
+    return k;
+}
+
+static void test_gate(void)
+{
+    /* A pulse train 10 ms apart, 2 ms wide, whose first rising edge bounces
+     * three times within 0.3 ms. */
+    struct nc_trigger_edge e[] = {
+        {0, 1, 0, NULL},       {100000, 0, 0, NULL}, {200000, 1, 0, NULL}, {300000, 0, 0, NULL},
+        {310000, 1, 0, NULL},  {2 * MS, 0, 0, NULL}, {10 * MS, 1, 0, NULL}, {12 * MS, 0, 0, NULL},
+        {20 * MS, 1, 0, NULL}, {22 * MS, 0, 0, NULL},
+    };
+    int n = (int)(sizeof e / sizeof e[0]), acc[16];
+    int k = gate_run(NC_TRIGGER_RISING, 0, e, n, acc);
+    CHECK(k == 5, "rising, no debounce: %d edges accepted, want every rising edge (5)", k);
+    k = gate_run(NC_TRIGGER_RISING, 1 * MS, e, n, acc);
+    CHECK(k == 3 && acc[0] == 0 && acc[1] == 6 && acc[2] == 8, "rising, 1 ms debounce: %d accepted (want 0, 6, 8)", k);
+    /* Falling: the bounce's first falling edge opens the lock-out; the
+     * pulse's real end, 1.9 ms later, is outside it. */
+    k = gate_run(NC_TRIGGER_FALLING, 1 * MS, e, n, acc);
+    CHECK(k == 4 && acc[0] == 1 && acc[1] == 5 && acc[2] == 7 && acc[3] == 9,
+          "falling, 1 ms debounce: %d accepted (want 1, 5, 7, 9)", k);
+    k = gate_run(NC_TRIGGER_ANY, 1 * MS, e, n, acc);
+    CHECK(k == 6 && acc[1] == 5 && acc[2] == 6, "any edge, 1 ms debounce: %d accepted (want 0, 5, 6, 7, 8, 9)", k);
+    /* Commands (software triggers) pass activation and debounce. */
+    struct nc_trigger_gate g = {.activation = NC_TRIGGER_FALLING, .debounce_ns = 1000 * MS};
+    struct nc_trigger_edge c = {.mono_ns = 0, .rising = 1, .command = 1};
+    int all = 1;
+    for (int i = 0; i < 5; i++, c.mono_ns += MS)
+        all &= nc_trigger_gate_accept(&g, &c);
+    CHECK(all && g.accepted == 5 && g.debounced == 0 && g.wrong_edge == 0, "commands filtered");
+    /* Counters add up. */
+    g = (struct nc_trigger_gate){.activation = NC_TRIGGER_RISING, .debounce_ns = 1 * MS};
+    for (int i = 0; i < n; i++)
+        nc_trigger_gate_accept(&g, &e[i]);
+    CHECK(g.edges == 10 && g.wrong_edge == 5 && g.debounced == 2 && g.accepted == 3,
+          "counters: edges %lu wrong %lu debounced %lu accepted %lu", g.edges, g.wrong_edge, g.debounced, g.accepted);
+}
+
+/* Edges recorded by the timer test's sink. */
+struct rec {
+    struct nc_trigger_edge e[64];
+    int64_t fired_at[64];
+    atomic_int n;
+};
+
+static void record(void *sink, const struct nc_trigger_edge *edge)
+{
+    struct rec *r = sink;
+    int i = atomic_load(&r->n);
+    if (i < 64) {
+        r->e[i] = *edge;
+        r->fired_at[i] = now_ns();
+        atomic_store(&r->n, i + 1);
+    }
+}
+
+static int open_yaml(struct nc_cfg *cfg, struct nc_trigger *t, const char *yaml, struct rec *r)
+{
+    nc_cfg_init(cfg);
+    int rc = nc_cfg_load_string(cfg, yaml, "trigger.yaml");
+    struct nc_trigger_ctx ctx = {record, r};
+    if (rc >= 0)
+        rc = nc_trigger_open(t, cfg->root, &ctx);
+    return rc;
+}
+
+static void test_timer(void)
+{
+    struct nc_cfg cfg;
+    struct nc_trigger t;
+    static struct rec r;
+    int rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 200\npulse_width_s: 0.001\nactivation: falling_edge\n"
+                                 "delay_s: 0.004\n", &r);
+    CHECK(rc == 0, "open: %s", nc_errmsg());
+    if (rc < 0)
+        return;
+    CHECK(nc_cfg_check_unused(&cfg) == 0, "timer options left unread: %s", nc_errmsg());
+    CHECK(t.gate.activation == NC_TRIGGER_FALLING && t.gate.delay_ns == 4 * MS, "gate options not applied");
+    CHECK(nc_trigger_start(&t) == 0, "start: %s", nc_errmsg());
+    while (atomic_load(&r.n) < 20)
+        nanosleep(&(struct timespec){0, 1000000}, NULL);
+    nc_trigger_stop(&t);
+    int n = atomic_load(&r.n);
+    int64_t worst_late = 0;
+    for (int i = 0; i < n; i++) {
+        CHECK(r.e[i].rising == !(i & 1), "edge %d: rising=%d", i, r.e[i].rising);
+        int64_t want = r.e[0].mono_ns + (i / 2) * 5 * MS + (i & 1) * MS;
+        CHECK(r.e[i].mono_ns == want, "edge %d at %lld ns, want the grid time %lld", i, (long long)r.e[i].mono_ns,
+              (long long)want);
+        CHECK(r.fired_at[i] >= r.e[i].mono_ns, "edge %d fired before its time", i);
+        if (r.fired_at[i] - r.e[i].mono_ns > worst_late)
+            worst_late = r.fired_at[i] - r.e[i].mono_ns;
+    }
+    printf("timer: %d edges on a 5 ms grid, 1 ms pulses; fired at most %.3f ms after the edge time\n", n,
+           worst_late * 1e-6);
+    nc_trigger_close(&t);
+    nc_cfg_free(&cfg);
+
+    /* stop() wakes a timer that would next fire in 100 s. */
+    static struct rec r2;
+    rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 0.01\n", &r2);
+    CHECK(rc == 0, "open: %s", nc_errmsg());
+    if (rc < 0)
+        return;
+    nc_trigger_start(&t);
+    nanosleep(&(struct timespec){0, 20000000}, NULL);
+    int64_t t0 = now_ns();
+    nc_trigger_close(&t);
+    double stop_ms = (now_ns() - t0) * 1e-6;
+    CHECK(stop_ms < 100, "stopping a slow timer took %.1f ms", stop_ms);
+    CHECK(atomic_load(&r2.n) == 0, "a 100 s timer fired within 20 ms");
+    nc_cfg_free(&cfg);
+}
+
+static void expect_error(const char *yaml, const char *needle)
+{
+    struct nc_cfg cfg;
+    struct nc_trigger t;
+    static struct rec r;
+    int rc = open_yaml(&cfg, &t, yaml, &r);
+    if (rc >= 0)
+        rc = nc_cfg_check_unused(&cfg);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), needle), "'%s': got rc %d, '%s'; want an error with '%s'", yaml, rc,
+          nc_errmsg(), needle);
+    if (t.drv && t.priv)
+        nc_trigger_close(&t);
+    nc_cfg_free(&cfg);
+}
+
+int main(void)
+{
+    test_gate();
+    test_timer();
+    expect_error("driver: gpio9\n", "this build has: software, timer");
+    expect_error("rate_hz: 3\n", "driver");
+    expect_error("driver: timer\nrate_hz: 100\npulse_width_s: 0.02\n", "shorter than the period");
+    expect_error("driver: timer\nactivation: sideways\n", "activation");
+    expect_error("driver: software\ndebounce_s: 0.01\n", "do not apply");
+    expect_error("driver: timer\nrate_hz: 10\nrate: 3\n", "rate");
+    expect_error("driver: timer\nrate_hz: -1\n", "rate_hz");
+    return nc_test_end();
+}
