@@ -568,32 +568,26 @@ static void *render_thread(void *arg)
             drop(e, &j, DROP_SHUTDOWN);
             continue;
         }
-        /* Triggered frames: the exposure ends before the frame is made, as
-         * in a camera, so real-time pose streams have caught up by then. */
-        while (atomic_load(&e->stop) < 2) {
-            int64_t wait = j.ready_mono_ns - mono_ns();
-            if (wait <= 0)
-                break;
-            struct timespec ts = {0, (long)(wait < 50000000 ? wait : 50000000)};
-            nanosleep(&ts, NULL);
-        }
-        if (atomic_load(&e->stop) >= 2) {
-            drop(e, &j, DROP_SHUTDOWN);
-            continue;
-        }
-        /* The pose at mid-exposure. */
+        /* Triggered frames are made after the exposure has ended, as in a
+         * camera; with serve.pose_wait_s a pose stream lagging the clock gets
+         * that much longer to pass mid-exposure, so the pose is interpolated. */
         struct nc_pose pose;
         int64_t gap = 0;
         pthread_mutex_lock(&e->tl_lock);
-        /* serve.pose_wait_s: give a pose stream that lags the clock a moment
-         * to pass mid-exposure, so the pose is interpolated. */
-        int64_t deadline = j.ready_mono_ns + e->pose_wait_ns;
-        while (e->mode != MODE_LOCKSTEP && atomic_load(&e->stop) < 2 && e->sim_anchor_ns < j.mid_sim_ns) {
-            int64_t now = mono_ns(), until = deadline < now + 50000000 ? deadline : now + 50000000;
-            if (now >= deadline)
+        for (;;) {
+            int64_t now = mono_ns(), until = j.ready_mono_ns;
+            if (now >= until && e->mode != MODE_LOCKSTEP && e->sim_anchor_ns < j.mid_sim_ns)
+                until += e->pose_wait_ns;
+            if (now >= until || atomic_load(&e->stop) >= 2)
                 break;
+            until = until < now + 50000000 ? until : now + 50000000; /* look at stop now and then */
             struct timespec ts = {(time_t)(until / 1000000000), (long)(until % 1000000000)};
             pthread_cond_timedwait(&e->tl_cond, &e->tl_lock, &ts);
+        }
+        if (atomic_load(&e->stop) >= 2) {
+            pthread_mutex_unlock(&e->tl_lock);
+            drop(e, &j, DROP_SHUTDOWN);
+            continue;
         }
         enum nc_pose_quality q = nc_timeline_at(&e->tl, j.mid_sim_ns, &pose, &gap);
         pthread_mutex_unlock(&e->tl_lock);
