@@ -1,7 +1,9 @@
 /* trigger_timer.c - the timer trigger: a pulse train on CLOCK_MONOTONIC, a
  * rising edge every 1/rate_hz and a falling edge pulse_width_s later, on a
  * fixed grid (no drift). Free-run mode uses it at serve.frame_rate_hz. The
- * edge times are the grid times, as a hardware timestamp would be. */
+ * edge times are the grid times, as a hardware timestamp would be. The
+ * "rate_hz" control (a double *) changes the rate at run time: the grid
+ * restarts one new period after the change. */
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
@@ -18,6 +20,7 @@ struct timer {
     pthread_mutex_t lock;
     pthread_cond_t cond; /* on CLOCK_MONOTONIC, so that stop() wakes the sleeper */
     int stop, running;
+    unsigned restart; /* bumped by a rate change */
 };
 
 static int64_t now_ns(void)
@@ -26,6 +29,9 @@ static int64_t now_ns(void)
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
+
+/* The default pulse: 1 ms, or half the period when that is shorter. */
+static int64_t default_width(int64_t period_ns) { return period_ns / 2 < 1000000 ? period_ns / 2 : 1000000; }
 
 static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx)
 {
@@ -37,8 +43,7 @@ static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trig
         return rc;
     t->ctx = *ctx;
     t->period_ns = llround(1e9 / rate_hz);
-    /* Default pulse: 1 ms, or half the period when that is shorter. */
-    t->width_ns = width_s > 0 ? llround(width_s * 1e9) : (t->period_ns / 2 < 1000000 ? t->period_ns / 2 : 1000000);
+    t->width_ns = width_s > 0 ? llround(width_s * 1e9) : default_width(t->period_ns);
     if (t->width_ns >= t->period_ns)
         return nc_cfg_error(nc_cfg_get(opts, "pulse_width_s"), "pulse_width_s must be shorter than the period 1/rate_hz = %g s",
                             t->period_ns * 1e-9);
@@ -51,14 +56,15 @@ static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trig
     return 0;
 }
 
-/* Sleep until an absolute CLOCK_MONOTONIC time; 0 when stopped first. */
-static int sleep_until(struct timer *t, int64_t at)
+/* Sleep until an absolute CLOCK_MONOTONIC time: 1 when reached, 0 when
+ * stopped, -1 when the rate changed meanwhile. */
+static int sleep_until(struct timer *t, int64_t at, unsigned restart)
 {
     struct timespec ts = {(time_t)(at / 1000000000), (long)(at % 1000000000)};
     pthread_mutex_lock(&t->lock);
-    while (!t->stop && pthread_cond_timedwait(&t->cond, &t->lock, &ts) != ETIMEDOUT)
+    while (!t->stop && t->restart == restart && pthread_cond_timedwait(&t->cond, &t->lock, &ts) != ETIMEDOUT)
         ;
-    int go = !t->stop;
+    int go = t->stop ? 0 : t->restart == restart ? 1 : -1;
     pthread_mutex_unlock(&t->lock);
     return go;
 }
@@ -66,17 +72,41 @@ static int sleep_until(struct timer *t, int64_t at)
 static void *timer_thread(void *arg)
 {
     struct timer *t = arg;
-    for (int64_t next = now_ns() + t->period_ns;; next += t->period_ns) {
-        struct nc_trigger_edge rise = {.mono_ns = next, .rising = 1};
-        struct nc_trigger_edge fall = {.mono_ns = next + t->width_ns, .rising = 0};
-        if (!sleep_until(t, rise.mono_ns))
-            break;
-        t->ctx.fire(t->ctx.sink, &rise);
-        if (!sleep_until(t, fall.mono_ns))
-            break;
-        t->ctx.fire(t->ctx.sink, &fall);
+    for (;;) {
+        pthread_mutex_lock(&t->lock);
+        unsigned restart = t->restart;
+        int64_t period = t->period_ns, width = t->width_ns;
+        pthread_mutex_unlock(&t->lock);
+        int go = 1;
+        for (int64_t next = now_ns() + period; go == 1; next += period) {
+            struct nc_trigger_edge rise = {.mono_ns = next, .rising = 1};
+            struct nc_trigger_edge fall = {.mono_ns = next + width, .rising = 0};
+            if ((go = sleep_until(t, rise.mono_ns, restart)) == 1)
+                t->ctx.fire(t->ctx.sink, &rise);
+            if (go == 1 && (go = sleep_until(t, fall.mono_ns, restart)) == 1)
+                t->ctx.fire(t->ctx.sink, &fall);
+        }
+        if (go == 0)
+            return NULL;
     }
-    return NULL;
+}
+
+static int timer_control(void *priv, const char *request, void *arg)
+{
+    struct timer *t = priv;
+    if (strcmp(request, "rate_hz"))
+        return NC_EUNSUPPORTED;
+    double hz = *(const double *)arg;
+    if (!(hz >= 1e-3 && hz <= 10000))
+        return nc_error(NC_ERANGE, "timer trigger: rate %g Hz outside [0.001, 10000]", hz);
+    pthread_mutex_lock(&t->lock);
+    t->period_ns = llround(1e9 / hz);
+    if (t->width_ns >= t->period_ns)
+        t->width_ns = default_width(t->period_ns);
+    t->restart++;
+    pthread_cond_broadcast(&t->cond);
+    pthread_mutex_unlock(&t->lock);
+    return 0;
 }
 
 static int timer_start(void *priv)
@@ -118,5 +148,6 @@ const struct nc_trigger_driver nc_trigger_timer = {
     .open = timer_open,
     .start = timer_start,
     .stop = timer_stop,
+    .control = timer_control,
     .close = timer_close,
 };

@@ -56,7 +56,7 @@ void nc_output_close(struct nc_output *o)
     memset(o, 0, sizeof *o);
 }
 
-static const char *const quality_names[] = {"interpolated", "extrapolated", "stale", "none"};
+static const char *const quality_names[] = {"interpolated", "extrapolated", "stale", "none", "scene"};
 
 int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *buf, size_t len)
 {

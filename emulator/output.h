@@ -12,6 +12,7 @@
 
 #include "config.h"
 #include "timeline.h"
+#include "trigger.h"
 
 /* Everything known about one delivered frame. The pixel buffers belong to
  * the emulator and are valid during submit() only. */
@@ -41,9 +42,31 @@ enum nc_output_caps {
     NC_OUTPUT_CAP_DN16 = 1u << 0, /* takes 16-bit DN frames */
 };
 
+/* The camera's acquisition settings, which a driver may hand to its clients
+ * (GenICam features, V4L2 controls). They apply from the next exposure. */
+enum nc_trigger_source { NC_SOURCE_SOFTWARE, NC_SOURCE_LINE };
+struct nc_acquisition {
+    int triggered;                         /* 0: free-run at frame_rate_hz; 1: a frame per trigger */
+    enum nc_trigger_source source;         /* when triggered: software commands, or the line (serve.trigger) */
+    enum nc_trigger_activation activation; /* of the line */
+    double frame_rate_hz, exposure_s, gain_db, trigger_delay_s;
+};
+
+/* The emulator's side, valid from open() to close(); callable from any
+ * thread. In lock-step mode frames follow the poses: set() takes exposure
+ * and gain and refuses a change of triggering (NC_EUNSUPPORTED). */
+struct nc_camera_control {
+    void *emu;
+    void (*get)(void *emu, struct nc_acquisition *a);
+    int (*set)(void *emu, const struct nc_acquisition *a);
+    /* A software trigger now (counted as ignored unless triggered by software). */
+    void (*software_trigger)(void *emu);
+};
+
 struct nc_output_ctx {
     int width_px, height_px, adc_bits;
-    const char *config_dir; /* for relative paths */
+    const char *config_dir;                   /* for relative paths */
+    const struct nc_camera_control *control;  /* NULL outside `navcam serve` */
 };
 
 struct nc_output_driver {

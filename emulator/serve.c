@@ -2,9 +2,12 @@
  *
  * net thread     poll(): UDP datagrams, TCP connections (length-prefixed);
  *                decodes, counts rejections, feeds the timeline, makes jobs.
- * trigger        free-run and trigger modes: the trigger driver (trigger.h)
- *                fires edges from its own thread (timer) or from the net
- *                thread (software); accepted edges become jobs.
+ * triggers       free-run and trigger modes: three trigger drivers
+ *                (trigger.h) fire edges: the free-run timer, the line
+ *                (serve.trigger) and software commands (from the net thread
+ *                or an output's client). The acquisition settings
+ *                (struct nc_acquisition, changeable at run time by output
+ *                drivers) say which of them make frames.
  * render thread  job -> pose at mid-exposure -> render -> camera model -> slot.
  * output thread  slot -> every output driver -> FRAME reply to the requester.
  * main thread    signals, limits, the periodic statistics line, shutdown.
@@ -57,6 +60,7 @@ struct job {
     unsigned client_gen;
     const char *source;
     double exposure_s, gain_db;
+    int before_poses; /* triggered before any pose: not on the simulator's clock */
 };
 
 struct slot {
@@ -87,8 +91,21 @@ struct emu {
     struct nc_renderer renderer;
     struct nc_output out[MAX_OUTPUTS];
     int nout;
-    struct nc_trigger trig; /* free-run (timer) and trigger modes */
-    int have_trig;
+    /* triggers (not in lock-step): the free-run timer, software commands,
+     * and the line of serve.trigger when it names a line driver */
+    struct nc_trigger trig[3];
+    int have_trig[3];
+    struct trig_sink {
+        struct emu *e;
+        int kind;
+    } sinks[3];
+    int configured; /* the trigger kind serve.trigger configured (its gate's counts go in the summary) */
+    int have_configured;
+    /* acquisition settings (output drivers may change them) */
+    struct nc_acquisition acq;
+    pthread_mutex_t acq_lock;
+    struct nc_camera_control control;
+    int no_pose_scene; /* before the first pose, render the scene's configured pose */
     /* poses */
     struct nc_timeline tl;
     pthread_mutex_t tl_lock;
@@ -132,6 +149,9 @@ static int64_t mono_ns(void)
     return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
 
+enum trig_kind { TRIG_FREERUN, TRIG_SOFTWARE, TRIG_LINE };
+static const char *const trig_kind_names[] = {"freerun", "software", "line"};
+
 static void on_edge(void *sink, const struct nc_trigger_edge *edge);
 static void drop(struct emu *e, const struct job *j, enum drop_reason why);
 
@@ -141,6 +161,7 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
 {
     struct nc_cfg_node *sv = NULL, *outs = NULL;
     int rc, m = MODE_FREERUN;
+    e->no_pose_scene = 1;
     e->frame_rate_hz = 10;
     e->queue_frames = 4;
     e->stats_interval_s = 5;
@@ -153,6 +174,8 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
     if (sv) {
         static const char *const drops[] = {"drop_newest", "drop_oldest", NULL};
         static const char *const stale[] = {"drop", "render", NULL};
+        static const char *const nopose[] = {"scene", "drop", NULL};
+        int np = 0;
         const char *bind = NULL;
         long v;
         int d = 0, st = 0;
@@ -162,9 +185,11 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
             (rc = nc_cfg_double(sv, "max_extrapolation_s", 0, 3600, &max_extrap)) < 0 ||
             (rc = nc_cfg_double(sv, "pose_wait_s", 0, 60, &pose_wait_s)) < 0 ||
             (rc = nc_cfg_enum(sv, "drop_policy", drops, &d)) < 0 || (rc = nc_cfg_enum(sv, "stale_pose", stale, &st)) < 0 ||
+            (rc = nc_cfg_enum(sv, "no_pose", nopose, &np)) < 0 ||
             (rc = nc_cfg_string(sv, "bind", &bind)) < 0)
             return rc;
         e->drop_oldest = d;
+        e->no_pose_scene = np == 0;
         e->stale_render = st;
         if (bind)
             snprintf(e->bind, sizeof e->bind, "%s", bind);
@@ -183,33 +208,62 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
     }
     e->mode = (enum mode)m;
     e->pose_wait_ns = llround(pose_wait_s * 1e9);
-    /* The trigger source: free-run is the timer at frame_rate_hz; trigger
-     * mode takes serve.trigger (default: software). */
+    if ((rc = nc_timeline_init(&e->tl, 4096, (int64_t)llround(max_extrap * 1e9))) < 0)
+        return rc;
+    /* Triggers: serve.trigger is the line (or the software source's gate);
+     * the free-run timer and the software source always exist. */
     struct nc_cfg_node *tr = NULL;
     if (sv && (rc = nc_cfg_map(sv, "trigger", &tr)) < 0)
         return rc;
-    if (tr && e->mode != MODE_TRIGGER)
-        return nc_cfg_error(tr, "serve.trigger applies to mode: trigger (free-run runs at serve.frame_rate_hz; "
-                                "lock-step takes POSE messages with CAPTURE)");
-    if (!tr && e->mode != MODE_LOCKSTEP) {
-        char set[128];
-        if (e->mode == MODE_FREERUN)
-            snprintf(set, sizeof set, "serve.trigger={driver: timer, rate_hz: %.17g}", e->frame_rate_hz);
-        else
-            snprintf(set, sizeof set, "serve.trigger={driver: software}");
-        if ((rc = nc_cfg_set(cfg, set)) < 0 || (rc = nc_cfg_map(cfg->root, "serve", &sv)) < 0 ||
-            (rc = nc_cfg_map(sv, "trigger", &tr)) < 0)
-            return rc;
-    }
+    if (tr && e->mode == MODE_LOCKSTEP)
+        return nc_cfg_error(tr, "serve.trigger does not apply to lock-step mode (frames follow POSE messages with "
+                                "CAPTURE)");
+    e->configured = TRIG_SOFTWARE;
     if (tr) {
-        struct nc_trigger_ctx tc = {.fire = on_edge, .sink = e};
-        if ((rc = nc_trigger_open(&e->trig, tr, &tc)) < 0)
+        const char *name = NULL;
+        if ((rc = nc_cfg_string(tr, "driver", &name)) < 0)
             return rc;
-        e->have_trig = 1;
+        const struct nc_trigger_driver *d = name ? nc_trigger_find(name) : NULL;
+        e->configured = d && (d->caps & NC_TRIGGER_CAP_LINE) ? TRIG_LINE : TRIG_SOFTWARE;
+        e->sinks[e->configured] = (struct trig_sink){e, e->configured};
+        struct nc_trigger_ctx tc = {.fire = on_edge, .sink = &e->sinks[e->configured]};
+        if ((rc = nc_trigger_open(&e->trig[e->configured], tr, &tc)) < 0)
+            return rc;
+        e->have_trig[e->configured] = 1;
+        e->have_configured = 1;
     }
-    if ((rc = nc_timeline_init(&e->tl, 4096, (int64_t)llround(max_extrap * 1e9))) < 0)
-        return rc;
-    struct nc_output_ctx ctx = {e->scene.camera.width_px, e->scene.camera.height_px, e->cs.sensor.adc_bits, config_dir};
+    for (int k = TRIG_FREERUN; e->mode != MODE_LOCKSTEP && k <= TRIG_SOFTWARE; k++) {
+        if (e->have_trig[k])
+            continue;
+        char text[128];
+        if (k == TRIG_FREERUN)
+            snprintf(text, sizeof text, "{driver: timer, rate_hz: %.17g}", e->frame_rate_hz);
+        else
+            snprintf(text, sizeof text, "{driver: software}");
+        struct nc_cfg tcfg;
+        nc_cfg_init(&tcfg);
+        e->sinks[k] = (struct trig_sink){e, k};
+        struct nc_trigger_ctx tc = {.fire = on_edge, .sink = &e->sinks[k]};
+        rc = nc_cfg_load_string(&tcfg, text, "serve");
+        if (rc >= 0)
+            rc = nc_trigger_open(&e->trig[k], tcfg.root, &tc);
+        nc_cfg_free(&tcfg);
+        if (rc < 0)
+            return rc;
+        e->have_trig[k] = 1;
+    }
+    /* The initial acquisition settings. */
+    e->acq = (struct nc_acquisition){
+        .triggered = e->mode == MODE_TRIGGER,
+        .source = e->configured == TRIG_LINE ? NC_SOURCE_LINE : NC_SOURCE_SOFTWARE,
+        .activation = e->have_trig[TRIG_LINE] ? e->trig[TRIG_LINE].gate.activation : NC_TRIGGER_RISING,
+        .frame_rate_hz = e->frame_rate_hz,
+        .exposure_s = e->cs.exposure_s,
+        .gain_db = e->cs.sensor.analog_gain_db,
+        .trigger_delay_s = e->have_trig[e->configured] ? e->trig[e->configured].gate.delay_ns * 1e-9 : 0,
+    };
+    struct nc_output_ctx ctx = {e->scene.camera.width_px, e->scene.camera.height_px, e->cs.sensor.adc_bits, config_dir,
+                                &e->control};
     if ((rc = nc_cfg_seq(cfg->root, "outputs", &outs)) < 0)
         return rc;
     if (!outs) { /* default: numbered PNG files and the sidecar under out/ */
@@ -254,26 +308,30 @@ static void push_job(struct emu *e, const struct job *j)
 
 static int64_t sim_now(struct emu *e, int64_t mono)
 {
-    return e->have_anchor ? e->sim_anchor_ns + (mono - e->mono_anchor_ns) : 0;
+    /* Before the first pose the clock counts from the emulator's start. */
+    return e->have_anchor ? e->sim_anchor_ns + (mono - e->mono_anchor_ns) : mono - e->start_mono_ns;
 }
 
-/* A frame request at simulation time t (gated already): the exposure window. */
-static void trigger(struct emu *e, int64_t t_sim, int64_t mono, uint32_t seq, int client,
-                    unsigned gen, const char *source, const struct nc_pose_msg *m)
+/* A frame request at simulation time t (gated already): the exposure window
+ * under the acquisition settings a, unless the message overrides them. */
+static void trigger(struct emu *e, int64_t t_sim, int64_t mono, uint32_t seq, int client, unsigned gen,
+                    const char *source, const struct nc_pose_msg *m, const struct nc_acquisition *a, int before_poses)
 {
     struct job j = {.trigger_sim_ns = t_sim, .trigger_mono_ns = mono, .ready_mono_ns = mono, .sequence = seq,
-                    .client = client, .client_gen = gen, .source = source, .exposure_s = e->cs.exposure_s,
-                    .gain_db = e->cs.sensor.analog_gain_db};
+                    .client = client, .client_gen = gen, .source = source, .exposure_s = a->exposure_s,
+                    .gain_db = a->gain_db, .before_poses = before_poses};
     if (m && (m->flags & NC_MSG_EXPOSURE))
         j.exposure_s = m->exposure_s;
     if (m && (m->flags & NC_MSG_GAIN))
         j.gain_db = m->gain_db;
-    /* Lock-step exposes around the requested pose; triggers start the
-     * exposure a delay after the trigger. */
-    j.mid_sim_ns = e->mode == MODE_LOCKSTEP ? t_sim
-                                            : t_sim + e->trig.gate.delay_ns + llround(0.5 * j.exposure_s * 1e9);
-    if (e->mode != MODE_LOCKSTEP)
-        j.ready_mono_ns = mono + (j.mid_sim_ns - t_sim) + llround(0.5 * j.exposure_s * 1e9);
+    /* Lock-step exposes around the requested pose; free-run and triggers
+     * start the exposure at the edge (plus the trigger delay). */
+    int64_t half = llround(0.5 * j.exposure_s * 1e9);
+    j.mid_sim_ns = t_sim;
+    if (e->mode != MODE_LOCKSTEP) {
+        j.mid_sim_ns = t_sim + (a->triggered ? llround(a->trigger_delay_s * 1e9) : 0) + half;
+        j.ready_mono_ns = mono + (j.mid_sim_ns - t_sim) + half;
+    }
     push_job(e, &j);
 }
 
@@ -284,27 +342,89 @@ struct sw_request {
     unsigned gen;
 };
 
-/* Every edge of the trigger driver: the gate, then a job. Line edges carry
- * CLOCK_MONOTONIC times; the simulation time follows the newest pose. */
+static void acq_get(struct emu *e, struct nc_acquisition *a)
+{
+    pthread_mutex_lock(&e->acq_lock);
+    *a = e->acq;
+    pthread_mutex_unlock(&e->acq_lock);
+}
+
+/* Every edge of every trigger driver. The acquisition settings say whether
+ * its source makes frames now; the source's gate filters it; line and timer
+ * edges carry CLOCK_MONOTONIC times, mapped onto the simulation clock. */
 static void on_edge(void *sink, const struct nc_trigger_edge *edge)
 {
-    struct emu *e = sink;
-    if (!nc_trigger_accept(&e->trig, edge))
-        return;
+    const struct trig_sink *ts = sink;
+    struct emu *e = ts->e;
     const struct sw_request *rq = edge->request;
+    struct nc_acquisition a;
+    acq_get(e, &a);
+    int active = ts->kind == TRIG_FREERUN ? !a.triggered
+                                          : a.triggered && a.source == (ts->kind == TRIG_LINE ? NC_SOURCE_LINE
+                                                                                              : NC_SOURCE_SOFTWARE);
+    if (!active) { /* a camera ignores sources it is not set to */
+        if (ts->kind == TRIG_SOFTWARE) {
+            struct job j = {.trigger_sim_ns = rq ? rq->m->sim_time_ns : 0, .sequence = rq ? rq->m->sequence : 0,
+                            .client = rq ? rq->client : -1, .client_gen = rq ? rq->gen : 0};
+            drop(e, &j, DROP_IGNORED);
+        }
+        return;
+    }
+    if (!nc_trigger_accept(&e->trig[ts->kind], edge))
+        return;
+    const char *source = ts->kind == TRIG_LINE ? e->trig[TRIG_LINE].drv->name : trig_kind_names[ts->kind];
     if (rq) {
-        trigger(e, rq->m->sim_time_ns, edge->mono_ns, rq->m->sequence, rq->client, rq->gen,
-                e->trig.drv->name, rq->m);
+        trigger(e, rq->m->sim_time_ns, edge->mono_ns, rq->m->sequence, rq->client, rq->gen, source, rq->m, &a, 0);
         return;
     }
     pthread_mutex_lock(&e->tl_lock);
-    int have = e->have_anchor;
     int64_t t = sim_now(e, edge->mono_ns);
+    int before = !e->have_anchor;
     pthread_mutex_unlock(&e->tl_lock);
-    if (have)
-        trigger(e, t, edge->mono_ns, 0, -1, 0, e->trig.drv->name, NULL);
-    else
-        atomic_fetch_add(&e->dropped[DROP_NO_POSE], 1);
+    trigger(e, t, edge->mono_ns, 0, -1, 0, source, NULL, &a, before);
+}
+
+/* ---- camera controls (output.h) ------------------------------------------- */
+
+static void control_get(void *emu, struct nc_acquisition *a) { acq_get(emu, a); }
+
+static int control_set(void *emu, const struct nc_acquisition *a)
+{
+    struct emu *e = emu;
+    if (!(a->exposure_s > 0 && a->exposure_s <= 3600) || !(a->gain_db >= -20 && a->gain_db <= 60) ||
+        !(a->frame_rate_hz >= 1e-3 && a->frame_rate_hz <= 1000) || !(a->trigger_delay_s >= 0 && a->trigger_delay_s <= 10))
+        return nc_error(NC_ERANGE, "acquisition settings out of range: exposure %g s, gain %g dB, rate %g Hz, delay %g s",
+                        a->exposure_s, a->gain_db, a->frame_rate_hz, a->trigger_delay_s);
+    pthread_mutex_lock(&e->acq_lock);
+    struct nc_acquisition old = e->acq;
+    int rc = 0;
+    if (e->mode == MODE_LOCKSTEP &&
+        (a->triggered != old.triggered || a->source != old.source || a->frame_rate_hz != old.frame_rate_hz))
+        rc = nc_error(NC_EUNSUPPORTED, "lock-step mode: frames follow the poses; only exposure and gain can change");
+    if (rc >= 0 && a->frame_rate_hz != old.frame_rate_hz)
+        rc = nc_trigger_control(&e->trig[TRIG_FREERUN], "rate_hz", (void *)&a->frame_rate_hz);
+    if (rc >= 0) {
+        e->acq = *a;
+        if (e->have_trig[TRIG_LINE]) {
+            pthread_mutex_lock(&e->trig[TRIG_LINE].lock);
+            e->trig[TRIG_LINE].gate.activation = a->activation;
+            pthread_mutex_unlock(&e->trig[TRIG_LINE].lock);
+        }
+    }
+    pthread_mutex_unlock(&e->acq_lock);
+    return rc;
+}
+
+static void control_software_trigger(void *emu)
+{
+    struct emu *e = emu;
+    if (!e->have_trig[TRIG_SOFTWARE]) {
+        struct job j = {.client = -1};
+        drop(e, &j, DROP_IGNORED);
+        return;
+    }
+    struct nc_trigger_edge edge = {.mono_ns = mono_ns()};
+    nc_trigger_control(&e->trig[TRIG_SOFTWARE], "fire", &edge);
 }
 
 /* ---- network ---------------------------------------------------------------- */
@@ -354,11 +474,13 @@ static void handle_message(struct emu *e, const uint8_t *buf, size_t len, int cl
         return; /* a TRIGGER without CAPTURE asks for nothing */
     }
     if (m.type == NC_MSG_POSE && e->mode == MODE_LOCKSTEP) {
-        trigger(e, m.sim_time_ns, now, m.sequence, client, gen, "lockstep", &m);
-    } else if (e->have_trig && (e->trig.drv->caps & NC_TRIGGER_CAP_COMMAND)) {
+        struct nc_acquisition a;
+        acq_get(e, &a);
+        trigger(e, m.sim_time_ns, now, m.sequence, client, gen, "lockstep", &m, &a, 0);
+    } else if (e->have_trig[TRIG_SOFTWARE]) {
         struct sw_request rq = {&m, client, gen};
         struct nc_trigger_edge edge = {.mono_ns = now, .request = &rq};
-        nc_trigger_control(&e->trig, "fire", &edge);
+        nc_trigger_control(&e->trig[TRIG_SOFTWARE], "fire", &edge);
     } else {
         struct job j = {.trigger_sim_ns = m.sim_time_ns, .sequence = m.sequence, .client = client, .client_gen = gen};
         drop(e, &j, DROP_IGNORED);
@@ -512,6 +634,23 @@ static void drop(struct emu *e, const struct job *j, enum drop_reason why)
     reply(e, j, UINT64_MAX, NC_FRAME_DROPPED);
 }
 
+/* The scene's configured pose at time t (no pose received yet). */
+static void scene_pose(const struct nc_scene *s, int64_t t, struct nc_pose *p)
+{
+    *p = (struct nc_pose){.t_ns = t,
+                          .cam_position_m = s->camera.position_m,
+                          .cam_attitude_q = s->camera.attitude_q,
+                          .cam_velocity_m_s = s->camera.velocity_m_s,
+                          .cam_angular_velocity_rad_s = s->camera.angular_velocity_rad_s,
+                          .sun = s->sun.has_position ? s->sun.position_m : s->sun.direction,
+                          .sun_is_position = s->sun.has_position,
+                          .has_body = 1,
+                          .body_position_m = s->body[0].position_m,
+                          .body_attitude_q = s->body[0].attitude_q,
+                          .body_velocity_m_s = s->body[0].velocity_m_s,
+                          .body_angular_velocity_rad_s = s->body[0].angular_velocity_rad_s};
+}
+
 /* Scene poses from a timeline pose. */
 static void apply_pose(struct nc_scene *s, const struct nc_pose *p)
 {
@@ -576,7 +715,7 @@ static void *render_thread(void *arg)
         pthread_mutex_lock(&e->tl_lock);
         for (;;) {
             int64_t now = mono_ns(), until = j.ready_mono_ns;
-            if (now >= until && e->mode != MODE_LOCKSTEP && e->sim_anchor_ns < j.mid_sim_ns)
+            if (now >= until && e->mode != MODE_LOCKSTEP && !j.before_poses && e->sim_anchor_ns < j.mid_sim_ns)
                 until += e->pose_wait_ns;
             if (now >= until || atomic_load(&e->stop) >= 2)
                 break;
@@ -589,8 +728,12 @@ static void *render_thread(void *arg)
             drop(e, &j, DROP_SHUTDOWN);
             continue;
         }
-        enum nc_pose_quality q = nc_timeline_at(&e->tl, j.mid_sim_ns, &pose, &gap);
+        enum nc_pose_quality q = j.before_poses ? NC_POSE_NONE : nc_timeline_at(&e->tl, j.mid_sim_ns, &pose, &gap);
         pthread_mutex_unlock(&e->tl_lock);
+        if (q == NC_POSE_NONE && e->no_pose_scene) {
+            scene_pose(&e->scene, j.mid_sim_ns, &pose);
+            q = NC_POSE_SCENE;
+        }
         if (q == NC_POSE_NONE) {
             drop(e, &j, DROP_NO_POSE);
             continue;
@@ -757,13 +900,14 @@ static void stats_json(struct emu *e, double elapsed_s, FILE *f)
     for (int i = 0; i < DROP_COUNT; i++)
         fprintf(f, "%s\"%s\": %lu", i ? ", " : "", drop_names[i], atomic_load(&e->dropped[i]));
     fprintf(f, "}, ");
-    if (e->have_trig) {
-        pthread_mutex_lock(&e->trig.lock);
-        struct nc_trigger_gate g = e->trig.gate;
-        pthread_mutex_unlock(&e->trig.lock);
+    if (e->have_configured) { /* the gate of serve.trigger */
+        struct nc_trigger *t = &e->trig[e->configured];
+        pthread_mutex_lock(&t->lock);
+        struct nc_trigger_gate g = t->gate;
+        pthread_mutex_unlock(&t->lock);
         fprintf(f, "\"trigger\": {\"driver\": \"%s\", \"edges\": %lu, \"wrong_edge\": %lu, \"debounced\": %lu, "
                    "\"accepted\": %lu}, ",
-                e->trig.drv->name, g.edges, g.wrong_edge, g.debounced, g.accepted);
+                t->drv->name, g.edges, g.wrong_edge, g.debounced, g.accepted);
     }
     fprintf(f, "\"latency_p50_ms\": %.3f, \"latency_p99_ms\": %.3f, \"render_camera_p50_ms\": %.3f, "
                "\"overhead_p99_ms\": %.3f, \"outputs\": [",
@@ -781,6 +925,8 @@ int nc_serve(const struct nc_serve_options *opt)
     struct emu *e = calloc(1, sizeof *e);
     if (!e)
         return nc_error(-ENOMEM, "out of memory");
+    pthread_mutex_init(&e->acq_lock, NULL);
+    e->control = (struct nc_camera_control){e, control_get, control_set, control_software_trigger};
     struct nc_cfg cfg;
     nc_cfg_init(&cfg);
     char dir[4096] = ".";
@@ -837,11 +983,13 @@ int nc_serve(const struct nc_serve_options *opt)
         pthread_create(&trender, NULL, render_thread, e);
         pthread_create(&tnet, NULL, net_thread, e);
         started = 1;
-        if (e->have_trig)
-            rc = nc_trigger_start(&e->trig);
+        for (int k = 0; k < 3 && rc >= 0; k++)
+            if (e->have_trig[k])
+                rc = nc_trigger_start(&e->trig[k]);
+        int tk = e->mode == MODE_TRIGGER ? e->configured : -1;
         fprintf(stderr, "navcam serve: %s mode%s%s%s, %dx%d, UDP %s:%d, TCP %s:%d, %d output%s; SIGINT or SIGTERM stops\n",
-                mode_names[e->mode], e->have_trig ? " (" : "", e->have_trig ? e->trig.drv->name : "",
-                e->have_trig ? " trigger)" : "", e->scene.camera.width_px, e->scene.camera.height_px, e->bind, e->udp_port, e->bind,
+                mode_names[e->mode], tk >= 0 ? " (" : "", tk >= 0 ? e->trig[tk].drv->name : "",
+                tk >= 0 ? " trigger)" : "", e->scene.camera.width_px, e->scene.camera.height_px, e->bind, e->udp_port, e->bind,
                 e->tcp_port, e->nout, e->nout == 1 ? "" : "s");
     }
     double next_stats = e->stats_interval_s;
@@ -863,8 +1011,9 @@ int nc_serve(const struct nc_serve_options *opt)
         /* Stop input, finish the frame in flight, drop what is queued, flush. */
         atomic_store(&e->stop, 1);
         pthread_join(tnet, NULL);
-        if (e->have_trig)
-            nc_trigger_stop(&e->trig);
+        for (int k = 0; k < 3; k++)
+            if (e->have_trig[k])
+                nc_trigger_stop(&e->trig[k]);
         atomic_store(&e->stop, 2);
         pthread_mutex_lock(&e->jlock);
         pthread_cond_broadcast(&e->jcond);
@@ -890,8 +1039,9 @@ int nc_serve(const struct nc_serve_options *opt)
     }
     for (int i = 0; i < e->nout; i++)
         nc_output_close(&e->out[i]);
-    if (e->have_trig)
-        nc_trigger_close(&e->trig);
+    for (int k = 0; k < 3; k++)
+        if (e->have_trig[k])
+            nc_trigger_close(&e->trig[k]);
     for (int i = 0; i < MAX_CLIENTS; i++)
         if (started && e->clients[i].fd >= 0)
             close(e->clients[i].fd);

@@ -37,6 +37,7 @@ enum nc_pose_quality {
     NC_POSE_EXTRAPOLATED = 1, /* beyond the newest (or before the oldest), within the limit */
     NC_POSE_STALE = 2,        /* beyond the limit: the pose is filled, the caller decides */
     NC_POSE_NONE = 3,         /* nothing buffered yet */
+    NC_POSE_SCENE = 4,        /* nothing received yet: the scene's configured pose (serve.no_pose: scene) */
 };
 
 int nc_timeline_init(struct nc_timeline *tl, size_t capacity, int64_t max_extrapolation_ns);

@@ -32,7 +32,7 @@ expect 2 "unknown command 'paint'" -- "$navcam" paint
 expect 0 "timer     a pulse train" -- "$navcam" serve --help
 expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
-expect 1 "serve.trigger applies to mode: trigger" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
+expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
 expect 1 "serve.trigger.activation" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: timer, activation: sideways}"
 expect 2 "missing -o OUT" -- "$navcam" render
