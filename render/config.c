@@ -314,6 +314,54 @@ static void set_origin(struct nc_cfg_node *n, const char *origin)
         set_origin(n->child[i], origin);
 }
 
+/* Move top's node n over base's node b: maps merge key by key, anything
+ * else replaces. Moved nodes are taken out of top. */
+static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
+{
+    for (size_t i = 0; i < n->nchild; i++) {
+        struct nc_cfg_node *c = n->child[i], *old = map_find(b, c->key);
+        if (old && old->kind == NC_CFG_MAP && c->kind == NC_CFG_MAP) {
+            int rc = overlay_node(old, c);
+            if (rc < 0)
+                return rc;
+            continue;
+        }
+        if (old) { /* replace in place, keeping the base's key order */
+            size_t k = 0;
+            while (b->child[k] != old)
+                k++;
+            node_free(old);
+            b->child[k] = c;
+            c->parent = b;
+        } else if (node_append(b, c) < 0) {
+            return -ENOMEM;
+        }
+        n->child[i] = NULL;
+    }
+    return 0;
+}
+
+int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top)
+{
+    if (!top->root)
+        return 0;
+    if (!base->root || base->root->kind != NC_CFG_MAP || top->root->kind != NC_CFG_MAP)
+        return nc_error(NC_ECONFIG, "configuration overlay: both documents must be maps");
+    /* The origins move with their nodes. */
+    char **o = realloc(base->origins, (base->norigins + top->norigins) * sizeof *o);
+    if (!o)
+        return nc_error(-ENOMEM, "out of memory");
+    base->origins = o;
+    memcpy(o + base->norigins, top->origins, top->norigins * sizeof *o);
+    base->norigins += top->norigins;
+    free(top->origins);
+    top->origins = NULL;
+    top->norigins = 0;
+    int rc = overlay_node(base->root, top->root);
+    nc_cfg_free(top); /* what was not moved (emptied maps) */
+    return rc < 0 ? nc_error(rc, "out of memory") : 0;
+}
+
 int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)
 {
     char origin_buf[300];

@@ -41,6 +41,9 @@ int nc_cfg_load_string(struct nc_cfg *cfg, const char *text, const char *origin)
 /* Apply "dotted.key=VALUE"; VALUE is YAML (a scalar or a flow list/map).
  * Sequence items are addressed by index: bodies.0.shape or bodies[0].shape. */
 int nc_cfg_set(struct nc_cfg *cfg, const char *assignment);
+/* Lay top over base: maps merge key by key, scalars and sequences replace.
+ * top's nodes (with their file and line) move into base; top is freed. */
+int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top);
 
 /* Child of a map by key, or NULL. Marks it used. */
 struct nc_cfg_node *nc_cfg_get(struct nc_cfg_node *map, const char *key);

@@ -295,6 +295,22 @@ fail:
 int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *sets, int nsets)
 {
     int rc = path ? nc_cfg_load_file(cfg, path) : nc_cfg_load_string(cfg, nc_default_scene_yaml, "<built-in default scene>");
+    /* `base: builtin:default`: this file is laid over the built-in default
+     * scene (maps merge, anything else replaces). */
+    const char *base = NULL;
+    if (rc >= 0 && path && cfg->root && cfg->root->kind == NC_CFG_MAP &&
+        (rc = nc_cfg_string(cfg->root, "base", &base)) > 0) {
+        if (strcmp(base, "builtin:default"))
+            return nc_cfg_error(nc_cfg_get(cfg->root, "base"), "unknown base '%s' (known: builtin:default)", base);
+        struct nc_cfg def;
+        nc_cfg_init(&def);
+        if ((rc = nc_cfg_load_string(&def, nc_default_scene_yaml, "<built-in default scene>")) >= 0 &&
+            (rc = nc_cfg_overlay(&def, cfg)) >= 0) {
+            *cfg = def;
+        } else {
+            nc_cfg_free(&def);
+        }
+    }
     for (int i = 0; rc >= 0 && i < nsets; i++)
         rc = nc_cfg_set(cfg, sets[i]);
     return rc;

@@ -163,5 +163,32 @@ int main(void)
     struct nc_vec3 img_up = nc_quat_rotate(s.camera.attitude_q, nc_v3(0, -1, 0));
     CHECK(nc_v3_dot(img_up, nc_v3(0, 1, 0)) > 0.9, "look_at 'up' appears up in the image");
     nc_scene_free(&s);
+
+    /* base: builtin:default - a file laid over the built-in scene; errors
+     * still name the file and line they come from. */
+    char path[4096];
+    snprintf(path, sizeof path, "%s", nc_test_path("over.yaml"));
+    nc_test_write(path, "base: builtin:default\ncamera:\n  width_px: 64\n  height_px: 40\n");
+    /* Read like `navcam render` does: the scene, then the camera model's
+     * sections (optics, sensor, exposure) are the camera model's to check. */
+    nc_cfg_init(&cfg);
+    rc = nc_cfg_load_scene(&cfg, path, NULL, 0);
+    if (rc >= 0)
+        rc = nc_scene_read(&cfg, &s);
+    CHECK(rc == 0, "overlay: %s", nc_errmsg());
+    if (rc == 0) {
+        CHECK(s.camera.width_px == 64 && s.camera.height_px == 40, "overlay: camera size %dx%d", s.camera.width_px,
+              s.camera.height_px);
+        CHECK(s.nbodies == 1 && s.camera.position_m.y == -6000, "overlay: the default scene's body and camera kept");
+        CHECK(nc_cfg_get(cfg.root, "optics") != NULL, "overlay: the default camera model kept");
+        nc_scene_free(&s);
+    }
+    nc_cfg_free(&cfg);
+    nc_test_write(path, "base: builtin:default\ncamera:\n  width_px: 64\n  height_px: forty\n");
+    rc = nc_scene_load(path, NULL, 0, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:4: camera.height_px"), "overlay error: %s", nc_errmsg());
+    nc_test_write(path, "base: builtin:nothing\n");
+    rc = nc_scene_load(path, NULL, 0, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:1: base: unknown base"), "bad base: %s", nc_errmsg());
     return nc_test_end();
 }
