@@ -36,6 +36,7 @@ bench: build
 	$(BUILD)/bench_brdf
 	$(BUILD)/bench_sensor
 	$(BUILD)/bench_latency
+	$(BUILD)/bench_gige
 
 clean:
 	rm -rf $(BUILD) $(TESTBUILD) $(TESTBUILD)-asan out

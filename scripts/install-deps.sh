@@ -4,7 +4,7 @@
 set -euo pipefail
 
 pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev libcfitsio-dev libfftw3-dev librandom123-dev zlib1g-dev
-      clang libclang-rt-14-dev python3)
+      clang libclang-rt-14-dev python3 libaravis-dev libusb-1.0-0-dev aravis-tools-cli)
 case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
 
 missing=()

@@ -1,0 +1,519 @@
+/* output_gige.c - the GigE Vision output: NavCam as a GenICam camera that
+ * any GigE Vision client (Aravis, vendor viewers) opens by address. It
+ * embeds Aravis's GigE Vision device (ArvGvFakeCamera) with NavCam's own
+ * GenICam description (drivers/gige/navcam-genicam.xml, compiled in).
+ *
+ * Who does what:
+ * - The device thread (Aravis) answers GVCP and sends GVSP. NavCam keeps it
+ *   in its internal software-trigger mode and raises its trigger latch once
+ *   per finished frame; the device polls that latch trigger_poll_hz times a
+ *   second and then calls fill(), which copies the newest frame (ROI, pixel
+ *   format, optional metadata row). fill() never waits on rendering.
+ * - NavCam's poll thread reads what clients wrote (ExposureTime, Gain,
+ *   AcquisitionFrameRate, TriggerMode/Source/Activation/Delay) poll_hz times
+ *   a second and hands changes to the emulator (struct nc_camera_control),
+ *   so they act on the next exposure; TriggerSoftware fires the emulator's
+ *   software trigger.
+ * Registers are plain memory shared with the device thread (no locking in
+ * Aravis 0.8): 32-bit accesses are single loads and stores.
+ */
+#include <arpa/inet.h>
+#include <arv.h>
+#include <errno.h>
+#include <ifaddrs.h>
+#include <math.h>
+#include <net/if.h>
+#include <netinet/in.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include "error.h"
+#include "navcam_genicam_xml.h"
+#include "output.h"
+#include "version.h"
+
+/* NavCam's application registers (see the XML's header comment). */
+enum {
+    REG_FRAME_RATE = 0x1000,     /* double, Hz */
+    REG_TRIGGER_MODE = 0x1010,   /* 0 Off, 1 On */
+    REG_TRIGGER_SOURCE = 0x1014, /* 0 Line0, 1 Software */
+    REG_TRIGGER_ACT = 0x1018,    /* 0 rising, 1 falling, 2 any */
+    REG_TRIGGER_SW = 0x101c,     /* latch: a client writes 1 */
+    REG_TRIGGER_DELAY = 0x1020,  /* double, us */
+    REG_META_ROWS = 0x1030,      /* 0 or 1 */
+    REG_PACKET_SIZE = 0xd04,     /* stream channel 0: packet size in the low 16 bits */
+    REG_VENDOR = 0x48,
+    REG_MODEL = 0x68,
+    REG_VERSION = 0x88,
+    REG_INFO = 0xa8,
+};
+#define PF_MONO8 0x01080001u
+#define PF_MONO12 0x01100005u
+#define PF_MONO16 0x01100007u
+#define META_BYTES 160
+
+struct gige {
+    ArvGvFakeCamera *gv;
+    ArvFakeCamera *fc;
+    const struct nc_camera_control *ctl;
+    int W, H, adc_bits, meta_rows;
+    char iface[IF_NAMESIZE], addr[INET_ADDRSTRLEN];
+    /* the newest finished frame */
+    pthread_mutex_t lock;
+    uint16_t *dn;
+    struct nc_frame_record rec;
+    uint64_t seq, sent_seq, submitted;
+    unsigned long sent, resent, skipped, empty;
+    /* the poll thread */
+    pthread_t thread;
+    atomic_int stop;
+    int running;
+    double poll_hz;
+    struct nc_acquisition applied; /* what the registers said last time */
+    unsigned long rejected_settings;
+};
+
+static uint32_t reg_get(struct gige *g, uint32_t a)
+{
+    guint32 v = 0;
+    arv_fake_camera_read_register(g->fc, a, &v);
+    return v;
+}
+
+static void reg_set(struct gige *g, uint32_t a, uint32_t v) { arv_fake_camera_write_register(g->fc, a, v); }
+
+static double reg_get_double(struct gige *g, uint32_t a)
+{
+    uint64_t be = 0, u;
+    double d;
+    arv_fake_camera_read_memory(g->fc, a, 8, &be);
+    u = GUINT64_FROM_BE(be);
+    memcpy(&d, &u, sizeof d);
+    return d;
+}
+
+static void reg_set_double(struct gige *g, uint32_t a, double d)
+{
+    uint64_t u;
+    memcpy(&u, &d, sizeof u);
+    u = GUINT64_TO_BE(u);
+    arv_fake_camera_write_memory(g->fc, a, 8, &u);
+}
+
+static void reg_set_string(struct gige *g, uint32_t a, size_t len, const char *s)
+{
+    char buf[64] = {0};
+    snprintf(buf, sizeof buf < len ? sizeof buf : len, "%s", s);
+    arv_fake_camera_write_memory(g->fc, a, (guint32)len, buf);
+}
+
+/* The registers a client sees, from the emulator's settings. */
+static void publish(struct gige *g, const struct nc_acquisition *a)
+{
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US, (uint32_t)llround(a->exposure_s * 1e6));
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW, (uint32_t)llround(fmax(a->gain_db, 0) * 100));
+    reg_set_double(g, REG_FRAME_RATE, a->frame_rate_hz);
+    reg_set(g, REG_TRIGGER_MODE, (uint32_t)a->triggered);
+    reg_set(g, REG_TRIGGER_SOURCE, a->source == NC_SOURCE_SOFTWARE ? 1 : 0);
+    reg_set(g, REG_TRIGGER_ACT, (uint32_t)a->activation);
+    reg_set_double(g, REG_TRIGGER_DELAY, a->trigger_delay_s * 1e6);
+    g->applied = *a;
+}
+
+/* The settings the registers hold now. */
+static void read_settings(struct gige *g, struct nc_acquisition *a)
+{
+    *a = g->applied;
+    a->exposure_s = reg_get(g, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US) * 1e-6;
+    a->gain_db = reg_get(g, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW) * 0.01;
+    a->frame_rate_hz = reg_get_double(g, REG_FRAME_RATE);
+    a->triggered = reg_get(g, REG_TRIGGER_MODE) != 0;
+    a->source = reg_get(g, REG_TRIGGER_SOURCE) == 1 ? NC_SOURCE_SOFTWARE : NC_SOURCE_LINE;
+    uint32_t act = reg_get(g, REG_TRIGGER_ACT);
+    a->activation = act <= 2 ? (enum nc_trigger_activation)act : NC_TRIGGER_RISING;
+    a->trigger_delay_s = reg_get_double(g, REG_TRIGGER_DELAY) * 1e-6;
+}
+
+static int same(const struct nc_acquisition *a, const struct nc_acquisition *b)
+{
+    return a->triggered == b->triggered && a->source == b->source && a->activation == b->activation &&
+           a->frame_rate_hz == b->frame_rate_hz && a->exposure_s == b->exposure_s && a->gain_db == b->gain_db &&
+           a->trigger_delay_s == b->trigger_delay_s;
+}
+
+static void *poll_thread(void *arg)
+{
+    struct gige *g = arg;
+    const long period_ns = (long)(1e9 / g->poll_hz);
+    while (!atomic_load(&g->stop)) {
+        nanosleep(&(struct timespec){0, period_ns}, NULL);
+        if (reg_get(g, REG_TRIGGER_SW) == 1) {
+            reg_set(g, REG_TRIGGER_SW, 0);
+            if (g->ctl)
+                g->ctl->software_trigger(g->ctl->emu);
+        }
+        struct nc_acquisition want;
+        read_settings(g, &want);
+        if (same(&want, &g->applied) || !g->ctl)
+            continue;
+        if (g->ctl->set(g->ctl->emu, &want) >= 0) {
+            g->applied = want; /* the registers already say so */
+            continue;
+        }
+        /* Refused (lock-step, out of range): show the client what holds. */
+        if (g->rejected_settings++ == 0)
+            fprintf(stderr, "navcam serve: gige: a client's setting was refused: %s\n", nc_errmsg());
+        g->ctl->get(g->ctl->emu, &want);
+        publish(g, &want);
+    }
+    return NULL;
+}
+
+/* ---- frames ----------------------------------------------------------------- */
+
+static void put_u16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8); }
+static void put_u32(uint8_t *p, uint32_t v) { put_u16(p, (uint16_t)v), put_u16(p + 2, (uint16_t)(v >> 16)); }
+static void put_u64(uint8_t *p, uint64_t v) { put_u32(p, (uint32_t)v), put_u32(p + 4, (uint32_t)(v >> 32)); }
+static void put_f64(uint8_t *p, double d)
+{
+    uint64_t u;
+    memcpy(&u, &d, sizeof u);
+    put_u64(p, u);
+}
+
+/* The metadata block (docs/gige.md gives the layout), little-endian: a
+ * 48-byte core with its own CRC (fits a Mono8 row of 48 pixels), then the
+ * pose, with a CRC over everything. */
+static void metadata(const struct nc_frame_record *r, uint8_t m[META_BYTES])
+{
+    memset(m, 0, META_BYTES);
+    memcpy(m, "NCMD", 4);
+    put_u16(m + 4, 1);
+    put_u16(m + 6, META_BYTES);
+    put_u64(m + 8, r->frame);
+    put_u64(m + 16, (uint64_t)r->exposure_start_sim_ns);
+    put_f64(m + 24, r->exposure_s);
+    put_f64(m + 32, r->gain_db);
+    put_u32(m + 40, r->request_sequence);
+    put_u32(m + 44, (uint32_t)crc32(0L, m, 44));
+    put_u64(m + 48, (uint64_t)r->trigger_sim_ns);
+    put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
+    put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
+    const struct nc_pose *p = &r->pose;
+    const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
+                          p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, p->sun.x,
+                          p->sun.y,            p->sun.z};
+    for (int i = 0; i < 10; i++)
+        put_f64(m + 72 + 8 * i, v[i]);
+    m[152] = (uint8_t)p->sun_is_position;
+    m[153] = (uint8_t)r->pose_quality;
+    put_u16(m + 154, (uint16_t)r->adc_bits);
+    put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
+}
+
+/* One DN as the pixel format stores it. */
+static inline uint16_t convert(uint16_t dn, uint32_t pf, int bits)
+{
+    if (pf == PF_MONO8)
+        return (uint16_t)(bits > 8 ? dn >> (bits - 8) : dn << (8 - bits));
+    if (pf == PF_MONO12)
+        return (uint16_t)(bits > 12 ? dn >> (bits - 12) : dn);
+    return (uint16_t)(dn << (16 - bits)); /* Mono16: most significant bits */
+}
+
+/* Device thread, camera mutex held: copy the newest frame, never wait. */
+static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gain_raw, ArvPixelFormat pf)
+{
+    struct gige *g = data;
+    size_t size = 0;
+    uint8_t *out = (uint8_t *)arv_buffer_get_data(buffer, &size); /* size reads 0 here */
+    const int w = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
+    const int ox = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET);
+    const int oy = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
+    const int bpp = pf == PF_MONO8 ? 1 : 2;
+    pthread_mutex_lock(&g->lock);
+    if (!g->seq) {
+        memset(out, 0, (size_t)w * h * bpp);
+        g->empty++;
+        pthread_mutex_unlock(&g->lock);
+        return;
+    }
+    /* Newer frames replace one the device has not sent yet (it polls its
+     * latch at trigger_poll_hz and can be late on a loaded machine). */
+    if (g->sent_seq && g->seq > g->sent_seq + 1)
+        g->skipped += g->seq - g->sent_seq - 1;
+    g->resent += g->sent_seq == g->seq;
+    g->sent_seq = g->seq;
+    g->sent++;
+    int row0 = 0;
+    if (g->meta_rows && h > 0) { /* the metadata row on top */
+        uint8_t m[META_BYTES];
+        metadata(&g->rec, m);
+        size_t rowb = (size_t)w * bpp;
+        memset(out, 0, rowb);
+        memcpy(out, m, rowb < META_BYTES ? rowb : META_BYTES);
+        row0 = 1;
+    }
+    for (int y = row0; y < h; y++) {
+        int sy = oy + y - row0;
+        uint8_t *o = out + (size_t)y * w * bpp;
+        if (sy >= g->H) {
+            memset(o, 0, (size_t)w * bpp);
+            continue;
+        }
+        const uint16_t *src = g->dn + (size_t)sy * g->W + ox;
+        int n = ox + w <= g->W ? w : g->W - ox;
+        if (bpp == 1) {
+            for (int x = 0; x < n; x++)
+                o[x] = (uint8_t)convert(src[x], pf, g->adc_bits);
+        } else {
+            for (int x = 0; x < n; x++)
+                put_u16(o + 2 * x, convert(src[x], pf, g->adc_bits));
+        }
+        if (n < w)
+            memset(o + (size_t)n * bpp, 0, (size_t)(w - n) * bpp);
+    }
+    /* The GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns. */
+    arv_buffer_set_timestamp(buffer, (guint64)g->rec.exposure_start_mono_ns);
+    pthread_mutex_unlock(&g->lock);
+}
+
+/* ---- open, submit, close ------------------------------------------------------ */
+
+static void gige_close(void *priv);
+
+/* The interface's IPv4 address, and whether the GigE Vision control port is
+ * free there (Aravis does not report a taken port: its device just goes
+ * deaf). */
+static int check_interface(struct gige *g, struct nc_cfg_node *opts)
+{
+    struct ifaddrs *ifa = NULL;
+    if (if_nametoindex(g->iface) == 0)
+        return nc_cfg_error(nc_cfg_get(opts, "interface") ? nc_cfg_get(opts, "interface") : opts,
+                            "gige: network interface '%s' not found", g->iface);
+    if (getifaddrs(&ifa) < 0)
+        return nc_error(-errno, "gige: getifaddrs: %s", strerror(errno));
+    struct sockaddr_in sa = {0};
+    for (struct ifaddrs *i = ifa; i; i = i->ifa_next)
+        if (i->ifa_addr && i->ifa_addr->sa_family == AF_INET && !strcmp(i->ifa_name, g->iface)) {
+            sa = *(struct sockaddr_in *)i->ifa_addr;
+            break;
+        }
+    freeifaddrs(ifa);
+    if (sa.sin_family != AF_INET)
+        return nc_error(NC_ECONFIG, "gige: interface '%s' has no IPv4 address", g->iface);
+    inet_ntop(AF_INET, &sa.sin_addr, g->addr, sizeof g->addr);
+    int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sa.sin_port = htons(3956);
+    int rc = 0;
+    if (fd < 0 || bind(fd, (struct sockaddr *)&sa, sizeof sa) < 0)
+        rc = nc_error(errno == EADDRINUSE ? NC_ECONFIG : -errno,
+                      "gige: UDP port 3956 (GigE Vision control) on %s (%s) is %s", g->addr, g->iface,
+                      errno == EADDRINUSE ? "already in use: another GigE Vision device (or navcam serve) runs there"
+                                          : strerror(errno));
+    if (fd >= 0)
+        close(fd);
+    return rc;
+}
+
+/* A GenICam description must parse and name the features NavCam serves. */
+static int check_xml(const char *what, const void *xml, size_t len)
+{
+    static const char *const need[] = {"Width", "Height", "OffsetX", "OffsetY", "PixelFormat", "PayloadSize",
+                                       "ExposureTime", "Gain", "AcquisitionStart", "AcquisitionStop", "TriggerMode",
+                                       "TriggerSource", "TriggerSoftware", "AcquisitionFrameRate", NULL};
+    ArvGc *gc = arv_gc_new(NULL, xml, len);
+    int rc = 0;
+    for (int i = 0; need[i] && rc == 0; i++)
+        if (!gc || !arv_gc_get_node(gc, need[i]))
+            rc = nc_error(NC_ECONFIG, "gige: GenICam XML %s is invalid: it %s feature '%s' NavCam serves", what,
+                          gc ? "does not parse (messages above) or lacks the" : "does not parse, so it lacks the",
+                          need[i]);
+    if (gc)
+        g_object_unref(gc);
+    return rc;
+}
+
+static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
+{
+    struct gige *g = priv;
+    static const char *const formats[] = {"Mono8", "Mono12", "Mono16", NULL};
+    const char *iface = "lo", *serial = "NAVCAM0001", *model = "NavCam emulator", *xml = NULL;
+    double trig_hz = 200;
+    long packet = -1, meta = 0;
+    int fmt = 2, rc;
+    g->poll_hz = 1000;
+    if ((rc = nc_cfg_string(opts, "interface", &iface)) < 0 || (rc = nc_cfg_string(opts, "serial", &serial)) < 0 ||
+        (rc = nc_cfg_string(opts, "model", &model)) < 0 || (rc = nc_cfg_string(opts, "xml", &xml)) < 0 ||
+        (rc = nc_cfg_enum(opts, "pixel_format", formats, &fmt)) < 0 ||
+        (rc = nc_cfg_double(opts, "trigger_poll_hz", 1, 1000, &trig_hz)) < 0 ||
+        (rc = nc_cfg_double(opts, "poll_hz", 1, 10000, &g->poll_hz)) < 0 ||
+        (rc = nc_cfg_int(opts, "packet_size", 576, 65000, &packet)) < 0 ||
+        (rc = nc_cfg_int(opts, "metadata_row", 0, 1, &meta)) < 0)
+        return rc;
+    if (strlen(serial) == 0 || strlen(serial) > 15)
+        return nc_cfg_error(nc_cfg_get(opts, "serial"), "expected 1 to 15 characters");
+    if (strlen(iface) >= sizeof g->iface)
+        return nc_cfg_error(nc_cfg_get(opts, "interface"), "interface name too long");
+    if (ctx->adc_bits > 16 || ctx->adc_bits < 8)
+        return nc_error(NC_EUNSUPPORTED, "gige: ADC depth %d bits: GigE output takes 8 to 16", ctx->adc_bits);
+    snprintf(g->iface, sizeof g->iface, "%s", iface);
+    g->W = ctx->width_px;
+    g->H = ctx->height_px;
+    g->adc_bits = ctx->adc_bits;
+    g->meta_rows = (int)meta;
+    g->ctl = ctx->control;
+    /* The GenICam description: NavCam's own, or the configured file. */
+    char *xml_text = NULL;
+    size_t xml_len = 0;
+    char path[4096];
+    if (xml) {
+        if (xml[0] == '/' || !ctx->config_dir)
+            snprintf(path, sizeof path, "%s", xml);
+        else
+            snprintf(path, sizeof path, "%s/%s", ctx->config_dir, xml);
+        GError *err = NULL;
+        if (!g_file_get_contents(path, &xml_text, &xml_len, &err)) {
+            rc = nc_cfg_error(nc_cfg_get(opts, "xml"), "gige: %s", err ? err->message : "cannot read");
+            g_clear_error(&err);
+            return rc;
+        }
+        rc = check_xml(path, xml_text, xml_len);
+        g_free(xml_text);
+        if (rc < 0)
+            return rc;
+    } else {
+        if ((rc = check_xml("(built in)", navcam_genicam_xml, sizeof navcam_genicam_xml)) < 0)
+            return rc;
+        /* The device reads its description from a file. */
+        snprintf(path, sizeof path, "%s/navcam-genicam-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+        int fd = mkstemp(path);
+        if (fd < 0)
+            return nc_error(-errno, "gige: %s: %s", path, strerror(errno));
+        ssize_t n = write(fd, navcam_genicam_xml, sizeof navcam_genicam_xml);
+        close(fd);
+        if (n != (ssize_t)sizeof navcam_genicam_xml) {
+            unlink(path);
+            return nc_error(-EIO, "gige: cannot write %s", path);
+        }
+    }
+    if ((rc = check_interface(g, opts)) < 0) {
+        if (!xml)
+            unlink(path);
+        return rc;
+    }
+    g->dn = calloc((size_t)g->W * g->H, sizeof *g->dn);
+    if (!g->dn) {
+        if (!xml)
+            unlink(path);
+        return nc_error(-ENOMEM, "out of memory");
+    }
+    pthread_mutex_init(&g->lock, NULL);
+    g->gv = arv_gv_fake_camera_new_full(g->iface, serial, path);
+    if (!xml)
+        unlink(path); /* read at construction */
+    if (!g->gv || !arv_gv_fake_camera_is_running(g->gv)) {
+        gige_close(g);
+        return nc_error(NC_ECONFIG, "gige: the GigE Vision device did not start on %s", g->iface);
+    }
+    g->fc = arv_gv_fake_camera_get_fake_camera(g->gv);
+    reg_set_string(g, REG_VENDOR, 32, "NavCam");
+    reg_set_string(g, REG_MODEL, 32, model);
+    reg_set_string(g, REG_VERSION, 32, NC_VERSION_STRING);
+    reg_set_string(g, REG_INFO, 48, "navcam serve: a rendered camera");
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, (uint32_t)g->W);
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT, (uint32_t)g->H);
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_WIDTH, (uint32_t)g->W);
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT, (uint32_t)(g->H + g->meta_rows));
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET, 0);
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET, 0);
+    reg_set(g, REG_META_ROWS, (uint32_t)g->meta_rows);
+    static const uint32_t pfs[] = {PF_MONO8, PF_MONO12, PF_MONO16};
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, pfs[fmt]);
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE, 1);
+    /* Loopback carries big packets; real links start at the safe 1400. */
+    reg_set(g, REG_PACKET_SIZE, (uint32_t)(packet > 0 ? packet : !strcmp(g->iface, "lo") ? 8192 : 1400));
+    /* Internal: the device sends a frame when NavCam raises its latch. */
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_MODE, 1);
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOURCE, 1);
+    arv_fake_camera_set_trigger_frequency(g->fc, trig_hz);
+    struct nc_acquisition a = {.frame_rate_hz = 10, .exposure_s = 1e-3};
+    if (g->ctl)
+        g->ctl->get(g->ctl->emu, &a);
+    publish(g, &a);
+    arv_fake_camera_set_fill_pattern(g->fc, fill, g);
+    int err = pthread_create(&g->thread, NULL, poll_thread, g);
+    if (err) {
+        gige_close(g);
+        return nc_error(-err, "gige: cannot start the poll thread: %s", strerror(err));
+    }
+    g->running = 1;
+    fprintf(stderr, "navcam serve: gige: GigE Vision camera '%s' (serial %s) on %s (%s), %dx%d %s; open it by address, "
+                    "e.g. arv-tool-0.8 -a %s features\n",
+            model, serial, g->addr, g->iface, g->W, g->H, formats[fmt], g->addr);
+    return 0;
+}
+
+static int gige_submit(void *priv, const struct nc_frame_record *r)
+{
+    struct gige *g = priv;
+    if (r->width_px != g->W || r->height_px != g->H)
+        return nc_error(NC_ERANGE, "gige: frame %dx%d, camera %dx%d", r->width_px, r->height_px, g->W, g->H);
+    pthread_mutex_lock(&g->lock);
+    memcpy(g->dn, r->dn, (size_t)g->W * g->H * sizeof *g->dn);
+    g->rec = *r;
+    g->rec.dn = g->dn;
+    g->seq++;
+    g->submitted++;
+    pthread_mutex_unlock(&g->lock);
+    reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOFTWARE, 1); /* the device sends it at its next poll */
+    return 0;
+}
+
+static int gige_control(void *priv, const char *request, void *arg)
+{
+    struct gige *g = priv;
+    if (!strcmp(request, "stats")) { /* arg: unsigned long[4] sent, resent, skipped, empty */
+        unsigned long *v = arg;
+        pthread_mutex_lock(&g->lock);
+        v[0] = g->sent, v[1] = g->resent, v[2] = g->skipped, v[3] = g->empty;
+        pthread_mutex_unlock(&g->lock);
+        return 0;
+    }
+    return NC_EUNSUPPORTED;
+}
+
+static void gige_close(void *priv)
+{
+    struct gige *g = priv;
+    if (g->running) {
+        atomic_store(&g->stop, 1);
+        pthread_join(g->thread, NULL);
+        fprintf(stderr, "navcam serve: gige: %llu frames handed over, %lu sent (%lu again, %lu replaced by newer before "
+                        "the device sent them), %lu client settings refused\n",
+                (unsigned long long)g->submitted, g->sent, g->resent, g->skipped, g->rejected_settings);
+    }
+    if (g->gv)
+        g_object_unref(g->gv); /* stops and joins the device thread before g goes */
+    if (g->dn)
+        pthread_mutex_destroy(&g->lock);
+    free(g->dn);
+}
+
+const struct nc_output_driver nc_output_gige = {
+    .name = "gige",
+    .description = "a GigE Vision camera (GenICam, Aravis) on a network interface (default lo)",
+    .caps = NC_OUTPUT_CAP_DN16,
+    .priv_size = sizeof(struct gige),
+    .open = gige_open,
+    .submit = gige_submit,
+    .control = gige_control,
+    .close = gige_close,
+};
