@@ -4,7 +4,8 @@
  * Mono16 and Mono8 shifted, ROI crops); ExposureTime and Gain act on the
  * physics of the next exposure (noise off: 2x exposure -> 2x signal above
  * bias, gain scales as 10^(dB/20)); TriggerMode On + Software: one frame per
- * TriggerSoftware and none without; AcquisitionFrameRate within 2%; a client
+ * TriggerSoftware and none without; TriggerSource Line0 follows the line of
+ * serve.trigger; AcquisitionFrameRate within 2%; a client
  * killed mid-stream, then a new client streams; clear errors for a missing
  * interface, a taken port 3956 and an invalid XML.
  * Usage: test_gige NAVCAM TMPDIR
@@ -64,11 +65,13 @@ static pid_t serve(const char *dir, const char *const *extra, int nextra)
     argv[n++] = "--max-seconds";
     argv[n++] = "60";
     argv[n] = NULL;
+    char log[4200];
+    if (!dir)
+        return -1;
+    snprintf(log, sizeof log, "%s/serve.log", dir);
     mkdir(dir, 0777);
     pid_t pid = fork();
     if (pid == 0) {
-        char log[4096];
-        snprintf(log, sizeof log, "%s/serve.log", dir);
         int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644), nul = open("/dev/null", O_WRONLY);
         if (chdir(dir) < 0 || fd < 0 || nul < 0)
             _exit(127);
@@ -419,6 +422,51 @@ static void test_trigger_and_rate(void)
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
 }
 
+/* TriggerSource Line0: the line of serve.trigger (an 8 Hz timer here)
+ * makes the frames, not the 20 Hz free-run. */
+static void test_line0(void)
+{
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/line0", tmp);
+    const char *extra[] = {"serve.mode=freerun", "serve.frame_rate_hz=20",
+                           "serve.trigger={driver: timer, rate_hz: 8, activation: rising_edge}",
+                           "outputs=[{driver: gige, pixel_format: Mono8, metadata_row: 1}]"};
+    pid_t pid = serve(dir, extra, 4);
+    ArvCamera *c = open_camera();
+    CHECK(c != NULL, "line0: no camera");
+    if (!c) {
+        stop(pid);
+        return;
+    }
+    GError *err = NULL;
+    arv_camera_set_trigger(c, "Line0", &err);
+    CHECK(!err, "Line0: %s", err ? err->message : "");
+    g_clear_error(&err);
+    uint8_t *img = malloc((size_t)W * (H + 1));
+    struct stream st = {0};
+    CHECK(start(c, &st) == 0, "stream");
+    uint64_t ts, first = 0, last = 0, f0 = 0, f1 = 0, frame;
+    double ex, gain;
+    int n = 0;
+    for (double t0 = now_s(); now_s() - t0 < 3;) {
+        if (next_frame(&st, 1, img, &ts) < 0 || meta(img, &frame, &ex, &gain) < 0)
+            break;
+        if (now_s() - t0 < 0.5)
+            continue; /* frames from before the switch */
+        if (!n)
+            first = ts, f0 = frame;
+        last = ts, f1 = frame;
+        n++;
+    }
+    double rate = n > 1 ? (double)(f1 - f0) / ((last - first) * 1e-9) : 0;
+    printf("TriggerSource Line0 (an 8 Hz timer line): %.3f Hz over %d frames\n", rate, n);
+    CHECK(n >= 10 && fabs(rate / 8 - 1) < 0.02, "Line0: %.3f Hz over %d frames, want 8", rate, n);
+    finish(c, &st);
+    free(img);
+    g_object_unref(c);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+}
+
 static void test_client_killed(void)
 {
     char dir[4096];
@@ -527,6 +575,7 @@ int main(int argc, char **argv)
     test_pixels();
     test_exposure_gain();
     test_trigger_and_rate();
+    test_line0();
     test_client_killed();
     test_errors();
     return nc_test_end();
