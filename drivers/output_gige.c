@@ -234,9 +234,15 @@ static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gai
     struct gige *g = data;
     size_t size = 0;
     uint8_t *out = (uint8_t *)arv_buffer_get_data(buffer, &size); /* size reads 0 here */
-    const int w = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
-    const int ox = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET);
-    const int oy = (int)reg_get(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
+    /* The device sized the buffer from these registers. Clients may write
+     * anything into them (GenICam range checks are the client's): offsets
+     * are clamped to the sensor, and a format NavCam does not serve leaves
+     * the buffer alone rather than overrun it. */
+    const uint32_t w = reg_get(g, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = reg_get(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
+    const uint32_t rox = reg_get(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET), roy = reg_get(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
+    const int ox = rox < (uint32_t)g->W ? (int)rox : g->W, oy = roy < (uint32_t)g->H ? (int)roy : g->H;
+    if ((pf != PF_MONO8 && pf != PF_MONO12 && pf != PF_MONO16) || w > 65536 || h > 65536)
+        return;
     const int bpp = pf == PF_MONO8 ? 1 : 2;
     pthread_mutex_lock(&g->lock);
     if (!g->seq) {
@@ -261,7 +267,7 @@ static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gai
         memcpy(out, m, rowb < META_BYTES ? rowb : META_BYTES);
         row0 = 1;
     }
-    for (int y = row0; y < h; y++) {
+    for (int y = row0; y < (int)h; y++) {
         int sy = oy + y - row0;
         uint8_t *o = out + (size_t)y * w * bpp;
         if (sy >= g->H) {
@@ -269,7 +275,7 @@ static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gai
             continue;
         }
         const uint16_t *src = g->dn + (size_t)sy * g->W + ox;
-        int n = ox + w <= g->W ? w : g->W - ox;
+        int n = ox + (int)w <= g->W ? (int)w : g->W - ox; /* >= 0: ox <= W */
         if (bpp == 1) {
             for (int x = 0; x < n; x++)
                 o[x] = (uint8_t)convert(src[x], pf, g->adc_bits);
@@ -277,8 +283,8 @@ static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gai
             for (int x = 0; x < n; x++)
                 put_u16(o + 2 * x, convert(src[x], pf, g->adc_bits));
         }
-        if (n < w)
-            memset(o + (size_t)n * bpp, 0, (size_t)(w - n) * bpp);
+        if (n < (int)w)
+            memset(o + (size_t)n * bpp, 0, (size_t)((int)w - n) * bpp);
     }
     /* The GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns. */
     arv_buffer_set_timestamp(buffer, (guint64)g->rec.exposure_start_mono_ns);
