@@ -483,19 +483,6 @@ static int gige_submit(void *priv, const struct nc_frame_record *r)
     return 0;
 }
 
-static int gige_control(void *priv, const char *request, void *arg)
-{
-    struct gige *g = priv;
-    if (!strcmp(request, "stats")) { /* arg: unsigned long[4] sent, resent, skipped, empty */
-        unsigned long *v = arg;
-        pthread_mutex_lock(&g->lock);
-        v[0] = g->sent, v[1] = g->resent, v[2] = g->skipped, v[3] = g->empty;
-        pthread_mutex_unlock(&g->lock);
-        return 0;
-    }
-    return NC_EUNSUPPORTED;
-}
-
 static void gige_close(void *priv)
 {
     struct gige *g = priv;
@@ -503,8 +490,8 @@ static void gige_close(void *priv)
         atomic_store(&g->stop, 1);
         pthread_join(g->thread, NULL);
         fprintf(stderr, "navcam serve: gige: %llu frames handed over, %lu sent (%lu again, %lu replaced by newer before "
-                        "the device sent them), %lu client settings refused\n",
-                (unsigned long long)g->submitted, g->sent, g->resent, g->skipped, g->rejected_settings);
+                        "the device sent them, %lu blank before the first frame), %lu client settings refused\n",
+                (unsigned long long)g->submitted, g->sent, g->resent, g->skipped, g->empty, g->rejected_settings);
     }
     if (g->gv)
         g_object_unref(g->gv); /* stops and joins the device thread before g goes */
@@ -520,6 +507,5 @@ const struct nc_output_driver nc_output_gige = {
     .priv_size = sizeof(struct gige),
     .open = gige_open,
     .submit = gige_submit,
-    .control = gige_control,
     .close = gige_close,
 };
