@@ -225,7 +225,8 @@ int main(int argc, char **argv)
     printf("pre-rendered frame fed at %.0f Hz, device polling at %.0f Hz: %.1f fps delivered, %ld of %ld frames lost, "
            "latency (handed to the driver -> complete at the client) p50 %.2f ms p99 %.2f ms, process CPU %.2f cores\n",
            rate, poll_hz, pre.fps, pre.lost, pre.made, pre.lat50, pre.lat99, cpu_share);
-    printf("render-limited (default scene 1024x1024, 1 spp, asking 30 Hz): %.1f fps delivered, %ld of %ld frames lost\n",
+    printf("render-limited (default scene 1024x1024, 1 spp, asking 30 Hz): %.1f fps delivered, %ld of %ld frames "
+           "lost\n",
            ren.fps, ren.lost, ren.made);
     printf("fps=%.1f lost_frames=%ld latency_p50_ms=%.3f latency_p99_ms=%.3f\n", pre.fps, pre.lost, pre.lat50,
            pre.lat99);

@@ -239,7 +239,8 @@ static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gai
      * are clamped to the sensor, and a format NavCam does not serve leaves
      * the buffer alone rather than overrun it. */
     const uint32_t w = reg_get(g, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = reg_get(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
-    const uint32_t rox = reg_get(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET), roy = reg_get(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
+    const uint32_t rox = reg_get(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET);
+    const uint32_t roy = reg_get(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
     const int ox = rox < (uint32_t)g->W ? (int)rox : g->W, oy = roy < (uint32_t)g->H ? (int)roy : g->H;
     if ((pf != PF_MONO8 && pf != PF_MONO12 && pf != PF_MONO16) || w > 65536 || h > 65536)
         return;
@@ -489,8 +490,8 @@ static void gige_close(void *priv)
     if (g->running) {
         atomic_store(&g->stop, 1);
         pthread_join(g->thread, NULL);
-        fprintf(stderr, "navcam serve: gige: %llu frames handed over, %lu sent (%lu again, %lu replaced by newer before "
-                        "the device sent them, %lu blank before the first frame), %lu client settings refused\n",
+        fprintf(stderr, "navcam serve: gige: %llu frames handed over, %lu sent (%lu again, %lu replaced by newer "
+                        "before the device sent them, %lu blank before the first frame), %lu client settings refused\n",
                 (unsigned long long)g->submitted, g->sent, g->resent, g->skipped, g->empty, g->rejected_settings);
     }
     if (g->gv)
