@@ -22,13 +22,14 @@ demo: build
 
 # From scratch: a fresh build tree, warnings as errors, every ctest test; then
 # the same tests again under AddressSanitizer and UndefinedBehaviorSanitizer.
-test: deps
+test:
+	@scripts/install-deps.sh --test
 	rm -rf $(TESTBUILD) $(TESTBUILD)-asan
 	cmake -S . -B $(TESTBUILD) -DCMAKE_BUILD_TYPE=Release -DNAVCAM_WERROR=ON $(CMAKE_FLAGS)
 	cmake --build $(TESTBUILD) -j $(JOBS)
 	cmake -S . -B $(TESTBUILD)-asan -DCMAKE_BUILD_TYPE=Asan -DNAVCAM_WERROR=ON -DNAVCAM_BUILD_BENCH=OFF $(CMAKE_FLAGS)
 	cmake --build $(TESTBUILD)-asan -j $(JOBS)
-	cd $(TESTBUILD)-asan && UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ctest --output-on-failure -j $(JOBS) --timeout 900
+	cd $(TESTBUILD)-asan && UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ctest --output-on-failure -j $(JOBS) --timeout 900 -LE vm
 	cd $(TESTBUILD) && ctest --output-on-failure -j $(JOBS) --timeout 600
 
 bench: build
@@ -37,6 +38,9 @@ bench: build
 	$(BUILD)/bench_sensor
 	$(BUILD)/bench_latency
 	$(BUILD)/bench_gige
+	@if command -v qemu-system-x86_64 >/dev/null && [ -x $(BUILD)/tests/v4l2_capture ]; then \
+	  bench/bench_edge_to_frame.sh $(BUILD); \
+	else echo "bench_edge_to_frame: needs the qemu guest of tests/vm (scripts/install-deps.sh --test)"; fi
 
 clean:
 	rm -rf $(BUILD) $(TESTBUILD) $(TESTBUILD)-asan out

@@ -23,13 +23,6 @@ struct timer {
     unsigned restart; /* bumped by a rate change */
 };
 
-static int64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
 /* The default pulse: 1 ms, or half the period when that is shorter. */
 static int64_t default_width(int64_t period_ns) { return period_ns / 2 < 1000000 ? period_ns / 2 : 1000000; }
 
@@ -78,7 +71,7 @@ static void *timer_thread(void *arg)
         int64_t period = t->period_ns, width = t->width_ns;
         pthread_mutex_unlock(&t->lock);
         int go = 1;
-        for (int64_t next = now_ns() + period; go == 1; next += period) {
+        for (int64_t next = nc_mono_ns() + period; go == 1; next += period) {
             struct nc_trigger_edge rise = {.mono_ns = next, .rising = 1};
             struct nc_trigger_edge fall = {.mono_ns = next + width, .rising = 0};
             if ((go = sleep_until(t, rise.mono_ns, restart)) == 1)

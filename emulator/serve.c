@@ -91,6 +91,8 @@ struct emu {
     struct nc_renderer renderer;
     struct nc_output out[MAX_OUTPUTS];
     int nout;
+    int64_t out_msg_ns[MAX_OUTPUTS]; /* last failure message, for rate limiting */
+    unsigned long out_quiet[MAX_OUTPUTS]; /* failures not printed since */
     /* triggers (not in lock-step): the free-run timer, software commands,
      * and the line of serve.trigger when it names a line driver */
     struct nc_trigger trig[3];
@@ -141,13 +143,6 @@ struct emu {
 
 static volatile sig_atomic_t got_signal;
 static void on_signal(int sig) { got_signal = sig; }
-
-static int64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 enum trig_kind { TRIG_FREERUN, TRIG_SOFTWARE, TRIG_LINE };
 static const char *const trig_kind_names[] = {"freerun", "software", "line"};
@@ -286,8 +281,9 @@ static int serve_config(struct nc_cfg *cfg, struct emu *e, const char *config_di
 
 /* ---- jobs ------------------------------------------------------------------ */
 
-/* Queue a frame job without ever waiting: when full, drop by policy. */
-static void push_job(struct emu *e, const struct job *j)
+/* Queue a frame job without ever waiting: when full, drop by policy.
+ * Returns 1 when this job was queued. */
+static int push_job(struct emu *e, const struct job *j)
 {
     pthread_mutex_lock(&e->jlock);
     atomic_fetch_add(&e->jobs_made, 1);
@@ -295,7 +291,7 @@ static void push_job(struct emu *e, const struct job *j)
         atomic_fetch_add(&e->dropped[DROP_QUEUE_FULL], 1);
         if (!e->drop_oldest) {
             pthread_mutex_unlock(&e->jlock);
-            return; /* the newest job goes */
+            return 0; /* the newest job goes */
         }
         e->jhead = (e->jhead + 1) % e->queue_frames; /* the oldest goes */
         e->jcount--;
@@ -304,6 +300,7 @@ static void push_job(struct emu *e, const struct job *j)
     e->jcount++;
     pthread_cond_signal(&e->jcond);
     pthread_mutex_unlock(&e->jlock);
+    return 1;
 }
 
 static int64_t sim_now(struct emu *e, int64_t mono)
@@ -332,7 +329,11 @@ static void trigger(struct emu *e, int64_t t_sim, int64_t mono, uint32_t seq, in
         j.mid_sim_ns = t_sim + (a->triggered ? llround(a->trigger_delay_s * 1e9) : 0) + half;
         j.ready_mono_ns = mono + (j.mid_sim_ns - t_sim) + half;
     }
-    push_job(e, &j);
+    if (push_job(e, &j) && e->mode != MODE_LOCKSTEP && e->have_trig[TRIG_LINE]) {
+        /* The exposure happens on the wall clock: a strobe line follows it. */
+        struct nc_trigger_window w = {.start_mono_ns = j.ready_mono_ns - 2 * half, .end_mono_ns = j.ready_mono_ns};
+        nc_trigger_control(&e->trig[TRIG_LINE], "exposure", &w);
+    }
 }
 
 /* A software request, as the software trigger driver passes it back. */
@@ -423,7 +424,7 @@ static void control_software_trigger(void *emu)
         drop(e, &j, DROP_IGNORED);
         return;
     }
-    struct nc_trigger_edge edge = {.mono_ns = mono_ns()};
+    struct nc_trigger_edge edge = {.mono_ns = nc_mono_ns()};
     nc_trigger_control(&e->trig[TRIG_SOFTWARE], "fire", &edge);
 }
 
@@ -432,7 +433,7 @@ static void control_software_trigger(void *emu)
 static void log_reject(struct emu *e, enum nc_reject r, const char *from)
 {
     atomic_fetch_add(&e->rejected[r], 1);
-    int64_t now = mono_ns();
+    int64_t now = nc_mono_ns();
     if (now - e->last_reject_log_ns > 1000000000) { /* at most one line a second */
         e->last_reject_log_ns = now;
         fprintf(stderr, "navcam serve: rejected a message from %s: %s (counting; further rejections this second not logged)\n",
@@ -443,7 +444,7 @@ static void log_reject(struct emu *e, enum nc_reject r, const char *from)
 static void handle_message(struct emu *e, const uint8_t *buf, size_t len, int client, unsigned gen, const char *from)
 {
     struct nc_pose_msg m;
-    int64_t now = mono_ns();
+    int64_t now = nc_mono_ns();
     atomic_fetch_add(&e->received, 1);
     enum nc_reject r = nc_msg_decode(buf, len, &m);
     if (r == NC_REJECT_NONE && m.type == NC_MSG_FRAME)
@@ -714,7 +715,7 @@ static void *render_thread(void *arg)
         int64_t gap = 0;
         pthread_mutex_lock(&e->tl_lock);
         for (;;) {
-            int64_t now = mono_ns(), until = j.ready_mono_ns;
+            int64_t now = nc_mono_ns(), until = j.ready_mono_ns;
             if (now >= until && e->mode != MODE_LOCKSTEP && !j.before_poses && e->sim_anchor_ns < j.mid_sim_ns)
                 until += e->pose_wait_ns;
             if (now >= until || atomic_load(&e->stop) >= 2)
@@ -747,9 +748,9 @@ static void *render_thread(void *arg)
         struct nc_exposure ex = {.exposure_s = j.exposure_s, .rolling = e->cs.sensor.shutter == NC_SHUTTER_ROLLING,
                                  .line_time_s = e->cs.sensor.line_time_s};
         int ts = 1;
-        int64_t t0 = mono_ns();
+        int64_t t0 = nc_mono_ns();
         int rc = nc_render_exposure(&e->renderer, &at, &ex, &f, &ts);
-        int64_t t1 = mono_ns();
+        int64_t t1 = nc_mono_ns();
         /* A free slot for the digitised frame, or drop by policy. */
         pthread_mutex_lock(&e->slock);
         if (e->scount == e->nslots) {
@@ -766,7 +767,7 @@ static void *render_thread(void *arg)
             rc = nc_camsys_electrons(&cs, f.radiance, j.exposure_s, el);
         if (rc >= 0)
             rc = nc_camsys_digitise(&cs, el, j.exposure_s, frame, sl->dn);
-        int64_t t2 = mono_ns();
+        int64_t t2 = nc_mono_ns();
         if (rc < 0) {
             fprintf(stderr, "navcam serve: frame %llu: %s\n", (unsigned long long)frame, nc_errmsg());
             drop(e, &j, DROP_OUTPUT_BUSY);
@@ -814,11 +815,25 @@ static void *output_thread(void *arg)
         pthread_mutex_unlock(&e->slock);
         /* Latency: pose received (lock-step) or exposure end (triggered) ->
          * frame handed to the outputs. */
-        int64_t handed = mono_ns();
-        for (int i = 0; i < e->nout; i++)
-            if (nc_output_submit(&e->out[i], &sl->rec) < 0)
-                fprintf(stderr, "navcam serve: output %s: frame %llu: %s\n", e->out[i].drv->name,
-                        (unsigned long long)sl->rec.frame, nc_errmsg());
+        int64_t handed = nc_mono_ns();
+        for (int i = 0; i < e->nout; i++) {
+            if (nc_output_submit(&e->out[i], &sl->rec) >= 0)
+                continue;
+            /* One output failing (a device gone) must not flood the log:
+             * at most one message a second per output. */
+            int64_t now = nc_mono_ns();
+            if (e->out_msg_ns[i] && now - e->out_msg_ns[i] < 1000000000) {
+                e->out_quiet[i]++;
+                continue;
+            }
+            fprintf(stderr, "navcam serve: output %s: frame %llu: %s", e->out[i].drv->name,
+                    (unsigned long long)sl->rec.frame, nc_errmsg());
+            if (e->out_quiet[i])
+                fprintf(stderr, " (and %lu more failures)", e->out_quiet[i]);
+            fputc('\n', stderr);
+            e->out_msg_ns[i] = now;
+            e->out_quiet[i] = 0;
+        }
         pthread_mutex_lock(&e->stat_lock);
         e->lat_ms[e->nlat % LAT_SAMPLES] = (handed - sl->job.ready_mono_ns) * 1e-6;
         e->render_ms[e->nlat % LAT_SAMPLES] = sl->rec.render_ms + sl->rec.camera_ms;
@@ -978,7 +993,7 @@ int nc_serve(const struct nc_serve_options *opt)
         sigemptyset(&sa.sa_mask);
         sigaction(SIGINT, &sa, NULL);
         sigaction(SIGTERM, &sa, NULL);
-        e->start_mono_ns = mono_ns();
+        e->start_mono_ns = nc_mono_ns();
         pthread_create(&tout, NULL, output_thread, e);
         pthread_create(&trender, NULL, render_thread, e);
         pthread_create(&tnet, NULL, net_thread, e);
@@ -996,7 +1011,7 @@ int nc_serve(const struct nc_serve_options *opt)
     while (started && rc >= 0 && !got_signal) {
         struct timespec ts = {0, 20000000};
         nanosleep(&ts, NULL);
-        double el = (mono_ns() - e->start_mono_ns) * 1e-9;
+        double el = (nc_mono_ns() - e->start_mono_ns) * 1e-9;
         unsigned long done = atomic_load(&e->delivered);
         for (int i = 0; i < DROP_COUNT; i++)
             done += i == DROP_IGNORED ? 0 : atomic_load(&e->dropped[i]);
@@ -1026,7 +1041,7 @@ int nc_serve(const struct nc_serve_options *opt)
         pthread_join(tout, NULL);
         for (int i = 0; i < e->nout; i++)
             nc_output_control(&e->out[i], "flush", NULL);
-        double el = (mono_ns() - e->start_mono_ns) * 1e-9;
+        double el = (nc_mono_ns() - e->start_mono_ns) * 1e-9;
         stats_line(e, el);
         stats_json(e, el, stdout);
         if (opt->stats_json_path) {

@@ -25,12 +25,22 @@ struct nc_trigger_edge {
     const void *request; /* for commands: the emulator's description of the request, valid during fire() */
 };
 
+/* CLOCK_MONOTONIC now, in ns: the clock of every edge and exposure window. */
+int64_t nc_mono_ns(void);
+
 /* Called by the driver for every edge, from one thread at a time. */
 typedef void (*nc_trigger_fire_fn)(void *sink, const struct nc_trigger_edge *edge);
 
 struct nc_trigger_ctx {
     nc_trigger_fire_fn fire;
     void *sink;
+};
+
+/* An exposure window on CLOCK_MONOTONIC: the argument of the "exposure"
+ * control, which the emulator sends to the line driver for every exposure
+ * it schedules (drivers with a strobe output drive it for the window). */
+struct nc_trigger_window {
+    int64_t start_mono_ns, end_mono_ns;
 };
 
 enum nc_trigger_caps {
@@ -48,7 +58,8 @@ struct nc_trigger_driver {
     int (*start)(void *priv);
     /* After stop() returns no edge is fired any more. */
     void (*stop)(void *priv);
-    /* Generic hook ("fire" for command sources); NULL: nothing supported. */
+    /* Generic hook ("fire" for command sources, "exposure" for strobes);
+     * NULL: nothing supported. */
     int (*control)(void *priv, const char *request, void *arg);
     void (*close)(void *priv);
 };

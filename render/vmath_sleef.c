@@ -1,35 +1,24 @@
 /* vmath_sleef.c - vmath.h with SLEEF's 4-wide AVX2 double functions (u10:
  * max error 1 ulp), chosen once at run time when the CPU has AVX2 and FMA;
- * otherwise the C library. Compiled with -mavx2 -mfma: nothing here may run
- * before the CPU check. */
-#include <immintrin.h>
+ * otherwise the C library. Only the code between the target pragmas is
+ * compiled for AVX2 and FMA (sleef.h declares its AVX2 functions only
+ * there); the check and the libm loops run on any x86-64. */
 #include <math.h>
-#include <sleef.h>
+#include <stddef.h>
 
 #include "vmath.h"
 
-static int use_avx2 = -1;
-
-static int avx2(void)
-{
-    if (use_avx2 < 0) {
-        __builtin_cpu_init();
-        use_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-    }
-    return use_avx2;
-}
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+#include <immintrin.h>
+#include <sleef.h>
 
 /* Full groups of lanes through SLEEF; the tail through a padded group, so a
  * value's result never depends on its position in the array. T is the
- * element type, V the vector type, LANES its width, LD/ST its load and store. */
-#define NC_VMATH_DEFINE_T(name, T, V, LANES, LD, ST, sleef_fn, libm_fn, pad)                                 \
-    void name(T *x, size_t n)                                                                                  \
+ * element type, LANES the vector width, LD/ST its load and store. */
+#define NC_VMATH_AVX2(name, T, LANES, LD, ST, sleef_fn, pad)                                                  \
+    static void name##_avx2(T *x, size_t n)                                                                    \
     {                                                                                                          \
-        if (!avx2()) {                                                                                         \
-            for (size_t i = 0; i < n; i++)                                                                     \
-                x[i] = libm_fn(x[i]);                                                                          \
-            return;                                                                                            \
-        }                                                                                                      \
         size_t i = 0;                                                                                          \
         for (; i + LANES <= n; i += LANES)                                                                     \
             ST(x + i, sleef_fn(LD(x + i)));                                                                    \
@@ -42,24 +31,14 @@ static int avx2(void)
                 x[i + k] = t[k];                                                                               \
         }                                                                                                      \
     }
-#define NC_VMATH_DEFINE(name, fn, libm_fn, pad)                                                                \
-    NC_VMATH_DEFINE_T(name, double, __m256d, 4, _mm256_loadu_pd, _mm256_storeu_pd, fn, libm_fn, pad)
-#define NC_VMATHF_DEFINE(name, fn, libm_fn, pad)                                                               \
-    NC_VMATH_DEFINE_T(name, float, __m256, 8, _mm256_loadu_ps, _mm256_storeu_ps, fn, libm_fn, pad)
+NC_VMATH_AVX2(nc_vexp, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_expd4_u10avx2, 0.0)
+NC_VMATH_AVX2(nc_vlog, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_logd4_u10avx2, 1.0)
+NC_VMATH_AVX2(nc_vacos, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_acosd4_u10avx2, 0.0)
+NC_VMATH_AVX2(nc_vlogf, float, 8, _mm256_loadu_ps, _mm256_storeu_ps, Sleef_logf8_u35avx2, 1.0f)
+NC_VMATH_AVX2(nc_vexpf, float, 8, _mm256_loadu_ps, _mm256_storeu_ps, Sleef_expf8_u10avx2, 0.0f)
 
-NC_VMATH_DEFINE(nc_vexp, Sleef_expd4_u10avx2, exp, 0.0)
-NC_VMATH_DEFINE(nc_vlog, Sleef_logd4_u10avx2, log, 1.0)
-NC_VMATH_DEFINE(nc_vacos, Sleef_acosd4_u10avx2, acos, 0.0)
-
-void nc_vsincospi(const double *x, double *s, double *c, size_t n)
+static void sincospi_avx2(const double *x, double *s, double *c, size_t n)
 {
-    if (!avx2()) {
-        for (size_t i = 0; i < n; i++) {
-            s[i] = sin(M_PI * x[i]);
-            c[i] = cos(M_PI * x[i]);
-        }
-        return;
-    }
     size_t i = 0;
     for (; i + 4 <= n; i += 4) {
         Sleef___m256d_2 r = Sleef_sincospid4_u05avx2(_mm256_loadu_pd(x + i));
@@ -80,18 +59,8 @@ void nc_vsincospi(const double *x, double *s, double *c, size_t n)
     }
 }
 
-NC_VMATHF_DEFINE(nc_vlogf, Sleef_logf8_u35avx2, logf, 1.0f)
-NC_VMATHF_DEFINE(nc_vexpf, Sleef_expf8_u10avx2, expf, 0.0f)
-
-void nc_vsincospif(const float *x, float *s, float *c, size_t n)
+static void sincospif_avx2(const float *x, float *s, float *c, size_t n)
 {
-    if (!avx2()) {
-        for (size_t i = 0; i < n; i++) {
-            s[i] = sinf((float)M_PI * x[i]);
-            c[i] = cosf((float)M_PI * x[i]);
-        }
-        return;
-    }
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
         Sleef___m256_2 r = Sleef_sincospif8_u35avx2(_mm256_loadu_ps(x + i));
@@ -109,6 +78,58 @@ void nc_vsincospif(const float *x, float *s, float *c, size_t n)
             s[i + k] = ts[k];
             c[i + k] = tc[k];
         }
+    }
+}
+#pragma GCC pop_options
+
+static int use_avx2 = -1;
+
+static int avx2(void)
+{
+    if (use_avx2 < 0) {
+        __builtin_cpu_init();
+        use_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    }
+    return use_avx2;
+}
+
+#define NC_VMATH_DEFINE(name, T, libm_fn)                                                                     \
+    void name(T *x, size_t n)                                                                                  \
+    {                                                                                                          \
+        if (avx2()) {                                                                                          \
+            name##_avx2(x, n);                                                                                 \
+            return;                                                                                            \
+        }                                                                                                      \
+        for (size_t i = 0; i < n; i++)                                                                         \
+            x[i] = libm_fn(x[i]);                                                                              \
+    }
+NC_VMATH_DEFINE(nc_vexp, double, exp)
+NC_VMATH_DEFINE(nc_vlog, double, log)
+NC_VMATH_DEFINE(nc_vacos, double, acos)
+NC_VMATH_DEFINE(nc_vlogf, float, logf)
+NC_VMATH_DEFINE(nc_vexpf, float, expf)
+
+void nc_vsincospi(const double *x, double *s, double *c, size_t n)
+{
+    if (avx2()) {
+        sincospi_avx2(x, s, c, n);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        s[i] = sin(M_PI * x[i]);
+        c[i] = cos(M_PI * x[i]);
+    }
+}
+
+void nc_vsincospif(const float *x, float *s, float *c, size_t n)
+{
+    if (avx2()) {
+        sincospif_avx2(x, s, c, n);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        s[i] = sinf((float)M_PI * x[i]);
+        c[i] = cosf((float)M_PI * x[i]);
     }
 }
 

@@ -1,11 +1,21 @@
 #!/usr/bin/env bash
 # Installs the Debian packages NavCam needs to build, test and run, and nothing else.
 # Idempotent: packages already present are not touched and apt is not called at all.
+#   install-deps.sh          what building and running NavCam needs
+#   install-deps.sh --test   also what the tests need, including the qemu guest
+#                            of tests/vm (Debian's kernel headers, v4l2loopback
+#                            built by dkms, qemu, busybox)
 set -euo pipefail
 
 pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev libcfitsio-dev libfftw3-dev librandom123-dev zlib1g-dev
-      clang libclang-rt-14-dev python3 libaravis-dev libusb-1.0-0-dev aravis-tools-cli)
+      python3 libaravis-dev libusb-1.0-0-dev libgpiod-dev)
 case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
+if [ "${1:-}" = --test ]; then
+  pkgs+=(clang libclang-rt-14-dev aravis-tools-cli gpiod v4l-utils)
+  case "$(uname -m)" in
+    x86_64) pkgs+=(qemu-system-x86 busybox-static cpio kmod xz-utils dkms linux-headers-amd64 v4l2loopback-dkms) ;;
+  esac
+fi
 
 missing=()
 for p in "${pkgs[@]}"; do

@@ -30,11 +30,26 @@ expect 2 "Usage: navcam" -- "$navcam"
 expect 2 "unknown command 'paint'" -- "$navcam" paint
 # serve: the drivers this build has, and trigger configuration errors.
 expect 0 "timer     a pulse train" -- "$navcam" serve --help
-expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer)" -- \
+expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
 expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
 expect 1 "serve.trigger.activation" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: timer, activation: sideways}"
+# gpio and v4l2 (the host has neither GPIO chips nor video devices; tests/vm
+# runs them against real drivers): configuration errors name the key.
+expect 1 "serve.trigger.line: no GPIO chip has a line named 'NOPE'" -- "$navcam" serve --set serve.mode=trigger \
+  --set "serve.trigger={driver: gpio, line: NOPE}"
+expect 1 "a line offset needs \`chip\`" -- "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio, line: 3}"
+expect 1 "serve.trigger.chip: cannot open GPIO chip 'gpiochip7'" -- "$navcam" serve --set serve.mode=trigger \
+  --set "serve.trigger={driver: gpio, chip: gpiochip7, line: 0}"
+expect 1 "serve.trigger.strobe.active" -- "$navcam" serve --set serve.mode=trigger \
+  --set "serve.trigger={driver: gpio, line: X, strobe: {line: Y, active: sideways}}"
+expect 1 "no video output device with card label 'NoSuchCam'" -- "$navcam" serve \
+  --set "outputs=[{driver: v4l2, card: NoSuchCam}]"
+expect 1 "give either \`device\` or \`card\`" -- "$navcam" serve --set "outputs=[{driver: v4l2, device: /dev/video0, card: X}]"
+expect 1 "GREY holds 8 bits; the camera's ADC has 12" -- "$navcam" serve --set "outputs=[{driver: v4l2, format: GREY}]"
+expect 1 "v4l2 output: /dev/nonexistent-video: No such file or directory" -- "$navcam" serve \
+  --set "outputs=[{driver: v4l2, device: /dev/nonexistent-video}]"
 expect 2 "missing -o OUT" -- "$navcam" render
 expect 2 "unsupported output format" -- "$navcam" render -o "$tmp/x.bmp"
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux

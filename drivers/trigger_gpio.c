@@ -1,0 +1,354 @@
+/* trigger_gpio.c - a hardware trigger on a GPIO line through libgpiod 1.6,
+ * with an optional strobe output line that is active while the sensor
+ * exposes.
+ *
+ * The trigger line is requested for both edges; the emulator's gate applies
+ * the activation edge and the debounce (trigger.h), so a client may change
+ * the activation at run time. Each edge carries the kernel's event timestamp,
+ * which on Linux >= 5.7 is CLOCK_MONOTONIC: the trigger time is when the line
+ * changed, not when this thread woke up.
+ *
+ * The strobe follows the "exposure" control: the emulator passes every
+ * exposure window (CLOCK_MONOTONIC) as it schedules the exposure, and this
+ * driver's thread drives the line at the window's start and end (ppoll with
+ * a nanosecond timeout, on the same thread that reads the edges).
+ *
+ * Options (the serve.trigger map):
+ *   line     name or offset of the input line (required)
+ *   chip     gpiochipN, /dev/gpiochipN, a chip label or a number; without it
+ *            `line` must be a name, searched on every chip
+ *   bias     as_is (default), disable, pull_up, pull_down
+ *   strobe   {line: NAME|OFFSET, chip: (the trigger's chip), active: high|low}
+ */
+#include <errno.h>
+#include <gpiod.h>
+#include <poll.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/eventfd.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "error.h"
+#include "trigger.h"
+
+#define CONSUMER "navcam"
+#define MAX_WINDOWS 64
+
+struct gpio_line {
+    struct gpiod_chip *chip; /* owned unless shared with the trigger line */
+    struct gpiod_line *line;
+    char desc[160];          /* "gpiochip0 line 3 \"TRIG\"" for messages */
+};
+
+struct gpio_trig {
+    struct nc_trigger_ctx ctx;
+    struct gpio_line in, strobe;
+    int have_strobe, strobe_active_low, strobe_on;
+    int wake_fd;
+    pthread_t thread;
+    int running;
+    atomic_int stop;
+    pthread_mutex_t lock; /* the exposure windows */
+    struct nc_trigger_window win[MAX_WINDOWS];
+    int whead, wcount, wseen[MAX_WINDOWS];
+    unsigned long strobes, strobe_missed, read_errors;
+    int warned_clock;
+};
+
+static int all_digits(const char *s)
+{
+    if (!*s)
+        return 0;
+    for (; *s; s++)
+        if (*s < '0' || *s > '9')
+            return 0;
+    return 1;
+}
+
+/* Find chip and line from the `line` and `chip` keys of opts; `shared` is a
+ * chip already open that the line defaults to. */
+static int find_line(struct nc_cfg_node *opts, struct gpiod_chip *shared, struct gpio_line *out)
+{
+    const char *name = NULL, *chip = NULL;
+    int rc;
+    if ((rc = nc_cfg_string(opts, "line", &name)) < 0 || (rc = nc_cfg_string(opts, "chip", &chip)) < 0)
+        return rc;
+    if (!name)
+        return nc_cfg_missing(opts, "line", "a GPIO line name or offset (gpioinfo lists them)");
+    struct nc_cfg_node *ln = nc_cfg_get(opts, "line");
+    if (chip) {
+        out->chip = gpiod_chip_open_lookup(chip);
+        if (!out->chip)
+            return nc_cfg_error(nc_cfg_get(opts, "chip"), "cannot open GPIO chip '%s': %s (gpiodetect lists the chips)",
+                                chip, strerror(errno));
+    }
+    struct gpiod_chip *c = out->chip ? out->chip : shared;
+    if (all_digits(name)) {
+        if (!c)
+            return nc_cfg_error(ln, "a line offset needs `chip` (or use the line's name)");
+        out->line = gpiod_chip_get_line(c, (unsigned)strtoul(name, NULL, 10));
+        if (!out->line)
+            return nc_cfg_error(ln, "GPIO chip %s has no line %s (it has %u lines)", gpiod_chip_name(c), name,
+                                gpiod_chip_num_lines(c));
+    } else if (c) {
+        out->line = gpiod_chip_find_line(c, name);
+        if (!out->line)
+            return nc_cfg_error(ln, "GPIO chip %s has no line named '%s' (gpioinfo %s lists them)", gpiod_chip_name(c),
+                                name, gpiod_chip_name(c));
+    } else {
+        out->line = gpiod_line_find(name);
+        if (!out->line)
+            return nc_cfg_error(ln, "no GPIO chip has a line named '%s' (gpioinfo lists them)", name);
+        out->chip = gpiod_line_get_chip(out->line);
+    }
+    const char *lname = gpiod_line_name(out->line);
+    snprintf(out->desc, sizeof out->desc, "%s line %u%s%s%s", gpiod_chip_name(gpiod_line_get_chip(out->line)),
+             gpiod_line_offset(out->line), lname ? " \"" : "", lname ? lname : "", lname ? "\"" : "");
+    if (gpiod_line_is_used(out->line)) {
+        const char *who = gpiod_line_consumer(out->line);
+        return nc_cfg_error(ln, "GPIO %s is already in use by '%s'", out->desc, who ? who : "another consumer");
+    }
+    return 0;
+}
+
+static void release_line(struct gpio_line *l, struct gpiod_chip *shared)
+{
+    if (l->line)
+        gpiod_line_release(l->line);
+    if (l->chip && l->chip != shared)
+        gpiod_chip_close(l->chip);
+    memset(l, 0, sizeof *l);
+}
+
+static int open_lines(struct gpio_trig *g, struct nc_cfg_node *opts)
+{
+    static const char *const biases[] = {"as_is", "disable", "pull_up", "pull_down", NULL};
+    static const int bias_flags[] = {0, GPIOD_LINE_REQUEST_FLAG_BIAS_DISABLE, GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_UP,
+                                     GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_DOWN};
+    int bias = 0, rc;
+    struct nc_cfg_node *st = NULL;
+    static const char *const levels[] = {"high", "low", NULL};
+    int low = 0;
+    /* All options first, then the hardware. */
+    if ((rc = nc_cfg_enum(opts, "bias", biases, &bias)) < 0 || (rc = nc_cfg_map(opts, "strobe", &st)) < 0 ||
+        (st && (rc = nc_cfg_enum(st, "active", levels, &low)) < 0))
+        return rc;
+    if ((rc = find_line(opts, NULL, &g->in)) < 0)
+        return rc;
+    if (gpiod_line_request_both_edges_events_flags(g->in.line, CONSUMER, bias_flags[bias]) < 0)
+        return nc_cfg_error(nc_cfg_get(opts, "line"), "cannot request GPIO %s for edge events: %s", g->in.desc,
+                            strerror(errno));
+    if (st) {
+        if ((rc = find_line(st, gpiod_line_get_chip(g->in.line), &g->strobe)) < 0)
+            return rc;
+        g->strobe_active_low = low;
+        if (gpiod_line_request_output(g->strobe.line, CONSUMER, low) < 0)
+            return nc_cfg_error(nc_cfg_get(st, "line"), "cannot request GPIO %s as an output: %s", g->strobe.desc,
+                                strerror(errno));
+        g->have_strobe = 1;
+    }
+    g->wake_fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+    if (g->wake_fd < 0)
+        return nc_error(-errno, "gpio trigger: eventfd: %s", strerror(errno));
+    pthread_mutex_init(&g->lock, NULL);
+    fprintf(stderr, "navcam: gpio trigger on %s%s%s (active %s)\n", g->in.desc, g->have_strobe ? ", strobe on " : "",
+            g->have_strobe ? g->strobe.desc : "", g->strobe_active_low ? "low" : "high");
+    return 0;
+}
+
+static void gpio_close(void *priv);
+
+static int gpio_open(void *priv, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx)
+{
+    struct gpio_trig *g = priv;
+    g->ctx = *ctx;
+    g->wake_fd = -1;
+    int rc = open_lines(g, opts);
+    if (rc < 0)
+        gpio_close(g);
+    return rc;
+}
+
+static void set_strobe(struct gpio_trig *g, int on)
+{
+    if (on == g->strobe_on)
+        return;
+    if (gpiod_line_set_value(g->strobe.line, on ^ g->strobe_active_low) < 0) {
+        fprintf(stderr, "navcam: gpio trigger: strobe %s: %s\n", g->strobe.desc, strerror(errno));
+        return;
+    }
+    g->strobe_on = on;
+}
+
+/* Where the strobe should be now; returns the time of the next change
+ * (INT64_MAX when no window is pending). Windows are kept in arrival order,
+ * which is start order; overlapping windows simply keep the line active. */
+static int64_t strobe_plan(struct gpio_trig *g, int64_t now, int *want)
+{
+    int64_t next = INT64_MAX;
+    *want = 0;
+    pthread_mutex_lock(&g->lock);
+    while (g->wcount && g->win[g->whead].end_mono_ns <= now) {
+        if (!g->wseen[g->whead])
+            g->strobe_missed++; /* the whole window passed before this thread ran */
+        g->whead = (g->whead + 1) % MAX_WINDOWS;
+        g->wcount--;
+    }
+    for (int i = 0; i < g->wcount; i++) {
+        int k = (g->whead + i) % MAX_WINDOWS;
+        const struct nc_trigger_window *w = &g->win[k];
+        if (w->start_mono_ns <= now) {
+            *want = 1;
+            if (!g->wseen[k])
+                g->wseen[k] = 1, g->strobes++;
+            next = w->end_mono_ns < next ? w->end_mono_ns : next;
+        } else {
+            next = w->start_mono_ns < next ? w->start_mono_ns : next;
+        }
+    }
+    pthread_mutex_unlock(&g->lock);
+    return next;
+}
+
+static void read_edges(struct gpio_trig *g, int fd)
+{
+    struct gpiod_line_event ev[16];
+    int n = gpiod_line_event_read_fd_multiple(fd, ev, 16);
+    if (n < 0) {
+        if (errno != EAGAIN && g->read_errors++ == 0)
+            fprintf(stderr, "navcam: gpio trigger: reading events of %s: %s\n", g->in.desc, strerror(errno));
+        return;
+    }
+    int64_t now = nc_mono_ns();
+    for (int i = 0; i < n; i++) {
+        struct nc_trigger_edge e = {.mono_ns = (int64_t)ev[i].ts.tv_sec * 1000000000 + ev[i].ts.tv_nsec,
+                                    .rising = ev[i].event_type == GPIOD_LINE_EVENT_RISING_EDGE};
+        /* Kernels before 5.7 stamp events with CLOCK_REALTIME: then the
+         * read time is the best CLOCK_MONOTONIC estimate there is. */
+        if (e.mono_ns > now || now - e.mono_ns > 3600 * (int64_t)1000000000) {
+            if (!g->warned_clock++)
+                fprintf(stderr, "navcam: gpio trigger: event timestamps of %s are not CLOCK_MONOTONIC (kernel "
+                                "older than 5.7?); using the time events are read\n", g->in.desc);
+            e.mono_ns = now;
+        }
+        g->ctx.fire(g->ctx.sink, &e);
+    }
+}
+
+static void *gpio_thread(void *arg)
+{
+    struct gpio_trig *g = arg;
+    int efd = gpiod_line_event_get_fd(g->in.line);
+    while (!atomic_load(&g->stop)) {
+        int64_t now = nc_mono_ns(), next = INT64_MAX;
+        if (g->have_strobe) {
+            int want;
+            next = strobe_plan(g, now, &want);
+            set_strobe(g, want);
+        }
+        struct pollfd p[2] = {{.fd = efd, .events = POLLIN}, {.fd = g->wake_fd, .events = POLLIN}};
+        struct timespec ts, *tp = NULL;
+        if (next != INT64_MAX) {
+            int64_t d = next > now ? next - now : 0;
+            ts = (struct timespec){(time_t)(d / 1000000000), (long)(d % 1000000000)};
+            tp = &ts;
+        }
+        if (ppoll(p, 2, tp, NULL) < 0 && errno != EINTR) {
+            fprintf(stderr, "navcam: gpio trigger: ppoll: %s\n", strerror(errno));
+            break;
+        }
+        if (p[1].revents & POLLIN) {
+            uint64_t v;
+            if (read(g->wake_fd, &v, sizeof v) < 0 && errno != EAGAIN)
+                break;
+        }
+        if (p[0].revents & POLLIN)
+            read_edges(g, efd);
+    }
+    if (g->have_strobe)
+        set_strobe(g, 0);
+    return NULL;
+}
+
+static void wake(struct gpio_trig *g)
+{
+    uint64_t one = 1;
+    if (write(g->wake_fd, &one, sizeof one) < 0 && errno != EAGAIN)
+        fprintf(stderr, "navcam: gpio trigger: eventfd: %s\n", strerror(errno));
+}
+
+static int gpio_start(void *priv)
+{
+    struct gpio_trig *g = priv;
+    int err = pthread_create(&g->thread, NULL, gpio_thread, g);
+    if (err)
+        return nc_error(-err, "gpio trigger: cannot start its thread: %s", strerror(err));
+    g->running = 1;
+    return 0;
+}
+
+static void gpio_stop(void *priv)
+{
+    struct gpio_trig *g = priv;
+    if (!g->running)
+        return;
+    atomic_store(&g->stop, 1);
+    wake(g);
+    pthread_join(g->thread, NULL);
+    g->running = 0;
+}
+
+/* "exposure": a struct nc_trigger_window to drive the strobe for. */
+static int gpio_control(void *priv, const char *request, void *arg)
+{
+    struct gpio_trig *g = priv;
+    if (strcmp(request, "exposure") || !g->have_strobe)
+        return NC_EUNSUPPORTED;
+    const struct nc_trigger_window *w = arg;
+    pthread_mutex_lock(&g->lock);
+    if (g->wcount == MAX_WINDOWS) { /* a storm: stretch the newest window */
+        struct nc_trigger_window *last = &g->win[(g->whead + g->wcount - 1) % MAX_WINDOWS];
+        if (w->end_mono_ns > last->end_mono_ns)
+            last->end_mono_ns = w->end_mono_ns;
+    } else {
+        int k = (g->whead + g->wcount++) % MAX_WINDOWS;
+        g->win[k] = *w;
+        g->wseen[k] = 0;
+    }
+    pthread_mutex_unlock(&g->lock);
+    wake(g);
+    return 0;
+}
+
+static void gpio_close(void *priv)
+{
+    struct gpio_trig *g = priv;
+    gpio_stop(g);
+    if (g->have_strobe && (g->strobe_missed || g->read_errors))
+        fprintf(stderr, "navcam: gpio trigger: %lu strobes, %lu exposure windows passed before the strobe could be "
+                        "driven, %lu event read errors\n", g->strobes, g->strobe_missed, g->read_errors);
+    struct gpiod_chip *shared = g->in.line ? gpiod_line_get_chip(g->in.line) : NULL;
+    release_line(&g->strobe, shared);
+    release_line(&g->in, NULL);
+    if (g->wake_fd >= 0) {
+        close(g->wake_fd);
+        pthread_mutex_destroy(&g->lock);
+    }
+}
+
+const struct nc_trigger_driver nc_trigger_gpio = {
+    .name = "gpio",
+    .description = "a GPIO line through libgpiod (kernel edge timestamps): line, chip, bias, "
+                   "strobe {line, chip, active: high|low}",
+    .caps = NC_TRIGGER_CAP_LINE,
+    .priv_size = sizeof(struct gpio_trig),
+    .open = gpio_open,
+    .start = gpio_start,
+    .stop = gpio_stop,
+    .control = gpio_control,
+    .close = gpio_close,
+};
