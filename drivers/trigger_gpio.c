@@ -155,8 +155,11 @@ static int open_lines(struct gpio_trig *g, struct nc_cfg_node *opts)
     if (g->wake_fd < 0)
         return nc_error(-errno, "gpio trigger: eventfd: %s", strerror(errno));
     pthread_mutex_init(&g->lock, NULL);
-    fprintf(stderr, "navcam: gpio trigger on %s%s%s (active %s)\n", g->in.desc, g->have_strobe ? ", strobe on " : "",
-            g->have_strobe ? g->strobe.desc : "", g->strobe_active_low ? "low" : "high");
+    if (g->have_strobe)
+        fprintf(stderr, "navcam: gpio trigger on %s, strobe on %s (active %s)\n", g->in.desc, g->strobe.desc,
+                g->strobe_active_low ? "low" : "high");
+    else
+        fprintf(stderr, "navcam: gpio trigger on %s\n", g->in.desc);
     return 0;
 }
 

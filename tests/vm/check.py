@@ -80,7 +80,7 @@ caps = csv_rows(os.path.join(out, "a/capture.csv"))
 check(len(edges) == n_edges, f"A: {len(edges)} edges driven")
 check(len(recs) == n_edges, f"A: {n_edges} edges -> {len(recs)} frames in the file output")
 check(len(caps) == n_edges, f"A: {n_edges} edges -> {len(caps)} frames at the V4L2 reader")
-same = 0
+same, w, h = 0, 0, 0
 for i, r in enumerate(recs[:len(caps)]):
     w, h, dn = fits_dn(os.path.join(out, "a/files/frame_%06d.fits" % r["frame"]))
     with open(os.path.join(out, "a/cap_%06d.raw" % i), "rb") as f:

@@ -80,7 +80,12 @@ for _ in $(seq 600); do [[ -f a/ready ]] && break; sleep 0.05; done
 "$helpers/gpio_sim" watch "$sim/sim_gpio1/value" a/strobe.csv a/stop-watch &
 watch_pid=$!
 sleep 0.3
-"$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" "$edges" 400 a/edges.csv
+# Edges are driven from CPU 0 only: gpio-sim raises them through irq_work on
+# the writing CPU, and handle_simple_irq drops an interrupt that arrives
+# while the same one is still being handled on another CPU - which happens
+# when the host stalls one TCG vCPU mid-handler (both edges of one pulse were
+# lost that way once in six runs). One CPU serialises the handlers.
+taskset -c 0 "$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" "$edges" 400 a/edges.csv
 wait "$cap_pid" || { echo "capture failed"; cat a/capture.log a/serve.log; exit 1; }
 sleep 0.2
 touch a/stop-watch
@@ -97,7 +102,7 @@ start_serve b --set "serve.trigger=$trig" --set serve.queue_frames=2 --set serve
 "$navcam" replay b/traj.csv --port 5760 >b/replay.log 2>&1 &
 replay_pid=$!
 grep VmRSS /proc/$serve_pid/status >b/rss_before
-"$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" 20000 0 b/edges.csv
+taskset -c 0 "$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" 20000 0 b/edges.csv
 grep VmRSS /proc/$serve_pid/status >b/rss_after
 wait "$replay_pid"
 sleep 0.5
