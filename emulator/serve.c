@@ -817,7 +817,8 @@ static void *output_thread(void *arg)
          * frame handed to the outputs. */
         int64_t handed = nc_mono_ns();
         for (int i = 0; i < e->nout; i++) {
-            if (nc_output_submit(&e->out[i], &sl->rec) >= 0)
+            int orc = nc_output_submit(&e->out[i], &sl->rec);
+            if (orc >= 0 || orc == -EAGAIN) /* busy (no free buffer): counted, not logged */
                 continue;
             /* One output failing (a device gone) must not flood the log:
              * at most one message a second per output. */

@@ -105,13 +105,20 @@ check(all(r["exposure_start_mono_ns"] == r["trigger_mono_ns"] for r in recs), "A
 strobe = csv_rows(os.path.join(out, "a/strobe.csv"))
 
 
-def level_at(t):
-    v = strobe[0][1]
-    for ts, val in strobe:
+def level_at(samples, t):
+    v = samples[0][1]
+    for ts, val in samples:
         if ts > t:
             break
         v = val
     return v
+
+
+def active_in(samples, start, end, level):
+    """Whether the line was at `level` at some time in [start, end]."""
+    if level_at(samples, start) == level:
+        return True
+    return any(start <= ts <= end and val == level for ts, val in samples)
 
 
 rises = [t for t, v in strobe[1:] if v == 1]
@@ -127,7 +134,7 @@ if len(rises) == len(recs) and len(falls) == len(recs):
     check(all(-0.5 <= e <= 50 for e in on_err + off_err),
           "A: strobe edges follow the exposure window: on %.2f..%.2f ms, off %.2f..%.2f ms after it"
           % (min(on_err), max(on_err), min(off_err), max(off_err)))
-check(all(level_at((r["exposure_start_mono_ns"] + r["exposure_end_mono_ns"]) // 2) == 1 for r in recs),
+check(all(level_at(strobe, (r["exposure_start_mono_ns"] + r["exposure_end_mono_ns"]) // 2) == 1 for r in recs),
       "A: strobe high at mid-exposure of every frame")
 sa = stats("a")
 check(sa["trigger"]["accepted"] == n_edges and sa["trigger"]["edges"] == 2 * n_edges,
@@ -175,6 +182,14 @@ log = open(os.path.join(out, "c/serve.log")).read()
 check("(card 'vivid') failed:" in log and "No such device" in log, "C: the failure is reported by device and cause")
 check("reopened after" in log, "C: the output found the device again and resumed")
 check(v4l2["submitted"] > 0, f"C: {v4l2['submitted']} frames written to the V4L2 device")
+# The strobe, active low, in free-run: the line is requested high (inactive)
+# and goes low during every exposure (seen within 20 ms of its end).
+cstrobe = csv_rows(os.path.join(out, "c/strobe.csv"))
+crecs = records(os.path.join(out, "c/files/frames.jsonl"))
+first = crecs[0]["exposure_start_mono_ns"] if crecs else 0
+check(level_at(cstrobe, first - 1) == 1, "C: strobe (active low) inactive-high before the first exposure")
+seen = sum(active_in(cstrobe, r["exposure_start_mono_ns"], r["exposure_end_mono_ns"] + 20000000, 0) for r in crecs)
+check(seen == len(crecs) and seen > 0, f"C: strobe low during {seen} of {len(crecs)} free-run exposures")
 
 print(f"{len(failures)} checks failed" if failures else "all checks passed")
 if lat:

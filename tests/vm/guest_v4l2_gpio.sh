@@ -121,8 +121,13 @@ for v in /sys/class/video4linux/video*; do
     [[ $(cat "$v/name") == vivid* ]] && vout=/dev/$(basename "$v")
 done
 echo "vivid output: $vout"
+# Meanwhile the strobe, active low this time, follows the free-run exposures
+# (the gpio line is configured but not the trigger source).
+"$helpers/gpio_sim" watch "$sim/sim_gpio1/value" c/strobe.csv c/stop-watch &
+watch_pid=$!
 start_serve c --set serve.mode=freerun --set serve.frame_rate_hz=10 --set sensor.adc_bits=12 \
     --set serve.udp_port=5770 --set serve.tcp_port=5771 \
+    --set "serve.trigger={driver: gpio, chip: $chip, line: TRIG, strobe: {line: STROBE, active: low}}" \
     --set "outputs=[{driver: v4l2, device: $vout, reopen_interval_s: 0.5}, {driver: file, directory: files, pattern: frame_%06llu.fits}]"
 sleep 3
 v4l2-ctl -d "$vout" --set-ctrl disconnect=1 || true
@@ -132,6 +137,8 @@ for _ in $(seq 50); do rmmod vivid 2>/dev/null && break; sleep 0.1; done
 modprobe -d $mods vivid n_devs=1 node_types=0x100 num_outputs=1 output_types=1
 sleep 3
 stop_serve c
+touch c/stop-watch
+wait "$watch_pid"
 
 step "checks"
 python3 "$src/tests/vm/check.py" "$out" "$edges"
