@@ -16,7 +16,8 @@
 #
 # Facts this relies on: ../shared/notes/kernel-drivers-in-qemu.md.
 # Cache: $NAVCAM_VM_CACHE (default /var/cache/navcam-vm), one directory per
-# kernel version; delete it to rebuild.
+# kernel version and version of this script (a changed module list or recipe
+# rebuilds); delete it to rebuild.
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -78,14 +79,14 @@ build_gpio_sim() {
 prepare() {
     local kver cache work
     kver=$(kernel_version)
-    cache=$cache_root/$kver
+    cache=$cache_root/$kver-$(sha256sum "$here/vm.sh" | cut -c1-12)
     if [[ -f $cache/ready ]]; then
         echo "$cache"
         return
     fi
     local dkms_ko=/lib/modules/$kver/updates/dkms/v4l2loopback.ko
     [[ -f $dkms_ko ]] || die "$dkms_ko missing: dkms did not build v4l2loopback for $kver (is v4l2loopback-dkms installed?)"
-    rm -rf "$cache"
+    rm -rf "$cache_root/$kver" "$cache_root/$kver"-* # guests of older versions of this script
     mkdir -p "$cache"
     work=$(mktemp -d)
     trap 'rm -rf "$work"' RETURN
