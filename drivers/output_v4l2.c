@@ -337,25 +337,27 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     return 0;
 }
 
-static void pack(struct v4l2_out *v, const uint16_t *dn)
+/* The frame in the device's pixel format, into dst (v->size bytes). */
+static void pack(const struct v4l2_out *v, const uint16_t *dn, unsigned char *dst)
 {
     size_t n = (size_t)v->width * (size_t)v->height;
     if (v->fourcc == V4L2_PIX_FMT_GREY) {
         for (size_t i = 0; i < n; i++)
-            v->buf[i] = (unsigned char)(dn[i] > 255 ? 255 : dn[i]);
+            dst[i] = (unsigned char)(dn[i] > 255 ? 255 : dn[i]);
         return;
     }
     int shift = v->msb ? 16 - v->bits : 0;
     for (size_t i = 0; i < n; i++) {
         unsigned x = (unsigned)dn[i] << shift;
-        v->buf[2 * i] = (unsigned char)(x & 0xff);
-        v->buf[2 * i + 1] = (unsigned char)((x >> 8) & 0xff);
+        dst[2 * i] = (unsigned char)(x & 0xff);
+        dst[2 * i + 1] = (unsigned char)((x >> 8) & 0xff);
     }
 }
 
 /* One frame through write(): 0, -EAGAIN (no free buffer) or a failure. */
-static int put_write(struct v4l2_out *v)
+static int put_write(struct v4l2_out *v, const uint16_t *dn)
 {
+    pack(v, dn, v->buf);
     ssize_t n = write(v->fd, v->buf, v->size);
     if (n == (ssize_t)v->size)
         return 0;
@@ -368,7 +370,7 @@ static int put_write(struct v4l2_out *v)
 
 /* One frame through streaming I/O: take back the buffers the driver is
  * done with, fill a free one, queue it. */
-static int put_mmap(struct v4l2_out *v)
+static int put_mmap(struct v4l2_out *v, const uint16_t *dn)
 {
     for (;;) {
         struct v4l2_buffer b = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP};
@@ -385,7 +387,7 @@ static int put_mmap(struct v4l2_out *v)
         k++;
     if (k == v->nmbuf)
         return -EAGAIN;
-    memcpy(v->mbuf[k].mem, v->buf, v->size);
+    pack(v, dn, v->mbuf[k].mem); /* straight into the driver's buffer */
     struct v4l2_buffer b = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP, .index = k,
                             .bytesused = (uint32_t)v->size, .field = V4L2_FIELD_NONE};
     if (xioctl(v->fd, VIDIOC_QBUF, &b) < 0)
@@ -414,8 +416,7 @@ static int v4l2_submit(void *priv, const struct nc_frame_record *r)
                 v->lost);
         v->tries = 0;
     }
-    pack(v, r->dn);
-    int rc = v->io == IO_MMAP ? put_mmap(v) : put_write(v);
+    int rc = v->io == IO_MMAP ? put_mmap(v, r->dn) : put_write(v, r->dn);
     if (rc == 0) {
         v->written++;
         return 0;

