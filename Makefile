@@ -5,7 +5,7 @@ TESTBUILD ?= build-test
 JOBS    ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build demo test bench clean
+.PHONY: all deps build demo test bench docs clean
 
 all: build
 
@@ -33,6 +33,7 @@ test:
 	cd $(TESTBUILD) && ctest --output-on-failure -j $(JOBS) --timeout 600
 
 bench: build
+	bench/startup.sh $(BUILD)
 	$(BUILD)/bench_render
 	$(BUILD)/bench_brdf
 	$(BUILD)/bench_sensor
@@ -41,6 +42,11 @@ bench: build
 	@if command -v qemu-system-x86_64 >/dev/null && [ -x $(BUILD)/tests/v4l2_capture ]; then \
 	  bench/bench_edge_to_frame.sh $(BUILD); \
 	else echo "bench_edge_to_frame: needs the qemu guest of tests/vm (scripts/install-deps.sh --test)"; fi
+
+# Generated documentation: the drivers' option tables (tests/app/test_cli.sh
+# checks that docs/drivers.md matches).
+docs: build
+	$(BUILD)/navcam serve --driver-docs > docs/drivers.md
 
 clean:
 	rm -rf $(BUILD) $(TESTBUILD) $(TESTBUILD)-asan out

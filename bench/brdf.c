@@ -14,11 +14,12 @@
 #include <unistd.h>
 
 #include "bench_util.h"
-#include "error.h"
-#include "material.h"
-#include "render.h"
-#include "camsys.h"
-#include "scene.h"
+#include "core/error.h"
+#include "render/material.h"
+#include "render/render.h"
+#include "camera/camsys.h"
+#include "camera/load.h"
+#include "render/scene.h"
 
 struct setup {
     struct nc_scene s;

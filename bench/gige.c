@@ -25,10 +25,11 @@
 #include <unistd.h>
 
 #include "bench_util.h"
-#include "config.h"
-#include "error.h"
-#include "output.h"
-#include "serve.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "emulator/output.h"
+#include "drivers/registry.h"
+#include "emulator/serve.h"
 
 #define W 1024
 #define H 1024
@@ -171,8 +172,11 @@ int main(int argc, char **argv)
     char yaml[200];
     snprintf(yaml, sizeof yaml, "{driver: gige, pixel_format: Mono16, metadata_row: 1, trigger_poll_hz: %g}", poll_hz);
     int rc = nc_cfg_load_string(&cfg, yaml, "bench");
+    const struct nc_output_driver *drv = nc_registry_output(&nc_drivers, "gige");
+    if (rc >= 0 && !drv)
+        rc = nc_error(NC_EUNSUPPORTED, "this build has no gige driver");
     if (rc >= 0)
-        rc = nc_output_open(&out, cfg.root, &ctx);
+        rc = nc_output_open(&out, drv, cfg.root, &ctx);
     if (rc < 0) {
         fprintf(stderr, "bench_gige: %s\n", nc_errmsg());
         return 1;
@@ -188,7 +192,10 @@ int main(int argc, char **argv)
     }
     atomic_store(&feeding, 1);
     pthread_t ft;
-    pthread_create(&ft, NULL, feeder, &fd);
+    if (pthread_create(&ft, NULL, feeder, &fd) != 0) {
+        fprintf(stderr, "bench_gige: cannot start the feeder thread\n");
+        return 1;
+    }
     struct result pre = {0}, ren = {0};
     struct rusage u0, u1;
     getrusage(RUSAGE_SELF, &u0);
@@ -211,10 +218,13 @@ int main(int argc, char **argv)
     static const char *const sets[] = {"outputs=[{driver: gige, pixel_format: Mono16, metadata_row: 1}]",
                                        "render.samples_per_pixel=1", "serve.mode=freerun", "serve.frame_rate_hz=30",
                                        "serve.stats_interval_s=0", "serve.udp_port=0", "serve.tcp_port=0"};
-    serve_opt = (struct nc_serve_options){.sets = sets, .nsets = 7, .max_seconds = seconds + 4};
+    serve_opt = (struct nc_serve_options){.sets = sets, .nsets = 7, .max_seconds = seconds + 4, .drivers = &nc_drivers};
     int serve_rc = 0;
     pthread_t st;
-    pthread_create(&st, NULL, serve_thread, &serve_rc);
+    if (pthread_create(&st, NULL, serve_thread, &serve_rc) != 0) {
+        fprintf(stderr, "bench_gige: cannot start the emulator thread\n");
+        return 1;
+    }
     cam = open_camera(packet);
     if (cam) {
         receive(cam, seconds, 0, &ren);

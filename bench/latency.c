@@ -21,9 +21,10 @@
 #include <unistd.h>
 
 #include "bench_util.h"
-#include "error.h"
+#include "core/error.h"
 #include "navcam/client.h"
-#include "serve.h"
+#include "drivers/registry.h"
+#include "emulator/serve.h"
 
 #define MAX_SETS 32
 
@@ -73,9 +74,13 @@ static int run_once(const char *const *user_sets, int nuser, int frames, double 
     for (int i = 0; i < nuser && n < MAX_SETS; i++)
         r.sets[n++] = user_sets[i];
     snprintf(r.json_path, sizeof r.json_path, "/tmp/navcam_bench_latency_%d.json", (int)getpid());
-    r.opt = (struct nc_serve_options){.sets = r.sets, .nsets = n, .max_frames = frames, .stats_json_path = r.json_path};
+    r.opt = (struct nc_serve_options){.sets = r.sets, .nsets = n, .max_frames = frames, .stats_json_path = r.json_path,
+                                      .drivers = &nc_drivers};
     pthread_t t;
-    pthread_create(&t, NULL, serve_thread, &r);
+    if (pthread_create(&t, NULL, serve_thread, &r) != 0) {
+        fprintf(stderr, "bench_latency: cannot start the emulator thread\n");
+        return -1;
+    }
     struct nc_client *c = NULL;
     for (int i = 0; i < 400 && nc_client_connect("127.0.0.1", port, 1, &c) < 0; i++)
         usleep(25000); /* the scene loads first */

@@ -15,11 +15,12 @@
 #include <unistd.h>
 
 #include "bench_util.h"
-#include "error.h"
-#include "render.h"
-#include "rt.h"
-#include "camsys.h"
-#include "scene.h"
+#include "core/error.h"
+#include "render/render.h"
+#include "render/rt.h"
+#include "camera/camsys.h"
+#include "camera/load.h"
+#include "render/scene.h"
 
 struct recorder {
     struct nc_ray16 *cam, *shadow;

@@ -10,9 +10,10 @@
 #include <string.h>
 #include <time.h>
 
-#include "camsys.h"
+#include "camera/camsys.h"
+#include "camera/load.h"
 #include "bench_util.h"
-#include "error.h"
+#include "core/error.h"
 
 int main(int argc, char **argv)
 {

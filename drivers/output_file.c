@@ -1,17 +1,15 @@
 /* output_file.c - the file output: numbered DN image files through
  * OpenImageIO/cfitsio (image_io.h) and a JSON-lines sidecar with every
- * frame's metadata. Options: directory (default "out"), pattern (a printf
- * pattern for the frame number, default "frame_%06llu.png"), sidecar (default
- * "frames.jsonl"; empty for none). */
+ * frame's metadata (options: file_params below). */
 #include <errno.h>
 #include <libgen.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 
-#include "error.h"
-#include "image_io.h"
-#include "output.h"
+#include "core/error.h"
+#include "render/image_io.h"
+#include "emulator/output.h"
 
 struct file_out {
     char dir[2048];
@@ -20,18 +18,23 @@ struct file_out {
     char sidecar_path[2300];
 };
 
+static const struct nc_param file_params[] = {
+    NC_P_STRING("directory", "out", "where the files go (made if missing)"),
+    NC_P_STRING("pattern", "frame_%06llu.png", "file name with one %llu-style conversion for the frame number; the extension picks the format "
+     "(.png, .tif, .fits, .exr)"),
+    NC_P_STRING_OR_EMPTY("sidecar", "frames.jsonl", "JSON-lines file with every frame's metadata, in the directory (empty: none)"),
+    NC_P_END,
+};
+
 static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
 {
     struct file_out *f = priv;
-    const char *dir = "out", *pattern = "frame_%06llu.png", *sidecar = "frames.jsonl";
+    const char *dir = NULL, *pattern = NULL, *sidecar = NULL;
     int rc;
-    if ((rc = nc_cfg_string(opts, "directory", &dir)) < 0 || (rc = nc_cfg_string(opts, "pattern", &pattern)) < 0)
+    if ((rc = nc_param_string(opts, file_params, "directory", &dir)) < 0 ||
+        (rc = nc_param_string(opts, file_params, "pattern", &pattern)) < 0 ||
+        (rc = nc_param_string(opts, file_params, "sidecar", &sidecar)) < 0)
         return rc;
-    struct nc_cfg_node *sc = nc_cfg_get(opts, "sidecar");
-    if (sc && sc->kind == NC_CFG_SCALAR)
-        sidecar = sc->value;
-    else if (sc)
-        return nc_cfg_error(sc, "expected a file name (or empty for no sidecar)");
     /* The pattern must format exactly one unsigned long long. */
     const char *pc = strchr(pattern, '%');
     if (!pc || strstr(pc + 1, "%") || !strstr(pc, "llu") || strchr(pattern, '/'))
@@ -101,6 +104,7 @@ const struct nc_output_driver nc_output_file = {
     .description = "numbered image files and a JSON-lines sidecar",
     .caps = NC_OUTPUT_CAP_DN16,
     .priv_size = sizeof(struct file_out),
+    .params = file_params,
     .open = file_open,
     .submit = file_submit,
     .control = file_control,

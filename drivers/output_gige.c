@@ -20,24 +20,23 @@
 #include <arpa/inet.h>
 #include <arv.h>
 #include <errno.h>
-#include <ifaddrs.h>
 #include <math.h>
 #include <net/if.h>
-#include <netinet/in.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 #include <zlib.h>
 
-#include "error.h"
-#include "navcam_genicam_xml.h"
-#include "output.h"
-#include "version.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "drivers/gige/gige_check.h"
+#include "drivers/navcam_genicam_xml.h"
+#include "emulator/output.h"
+#include "core/version.h"
 
 /* NavCam's application registers (see the XML's header comment). */
 enum {
@@ -169,7 +168,7 @@ static void *poll_thread(void *arg)
         }
         /* Refused (lock-step, out of range): show the client what holds. */
         if (g->rejected_settings++ == 0)
-            fprintf(stderr, "navcam serve: gige: a client's setting was refused: %s\n", nc_errmsg());
+            nc_log_warn("output/gige", "a client's setting was refused: %s", nc_errmsg());
         g->ctl->get(g->ctl->emu, &want);
         publish(g, &want);
     }
@@ -296,74 +295,37 @@ static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gai
 
 static void gige_close(void *priv);
 
-/* The interface's IPv4 address, and whether the GigE Vision control port is
- * free there (Aravis does not report a taken port: its device just goes
- * deaf). */
-static int check_interface(struct gige *g, struct nc_cfg_node *opts)
-{
-    struct ifaddrs *ifa = NULL;
-    if (if_nametoindex(g->iface) == 0)
-        return nc_cfg_error(nc_cfg_get(opts, "interface") ? nc_cfg_get(opts, "interface") : opts,
-                            "gige: network interface '%s' not found", g->iface);
-    if (getifaddrs(&ifa) < 0)
-        return nc_error(-errno, "gige: getifaddrs: %s", strerror(errno));
-    struct sockaddr_in sa = {0};
-    for (struct ifaddrs *i = ifa; i; i = i->ifa_next)
-        if (i->ifa_addr && i->ifa_addr->sa_family == AF_INET && !strcmp(i->ifa_name, g->iface)) {
-            sa = *(struct sockaddr_in *)i->ifa_addr;
-            break;
-        }
-    freeifaddrs(ifa);
-    if (sa.sin_family != AF_INET)
-        return nc_error(NC_ECONFIG, "gige: interface '%s' has no IPv4 address", g->iface);
-    inet_ntop(AF_INET, &sa.sin_addr, g->addr, sizeof g->addr);
-    int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    sa.sin_port = htons(3956);
-    int rc = 0;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&sa, sizeof sa) < 0)
-        rc = nc_error(errno == EADDRINUSE ? NC_ECONFIG : -errno,
-                      "gige: UDP port 3956 (GigE Vision control) on %s (%s) is %s", g->addr, g->iface,
-                      errno == EADDRINUSE ? "already in use: another GigE Vision device (or navcam serve) runs there"
-                                          : strerror(errno));
-    if (fd >= 0)
-        close(fd);
-    return rc;
-}
+static const char *const formats[] = {"Mono8", "Mono12", "Mono16", NULL};
 
-/* A GenICam description must parse and name the features NavCam serves. */
-static int check_xml(const char *what, const void *xml, size_t len)
-{
-    static const char *const need[] = {"Width", "Height", "OffsetX", "OffsetY", "PixelFormat", "PayloadSize",
-                                       "ExposureTime", "Gain", "AcquisitionStart", "AcquisitionStop", "TriggerMode",
-                                       "TriggerSource", "TriggerSoftware", "AcquisitionFrameRate", NULL};
-    ArvGc *gc = arv_gc_new(NULL, xml, len);
-    int rc = 0;
-    for (int i = 0; need[i] && rc == 0; i++)
-        if (!gc || !arv_gc_get_node(gc, need[i]))
-            rc = nc_error(NC_ECONFIG, "gige: GenICam XML %s is invalid: it %s feature '%s' NavCam serves", what,
-                          gc ? "does not parse (messages above) or lacks the" : "does not parse, so it lacks the",
-                          need[i]);
-    if (gc)
-        g_object_unref(gc);
-    return rc;
-}
+static const struct nc_param gige_params[] = {
+    NC_P_STRING("interface", "lo", "network interface the camera lives on (its IPv4 address)"),
+    NC_P_STRING("serial", "NAVCAM0001", "serial number, 1 to 15 characters"),
+    NC_P_STRING("model", "NavCam emulator", "model name the device reports"),
+    NC_P_STRING("xml", NULL, "a GenICam description file to serve instead of NavCam's own (relative to the config file)"),
+    NC_P_ENUM("pixel_format", "Mono16", formats, "initial pixel format (clients may change it)"),
+    NC_P_DOUBLE("trigger_poll_hz", "200", 1, 1000, "Hz", "how often the device looks for a finished frame"),
+    NC_P_DOUBLE("poll_hz", "1000", 1, 10000, "Hz", "how often client-written settings are read"),
+    NC_P_INT("packet_size", NULL, 576, 65000, "bytes", "GVSP packet size (default 8192 on lo, 1400 elsewhere)"),
+    NC_P_INT("metadata_row", "0", 0, 1, "", "1: append a row with the frame's metadata"),
+    NC_P_END,
+};
 
 static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
 {
     struct gige *g = priv;
-    static const char *const formats[] = {"Mono8", "Mono12", "Mono16", NULL};
-    const char *iface = "lo", *serial = "NAVCAM0001", *model = "NavCam emulator", *xml = NULL;
-    double trig_hz = 200;
+    const char *iface = NULL, *serial = NULL, *model = NULL, *xml = NULL;
+    double trig_hz = 0;
     long packet = -1, meta = 0;
-    int fmt = 2, rc;
-    g->poll_hz = 1000;
-    if ((rc = nc_cfg_string(opts, "interface", &iface)) < 0 || (rc = nc_cfg_string(opts, "serial", &serial)) < 0 ||
-        (rc = nc_cfg_string(opts, "model", &model)) < 0 || (rc = nc_cfg_string(opts, "xml", &xml)) < 0 ||
-        (rc = nc_cfg_enum(opts, "pixel_format", formats, &fmt)) < 0 ||
-        (rc = nc_cfg_double(opts, "trigger_poll_hz", 1, 1000, &trig_hz)) < 0 ||
-        (rc = nc_cfg_double(opts, "poll_hz", 1, 10000, &g->poll_hz)) < 0 ||
-        (rc = nc_cfg_int(opts, "packet_size", 576, 65000, &packet)) < 0 ||
-        (rc = nc_cfg_int(opts, "metadata_row", 0, 1, &meta)) < 0)
+    int fmt = 0, rc;
+    if ((rc = nc_param_string(opts, gige_params, "interface", &iface)) < 0 ||
+        (rc = nc_param_string(opts, gige_params, "serial", &serial)) < 0 ||
+        (rc = nc_param_string(opts, gige_params, "model", &model)) < 0 ||
+        (rc = nc_param_string(opts, gige_params, "xml", &xml)) < 0 ||
+        (rc = nc_param_enum(opts, gige_params, "pixel_format", &fmt)) < 0 ||
+        (rc = nc_param_double(opts, gige_params, "trigger_poll_hz", &trig_hz)) < 0 ||
+        (rc = nc_param_double(opts, gige_params, "poll_hz", &g->poll_hz)) < 0 ||
+        (rc = nc_param_int(opts, gige_params, "packet_size", &packet)) < 0 ||
+        (rc = nc_param_int(opts, gige_params, "metadata_row", &meta)) < 0)
         return rc;
     if (strlen(serial) == 0 || strlen(serial) > 15)
         return nc_cfg_error(nc_cfg_get(opts, "serial"), "expected 1 to 15 characters");
@@ -392,12 +354,12 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
             g_clear_error(&err);
             return rc;
         }
-        rc = check_xml(path, xml_text, xml_len);
+        rc = nc__gige_check_xml(path, xml_text, xml_len);
         g_free(xml_text);
         if (rc < 0)
             return rc;
     } else {
-        if ((rc = check_xml("(built in)", navcam_genicam_xml, sizeof navcam_genicam_xml)) < 0)
+        if ((rc = nc__gige_check_xml("(built in)", navcam_genicam_xml, sizeof navcam_genicam_xml)) < 0)
             return rc;
         /* The device reads its description from a file. */
         snprintf(path, sizeof path, "%s/navcam-genicam-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -411,7 +373,7 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
             return nc_error(-EIO, "gige: cannot write %s", path);
         }
     }
-    if ((rc = check_interface(g, opts)) < 0) {
+    if ((rc = nc__gige_check_interface(g->iface, nc_cfg_get(opts, "interface") ? nc_cfg_get(opts, "interface") : opts, g->addr, sizeof g->addr)) < 0) {
         if (!xml)
             unlink(path);
         return rc;
@@ -462,8 +424,8 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         return nc_error(-err, "gige: cannot start the poll thread: %s", strerror(err));
     }
     g->running = 1;
-    fprintf(stderr, "navcam serve: gige: GigE Vision camera '%s' (serial %s) on %s (%s), %dx%d %s; open it by address, "
-                    "e.g. arv-tool-0.8 -a %s features\n",
+    nc_log_info("output/gige", "GigE Vision camera '%s' (serial %s) on %s (%s), %dx%d %s; open it by address, "
+                "e.g. arv-tool-0.8 -a %s features",
             model, serial, g->addr, g->iface, g->W, g->H, formats[fmt], g->addr);
     return 0;
 }
@@ -490,8 +452,8 @@ static void gige_close(void *priv)
     if (g->running) {
         atomic_store(&g->stop, 1);
         pthread_join(g->thread, NULL);
-        fprintf(stderr, "navcam serve: gige: %llu frames handed over, %lu sent (%lu again, %lu replaced by newer "
-                        "before the device sent them, %lu blank before the first frame), %lu client settings refused\n",
+        nc_log_info("output/gige", "%llu frames handed over, %lu sent (%lu again, %lu replaced by newer "
+                    "before the device sent them, %lu blank before the first frame), %lu client settings refused",
                 (unsigned long long)g->submitted, g->sent, g->resent, g->skipped, g->empty, g->rejected_settings);
     }
     if (g->gv)
@@ -506,6 +468,7 @@ const struct nc_output_driver nc_output_gige = {
     .description = "a GigE Vision camera (GenICam, Aravis) on a network interface (default lo)",
     .caps = NC_OUTPUT_CAP_DN16,
     .priv_size = sizeof(struct gige),
+    .params = gige_params,
     .open = gige_open,
     .submit = gige_submit,
     .close = gige_close,

@@ -34,8 +34,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "error.h"
-#include "output.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "emulator/output.h"
 
 #define MAX_VIDEO_NODES 64
 #define MMAP_BUFFERS 4
@@ -249,8 +250,10 @@ static int setup(struct v4l2_out *v)
     if (v->io == IO_MMAP) {
         struct v4l2_requestbuffers rb = {.count = MMAP_BUFFERS, .type = V4L2_BUF_TYPE_VIDEO_OUTPUT,
                                          .memory = V4L2_MEMORY_MMAP};
-        if (xioctl(v->fd, VIDIOC_REQBUFS, &rb) < 0 || rb.count < 1)
+        if (xioctl(v->fd, VIDIOC_REQBUFS, &rb) < 0)
             return fail_setup(v, -errno, "VIDIOC_REQBUFS: %s", strerror(errno));
+        if (rb.count < 1) /* success with no buffers: errno says nothing here */
+            return fail_setup(v, NC_EUNSUPPORTED, "VIDIOC_REQBUFS granted no buffers");
         for (unsigned i = 0; i < rb.count && i < MMAP_BUFFERS; i++) {
             struct v4l2_buffer b = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP, .index = i};
             if (xioctl(v->fd, VIDIOC_QUERYBUF, &b) < 0)
@@ -282,15 +285,28 @@ static int connect_device(struct v4l2_out *v)
     return rc;
 }
 
+static const char *const formats[] = {"auto", "GREY", "Y16", NULL};
+static const char *const aligns[] = {"msb", "lsb", NULL};
+static const char *const ios[] = {"auto", "write", "mmap", NULL};
+
+static const struct nc_param v4l2_params[] = {
+    NC_P_STRING("device", NULL, "device node, e.g. /dev/navcam0 (default: `card`, else the first output device)"),
+    NC_P_STRING("card", NULL, "the device's card label, e.g. NavCam (at most 31 characters)"),
+    NC_P_ENUM("format", "auto", formats, "GREY for ADCs up to 8 bits, else Y16 (auto)"),
+    NC_P_ENUM("y16_align", "msb", aligns, "where Y16 puts the ADC's bits in each 16-bit word"),
+    NC_P_ENUM("io", "auto", ios, "write() for v4l2loopback, mmap streaming elsewhere (auto)"),
+    NC_P_DOUBLE("frame_rate_hz", NULL, 1e-3, 1000, "Hz", "frame interval announced to readers (default serve.frame_rate_hz)"),
+    NC_P_DOUBLE("reopen_interval_s", "1", 0, 3600, "s", "how often a lost device is looked for again"),
+    NC_P_INT("reopen_limit", "0", 0, 1000000000, "", "give up after this many attempts (0: never)"),
+    NC_P_END,
+};
+
 static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
 {
     struct v4l2_out *v = priv;
-    static const char *const formats[] = {"auto", "GREY", "Y16", NULL};
-    static const char *const aligns[] = {"msb", "lsb", NULL};
-    static const char *const ios[] = {"auto", "write", "mmap", NULL};
     const char *device = NULL, *card = NULL;
     int fmt = 0, align = 0, io = 0, rc;
-    double reopen_s = 1;
+    double reopen_s = 0;
     long limit = 0;
     v->fd = -1;
     v->fps = 10;
@@ -299,11 +315,14 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         ctx->control->get(ctx->control->emu, &a);
         v->fps = a.frame_rate_hz;
     }
-    if ((rc = nc_cfg_string(opts, "device", &device)) < 0 || (rc = nc_cfg_string(opts, "card", &card)) < 0 ||
-        (rc = nc_cfg_enum(opts, "format", formats, &fmt)) < 0 || (rc = nc_cfg_enum(opts, "y16_align", aligns, &align)) < 0 || (rc = nc_cfg_enum(opts, "io", ios, &io)) < 0 ||
-        (rc = nc_cfg_double(opts, "frame_rate_hz", 1e-3, 1000, &v->fps)) < 0 ||
-        (rc = nc_cfg_double(opts, "reopen_interval_s", 0, 3600, &reopen_s)) < 0 ||
-        (rc = nc_cfg_int(opts, "reopen_limit", 0, 1000000000, &limit)) < 0)
+    if ((rc = nc_param_string(opts, v4l2_params, "device", &device)) < 0 ||
+        (rc = nc_param_string(opts, v4l2_params, "card", &card)) < 0 ||
+        (rc = nc_param_enum(opts, v4l2_params, "format", &fmt)) < 0 ||
+        (rc = nc_param_enum(opts, v4l2_params, "y16_align", &align)) < 0 ||
+        (rc = nc_param_enum(opts, v4l2_params, "io", &io)) < 0 ||
+        (rc = nc_param_double(opts, v4l2_params, "frame_rate_hz", &v->fps)) < 0 ||
+        (rc = nc_param_double(opts, v4l2_params, "reopen_interval_s", &reopen_s)) < 0 ||
+        (rc = nc_param_int(opts, v4l2_params, "reopen_limit", &limit)) < 0)
         return rc;
     if (device && card)
         return nc_cfg_error(nc_cfg_get(opts, "card"), "give either `device` or `card`, not both");
@@ -331,7 +350,7 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     if ((rc = connect_device(v)) < 0)
         return rc;
     char fc[5];
-    fprintf(stderr, "navcam: v4l2 output on %s (card '%s', driver '%s'): %dx%d %s at %g Hz through %s\n", v->path,
+    nc_log_info("output/v4l2", "%s (card '%s', driver '%s'): %dx%d %s at %g Hz through %s", v->path,
             v->card, v->driver, v->width, v->height, fourcc_text(v->fourcc, fc), v->fps,
             v->io == IO_MMAP ? "mmap streaming" : "write()");
     return 0;
@@ -412,7 +431,7 @@ static int v4l2_submit(void *priv, const struct nc_frame_record *r)
             return nc_error(-ENODEV, "v4l2 output: reopening failed (attempt %ld): %s", v->tries, nc_errmsg());
         }
         v->reopened++;
-        fprintf(stderr, "navcam: v4l2 output: %s (card '%s') reopened after %lu lost frames\n", v->path, v->card,
+        nc_log_info("output/v4l2", "%s (card '%s') reopened after %lu lost frames", v->path, v->card,
                 v->lost);
         v->tries = 0;
     }
@@ -440,17 +459,17 @@ static void v4l2_close(void *priv)
     struct v4l2_out *v = priv;
     disconnect(v);
     if (v->lost || v->reopened)
-        fprintf(stderr, "navcam: v4l2 output: %lu frames written, %lu lost, %lu reopens\n", v->written, v->lost,
+        nc_log_info("output/v4l2", "%lu frames written, %lu lost, %lu reopens", v->written, v->lost,
                 v->reopened);
     free(v->buf);
 }
 
 const struct nc_output_driver nc_output_v4l2 = {
     .name = "v4l2",
-    .description = "a V4L2 video output device (v4l2loopback): device or card, format (auto, GREY, Y16), "
-                   "y16_align, io (auto, write, mmap), frame_rate_hz, reopen_interval_s, reopen_limit",
+    .description = "a V4L2 video output device (v4l2loopback, or any output device)",
     .caps = NC_OUTPUT_CAP_DN16,
     .priv_size = sizeof(struct v4l2_out),
+    .params = v4l2_params,
     .open = v4l2_open,
     .submit = v4l2_submit,
     .close = v4l2_close,

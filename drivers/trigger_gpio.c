@@ -13,12 +13,7 @@
  * driver's thread drives the line at the window's start and end (ppoll with
  * a nanosecond timeout, on the same thread that reads the edges).
  *
- * Options (the serve.trigger map):
- *   line     name or offset of the input line (required)
- *   chip     gpiochipN, /dev/gpiochipN, a chip label or a number; without it
- *            `line` must be a name, searched on every chip
- *   bias     as_is (default), disable, pull_up, pull_down
- *   strobe   {line: NAME|OFFSET, chip: (the trigger's chip), active: high|low}
+ * Options (the serve.trigger map): gpio_params below.
  */
 #include <errno.h>
 #include <gpiod.h>
@@ -32,8 +27,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "error.h"
-#include "trigger.h"
+#include "core/clock.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "emulator/trigger.h"
 
 #define CONSUMER "navcam"
 #define MAX_WINDOWS 64
@@ -69,13 +66,32 @@ static int all_digits(const char *s)
     return 1;
 }
 
-/* Find chip and line from the `line` and `chip` keys of opts; `shared` is a
- * chip already open that the line defaults to. */
-static int find_line(struct nc_cfg_node *opts, struct gpiod_chip *shared, struct gpio_line *out)
+static const char *const biases[] = {"as_is", "disable", "pull_up", "pull_down", NULL};
+static const char *const levels[] = {"high", "low", NULL};
+
+static const struct nc_param strobe_params[] = {
+    NC_P_STRING("line", NULL, "name or offset of the strobe output line (required)"),
+    NC_P_STRING("chip", NULL, "its chip (default: the trigger line's chip)"),
+    NC_P_ENUM("active", "high", levels, "the line's level during an exposure"),
+    NC_P_END,
+};
+
+static const struct nc_param gpio_params[] = {
+    NC_P_STRING("line", NULL, "name or offset of the trigger input line (required)"),
+    NC_P_STRING("chip", NULL, "gpiochipN, /dev/gpiochipN, a chip label or a number (without it `line` must be a name, searched on every chip)"),
+    NC_P_ENUM("bias", "as_is", biases, "the input's pull resistor"),
+    NC_P_MAP("strobe", strobe_params, "an output line active while the sensor exposes"),
+    NC_P_END,
+};
+
+/* Find chip and line from the `line` and `chip` keys of opts (whose table is
+ * params); `shared` is a chip already open that the line defaults to. */
+static int find_line(struct nc_cfg_node *opts, const struct nc_param *params, struct gpiod_chip *shared,
+                     struct gpio_line *out)
 {
     const char *name = NULL, *chip = NULL;
     int rc;
-    if ((rc = nc_cfg_string(opts, "line", &name)) < 0 || (rc = nc_cfg_string(opts, "chip", &chip)) < 0)
+    if ((rc = nc_param_string(opts, params, "line", &name)) < 0 || (rc = nc_param_string(opts, params, "chip", &chip)) < 0)
         return rc;
     if (!name)
         return nc_cfg_missing(opts, "line", "a GPIO line name or offset (gpioinfo lists them)");
@@ -126,24 +142,23 @@ static void release_line(struct gpio_line *l, struct gpiod_chip *shared)
 
 static int open_lines(struct gpio_trig *g, struct nc_cfg_node *opts)
 {
-    static const char *const biases[] = {"as_is", "disable", "pull_up", "pull_down", NULL};
     static const int bias_flags[] = {0, GPIOD_LINE_REQUEST_FLAG_BIAS_DISABLE, GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_UP,
                                      GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_DOWN};
     int bias = 0, rc;
     struct nc_cfg_node *st = NULL;
-    static const char *const levels[] = {"high", "low", NULL};
     int low = 0;
     /* All options first, then the hardware. */
-    if ((rc = nc_cfg_enum(opts, "bias", biases, &bias)) < 0 || (rc = nc_cfg_map(opts, "strobe", &st)) < 0 ||
-        (st && (rc = nc_cfg_enum(st, "active", levels, &low)) < 0))
+    if ((rc = nc_param_enum(opts, gpio_params, "bias", &bias)) < 0 ||
+        (rc = nc_param_map(opts, gpio_params, "strobe", &st)) < 0 ||
+        (st && (rc = nc_param_enum(st, strobe_params, "active", &low)) < 0))
         return rc;
-    if ((rc = find_line(opts, NULL, &g->in)) < 0)
+    if ((rc = find_line(opts, gpio_params, NULL, &g->in)) < 0)
         return rc;
     if (gpiod_line_request_both_edges_events_flags(g->in.line, CONSUMER, bias_flags[bias]) < 0)
         return nc_cfg_error(nc_cfg_get(opts, "line"), "cannot request GPIO %s for edge events: %s", g->in.desc,
                             strerror(errno));
     if (st) {
-        if ((rc = find_line(st, gpiod_line_get_chip(g->in.line), &g->strobe)) < 0)
+        if ((rc = find_line(st, strobe_params, gpiod_line_get_chip(g->in.line), &g->strobe)) < 0)
             return rc;
         g->strobe_active_low = low;
         if (gpiod_line_request_output(g->strobe.line, CONSUMER, low) < 0)
@@ -156,10 +171,10 @@ static int open_lines(struct gpio_trig *g, struct nc_cfg_node *opts)
         return nc_error(-errno, "gpio trigger: eventfd: %s", strerror(errno));
     pthread_mutex_init(&g->lock, NULL);
     if (g->have_strobe)
-        fprintf(stderr, "navcam: gpio trigger on %s, strobe on %s (active %s)\n", g->in.desc, g->strobe.desc,
-                g->strobe_active_low ? "low" : "high");
+        nc_log_info("trigger/gpio", "trigger on %s, strobe on %s (active %s)", g->in.desc, g->strobe.desc,
+                    g->strobe_active_low ? "low" : "high");
     else
-        fprintf(stderr, "navcam: gpio trigger on %s\n", g->in.desc);
+        nc_log_info("trigger/gpio", "trigger on %s", g->in.desc);
     return 0;
 }
 
@@ -181,7 +196,7 @@ static void set_strobe(struct gpio_trig *g, int on)
     if (on == g->strobe_on)
         return;
     if (gpiod_line_set_value(g->strobe.line, on ^ g->strobe_active_low) < 0) {
-        fprintf(stderr, "navcam: gpio trigger: strobe %s: %s\n", g->strobe.desc, strerror(errno));
+        nc_log_error("trigger/gpio", "strobe %s: %s", g->strobe.desc, strerror(errno));
         return;
     }
     g->strobe_on = on;
@@ -223,7 +238,7 @@ static void read_edges(struct gpio_trig *g, int fd)
     int n = gpiod_line_event_read_fd_multiple(fd, ev, 16);
     if (n < 0) {
         if (errno != EAGAIN && g->read_errors++ == 0)
-            fprintf(stderr, "navcam: gpio trigger: reading events of %s: %s\n", g->in.desc, strerror(errno));
+            nc_log_error("trigger/gpio", "reading events of %s: %s", g->in.desc, strerror(errno));
         return;
     }
     int64_t now = nc_mono_ns();
@@ -234,8 +249,8 @@ static void read_edges(struct gpio_trig *g, int fd)
          * read time is the best CLOCK_MONOTONIC estimate there is. */
         if (e.mono_ns > now || now - e.mono_ns > 3600 * (int64_t)1000000000) {
             if (!g->warned_clock++)
-                fprintf(stderr, "navcam: gpio trigger: event timestamps of %s are not CLOCK_MONOTONIC (kernel "
-                                "older than 5.7?); using the time events are read\n", g->in.desc);
+                nc_log_warn("trigger/gpio", "event timestamps of %s are not CLOCK_MONOTONIC (kernel "
+                            "older than 5.7?); using the time events are read", g->in.desc);
             e.mono_ns = now;
         }
         g->ctx.fire(g->ctx.sink, &e);
@@ -261,7 +276,7 @@ static void *gpio_thread(void *arg)
             tp = &ts;
         }
         if (ppoll(p, 2, tp, NULL) < 0 && errno != EINTR) {
-            fprintf(stderr, "navcam: gpio trigger: ppoll: %s\n", strerror(errno));
+            nc_log_error("trigger/gpio", "ppoll: %s", strerror(errno));
             break;
         }
         if (p[1].revents & POLLIN) {
@@ -281,7 +296,7 @@ static void wake(struct gpio_trig *g)
 {
     uint64_t one = 1;
     if (write(g->wake_fd, &one, sizeof one) < 0 && errno != EAGAIN)
-        fprintf(stderr, "navcam: gpio trigger: eventfd: %s\n", strerror(errno));
+        nc_log_error("trigger/gpio", "eventfd: %s", strerror(errno));
 }
 
 static int gpio_start(void *priv)
@@ -332,8 +347,8 @@ static void gpio_close(void *priv)
     struct gpio_trig *g = priv;
     gpio_stop(g);
     if (g->have_strobe && (g->strobe_missed || g->read_errors))
-        fprintf(stderr, "navcam: gpio trigger: %lu strobes, %lu exposure windows passed before the strobe could be "
-                        "driven, %lu event read errors\n", g->strobes, g->strobe_missed, g->read_errors);
+        nc_log_info("trigger/gpio", "%lu strobes, %lu exposure windows passed before the strobe could be "
+                    "driven, %lu event read errors", g->strobes, g->strobe_missed, g->read_errors);
     struct gpiod_chip *shared = g->in.line ? gpiod_line_get_chip(g->in.line) : NULL;
     release_line(&g->strobe, shared);
     release_line(&g->in, NULL);
@@ -345,10 +360,10 @@ static void gpio_close(void *priv)
 
 const struct nc_trigger_driver nc_trigger_gpio = {
     .name = "gpio",
-    .description = "a GPIO line through libgpiod (kernel edge timestamps): line, chip, bias, "
-                   "strobe {line, chip, active: high|low}",
+    .description = "a GPIO line through libgpiod (kernel edge timestamps), with an optional strobe output",
     .caps = NC_TRIGGER_CAP_LINE,
     .priv_size = sizeof(struct gpio_trig),
+    .params = gpio_params,
     .open = gpio_open,
     .start = gpio_start,
     .stop = gpio_stop,

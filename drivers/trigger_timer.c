@@ -10,8 +10,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "error.h"
-#include "trigger.h"
+#include "core/clock.h"
+#include "core/error.h"
+#include "emulator/trigger.h"
 
 struct timer {
     struct nc_trigger_ctx ctx;
@@ -26,13 +27,19 @@ struct timer {
 /* The default pulse: 1 ms, or half the period when that is shorter. */
 static int64_t default_width(int64_t period_ns) { return period_ns / 2 < 1000000 ? period_ns / 2 : 1000000; }
 
+static const struct nc_param timer_params[] = {
+    NC_P_DOUBLE("rate_hz", "10", 1e-3, 10000, "Hz", "pulses per second"),
+    NC_P_DOUBLE("pulse_width_s", NULL, 1e-6, 1000, "s", "from the rising to the falling edge (default 1 ms, or half the period when that is shorter)"),
+    NC_P_END,
+};
+
 static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx)
 {
     struct timer *t = priv;
-    double rate_hz = 10, width_s = -1;
+    double rate_hz = 0, width_s = -1;
     int rc;
-    if ((rc = nc_cfg_double(opts, "rate_hz", 1e-3, 10000, &rate_hz)) < 0 ||
-        (rc = nc_cfg_double(opts, "pulse_width_s", 1e-6, 1000, &width_s)) < 0)
+    if ((rc = nc_param_double(opts, timer_params, "rate_hz", &rate_hz)) < 0 ||
+        (rc = nc_param_double(opts, timer_params, "pulse_width_s", &width_s)) < 0)
         return rc;
     t->ctx = *ctx;
     t->period_ns = llround(1e9 / rate_hz);
@@ -135,9 +142,10 @@ static void timer_close(void *priv)
 
 const struct nc_trigger_driver nc_trigger_timer = {
     .name = "timer",
-    .description = "a pulse train: rate_hz (10), pulse_width_s (1 ms or half the period)",
+    .description = "a pulse train on the CLOCK_MONOTONIC grid (a pulse generator)",
     .caps = NC_TRIGGER_CAP_LINE,
     .priv_size = sizeof(struct timer),
+    .params = timer_params,
     .open = timer_open,
     .start = timer_start,
     .stop = timer_stop,

@@ -1,16 +1,31 @@
-/* driver.h - what output and trigger registries share: choosing a driver by
- * the `driver` key of its config map. Internal to the emulator. */
+/* driver.h - the set of drivers a program has, and choosing one by the
+ * `driver` key of its config map. The emulator never names a driver: the
+ * program (app/) hands it a registry, which drivers/registry.c (generated
+ * by CMake) fills with the drivers of the build. So no library calls up a
+ * layer, and a test can hand the emulator drivers of its own.
+ */
 #ifndef NC_DRIVER_H
 #define NC_DRIVER_H
 
-#include "config.h"
+#include "core/config.h"
+#include "emulator/output.h"
+#include "emulator/trigger.h"
 
-/* A registry is a NULL-terminated array of pointers to driver structs whose
- * first member is `const char *name`. */
-const void *nc__driver_find(const void *const *registry, const char *name);
+struct nc_driver_registry {
+    const struct nc_output_driver *const *outputs;   /* NULL-terminated */
+    const struct nc_trigger_driver *const *triggers; /* NULL-terminated */
+};
 
-/* Reads opts' `driver` and finds it; on failure returns NULL with *rc set to
- * an error naming the file, line and the drivers this build has. */
-const void *nc__driver_select(struct nc_cfg_node *opts, const char *kind, const void *const *registry, int *rc);
+const struct nc_output_driver *nc_registry_output(const struct nc_driver_registry *r, const char *name);
+const struct nc_trigger_driver *nc_registry_trigger(const struct nc_driver_registry *r, const char *name);
+
+/* Reads opts' `driver` and finds it among the outputs (or triggers); on
+ * failure returns NULL with *rc set to an error naming the file, line and
+ * the drivers this build has. builtin (may be NULL) is a further name that
+ * the caller handles itself; it is returned as *is_builtin = 1. */
+const struct nc_output_driver *nc_registry_select_output(const struct nc_driver_registry *r, struct nc_cfg_node *opts,
+                                                         int *rc);
+const struct nc_trigger_driver *nc_registry_select_trigger(const struct nc_driver_registry *r, struct nc_cfg_node *opts,
+                                                           const char *builtin, int *is_builtin, int *rc);
 
 #endif

@@ -1,26 +1,29 @@
 /* output.c - opening drivers by name, the frame record as JSON. */
-#include "output.h"
+#include "emulator/output.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "driver.h"
-#include "error.h"
+#include "core/error.h"
 
-const struct nc_output_driver *nc_output_find(const char *name)
-{
-    return nc__driver_find((const void *const *)nc_output_drivers, name);
-}
+static const struct nc_param common_params[] = {
+    NC_P_STRING("driver", NULL, "the output (`navcam serve --help` lists them)"),
+    NC_P_END,
+};
 
-int nc_output_open(struct nc_output *o, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
+int nc_output_open(struct nc_output *o, const struct nc_output_driver *drv, struct nc_cfg_node *opts,
+                   const struct nc_output_ctx *ctx)
 {
     memset(o, 0, sizeof *o);
-    int rc;
-    o->drv = nc__driver_select(opts, "output driver", (const void *const *)nc_output_drivers, &rc);
-    if (!o->drv)
+    char what[96];
+    snprintf(what, sizeof what, "output driver '%s'", drv->name);
+    const struct nc_param *const tables[] = {common_params, drv->params};
+    int rc = nc_params_check(opts, tables, 2, what);
+    if (rc < 0)
         return rc;
+    o->drv = drv;
     o->priv = calloc(1, o->drv->priv_size ? o->drv->priv_size : 1);
     if (!o->priv)
         return nc_error(-ENOMEM, "out of memory");

@@ -1,13 +1,13 @@
 /* timeline.c - pose buffering and interpolation (timeline.h). */
-#include "timeline.h"
+#include "emulator/timeline.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
-#include "scene.h"
+#include "core/error.h"
+#include "render/scene.h"
 
 int nc_timeline_init(struct nc_timeline *tl, size_t cap, int64_t max_extrapolation_ns)
 {

@@ -11,33 +11,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "protocol.h"
-
-struct nc_pose {
-    int64_t t_ns; /* simulation time */
-    struct nc_vec3 cam_position_m;
-    struct nc_quat cam_attitude_q;
-    struct nc_vec3 sun;
-    int sun_is_position;
-    int has_body;
-    struct nc_vec3 body_position_m;
-    struct nc_quat body_attitude_q;
-    struct nc_vec3 cam_velocity_m_s, cam_angular_velocity_rad_s;
-    struct nc_vec3 body_velocity_m_s, body_angular_velocity_rad_s;
-};
+#include "core/pose.h"
+#include "navcam/protocol.h"
 
 struct nc_timeline {
     struct nc_pose *ring;
     size_t cap, n, head; /* head: index of the oldest pose */
     int64_t max_extrapolation_ns;
-};
-
-enum nc_pose_quality {
-    NC_POSE_INTERPOLATED = 0, /* between two buffered poses (or exactly on one) */
-    NC_POSE_EXTRAPOLATED = 1, /* beyond the newest (or before the oldest), within the limit */
-    NC_POSE_STALE = 2,        /* beyond the limit: the pose is filled, the caller decides */
-    NC_POSE_NONE = 3,         /* nothing buffered yet */
-    NC_POSE_SCENE = 4,        /* nothing received yet: the scene's configured pose (serve.no_pose: scene) */
 };
 
 int nc_timeline_init(struct nc_timeline *tl, size_t capacity, int64_t max_extrapolation_ns);

@@ -1,79 +1,88 @@
-/* trigger.c - opening trigger drivers, and the gate every edge passes:
- * activation edge, debounce, delay (trigger.h). Must not know any driver. */
-#include "trigger.h"
+/* trigger.c - opening trigger drivers, and the gate every edge passes
+ * between a driver and the emulator: activation edge, debounce, delay
+ * (trigger.h). Must not know any driver. */
+#include "emulator/trigger.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
-#include "driver.h"
-#include "error.h"
+#include "core/error.h"
 
-int64_t nc_mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
+static const char *const activations[] = {"rising_edge", "falling_edge", "any_edge", NULL};
 
-const struct nc_trigger_driver *nc_trigger_find(const char *name)
-{
-    return nc__driver_find((const void *const *)nc_trigger_drivers, name);
-}
+const struct nc_param nc_trigger_common_params[] = {
+    NC_P_STRING("driver", NULL, "the trigger source (`navcam serve --help` lists them)"),
+    NC_P_ENUM("activation", "rising_edge", activations, "which line edge triggers (line sources only)"),
+    NC_P_DOUBLE("delay_s", "0", 0, 10, "s", "from the edge to the start of the exposure"),
+    NC_P_DOUBLE("debounce_s", "0", 0, 10, "s", "edges this soon after an accepted one are ignored (line sources only)"),
+    NC_P_END,
+};
 
 int nc_trigger_gate_accept(struct nc_trigger_gate *g, const struct nc_trigger_edge *edge)
 {
     g->edges++;
-    if (!edge->command) {
-        if ((g->activation == NC_TRIGGER_RISING && !edge->rising) ||
-            (g->activation == NC_TRIGGER_FALLING && edge->rising)) {
-            g->wrong_edge++;
-            return 0;
-        }
-        /* Lock-out debounce: bounce after an accepted edge is ignored. */
-        if (g->debounce_ns > 0 && g->have_last && edge->mono_ns - g->last_ns < g->debounce_ns) {
-            g->debounced++;
-            return 0;
-        }
-        g->last_ns = edge->mono_ns;
-        g->have_last = 1;
+    if ((g->activation == NC_TRIGGER_RISING && !edge->rising) || (g->activation == NC_TRIGGER_FALLING && edge->rising)) {
+        g->wrong_edge++;
+        return 0;
     }
+    /* Lock-out debounce: bounce after an accepted edge is ignored. */
+    if (g->debounce_ns > 0 && g->have_last && edge->mono_ns - g->last_ns < g->debounce_ns) {
+        g->debounced++;
+        return 0;
+    }
+    g->last_ns = edge->mono_ns;
+    g->have_last = 1;
     g->accepted++;
     return 1;
 }
 
-int nc_trigger_open(struct nc_trigger *t, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx)
+/* Every edge of the driver: through the gate, then to the emulator. */
+static void on_edge(void *sink, const struct nc_trigger_edge *edge)
 {
-    static const char *const acts[] = {"rising_edge", "falling_edge", "any_edge", NULL};
+    struct nc_trigger *t = sink;
+    pthread_mutex_lock(&t->lock);
+    int ok = nc_trigger_gate_accept(&t->gate, edge);
+    int64_t delay = t->gate.delay_ns;
+    pthread_mutex_unlock(&t->lock);
+    if (ok) {
+        struct nc_trigger_event ev = {.edge_mono_ns = edge->mono_ns, .start_mono_ns = edge->mono_ns + delay};
+        t->sink(t->sink_arg, &ev);
+    }
+}
+
+int nc_trigger_open(struct nc_trigger *t, const struct nc_trigger_driver *drv, struct nc_cfg_node *opts,
+                    nc_trigger_sink_fn sink, void *arg)
+{
     memset(t, 0, sizeof *t);
+    char what[96];
+    snprintf(what, sizeof what, "trigger driver '%s'", drv->name);
+    const struct nc_param *const tables[] = {nc_trigger_common_params, drv->params};
     int rc, act = NC_TRIGGER_RISING;
     double delay_s = 0, debounce_s = 0;
-    t->drv = nc__driver_select(opts, "trigger driver", (const void *const *)nc_trigger_drivers, &rc);
-    if (!t->drv)
+    if ((rc = nc_params_check(opts, tables, 2, what)) < 0 ||
+        (rc = nc_param_enum(opts, nc_trigger_common_params, "activation", &act)) < 0 ||
+        (rc = nc_param_double(opts, nc_trigger_common_params, "delay_s", &delay_s)) < 0 ||
+        (rc = nc_param_double(opts, nc_trigger_common_params, "debounce_s", &debounce_s)) < 0)
         return rc;
-    if ((rc = nc_cfg_enum(opts, "activation", acts, &act)) < 0 ||
-        (rc = nc_cfg_double(opts, "delay_s", 0, 10, &delay_s)) < 0 ||
-        (rc = nc_cfg_double(opts, "debounce_s", 0, 10, &debounce_s)) < 0)
-        return rc;
-    if (!(t->drv->caps & NC_TRIGGER_CAP_LINE) && (nc_cfg_get(opts, "activation") || nc_cfg_get(opts, "debounce_s")))
-        return nc_cfg_error(opts, "trigger driver '%s' gives commands, not line edges: activation and debounce_s do "
-                                  "not apply",
-                            t->drv->name);
+    t->drv = drv;
+    t->sink = sink;
+    t->sink_arg = arg;
     t->gate.activation = (enum nc_trigger_activation)act;
     t->gate.delay_ns = llround(delay_s * 1e9);
     t->gate.debounce_ns = llround(debounce_s * 1e9);
-    t->priv = calloc(1, t->drv->priv_size ? t->drv->priv_size : 1);
+    t->priv = calloc(1, drv->priv_size ? drv->priv_size : 1);
     if (!t->priv)
         return nc_error(-ENOMEM, "out of memory");
-    if ((rc = t->drv->open(t->priv, opts, ctx)) < 0) {
-        free(t->priv);
-        t->priv = NULL;
-        return rc;
-    }
     pthread_mutex_init(&t->lock, NULL);
-    return 0;
+    struct nc_trigger_ctx ctx = {.fire = on_edge, .sink = t};
+    if ((rc = drv->open(t->priv, opts, &ctx)) < 0) {
+        free(t->priv);
+        pthread_mutex_destroy(&t->lock);
+        memset(t, 0, sizeof *t);
+    }
+    return rc;
 }
 
 int nc_trigger_start(struct nc_trigger *t)
@@ -97,12 +106,35 @@ int nc_trigger_control(struct nc_trigger *t, const char *request, void *arg)
     return t->drv->control(t->priv, request, arg);
 }
 
-int nc_trigger_accept(struct nc_trigger *t, const struct nc_trigger_edge *edge)
+void nc_trigger_set_gate(struct nc_trigger *t, enum nc_trigger_activation activation, int64_t delay_ns)
 {
     pthread_mutex_lock(&t->lock);
-    int ok = nc_trigger_gate_accept(&t->gate, edge);
+    t->gate.activation = activation;
+    t->gate.delay_ns = delay_ns;
     pthread_mutex_unlock(&t->lock);
-    return ok;
+}
+
+enum nc_trigger_activation nc_trigger_activation(struct nc_trigger *t)
+{
+    pthread_mutex_lock(&t->lock);
+    enum nc_trigger_activation a = t->gate.activation;
+    pthread_mutex_unlock(&t->lock);
+    return a;
+}
+
+int64_t nc_trigger_delay_ns(struct nc_trigger *t)
+{
+    pthread_mutex_lock(&t->lock);
+    int64_t d = t->gate.delay_ns;
+    pthread_mutex_unlock(&t->lock);
+    return d;
+}
+
+void nc_trigger_counts(struct nc_trigger *t, struct nc_trigger_counts *out)
+{
+    pthread_mutex_lock(&t->lock);
+    *out = (struct nc_trigger_counts){t->gate.edges, t->gate.wrong_edge, t->gate.debounced, t->gate.accepted};
+    pthread_mutex_unlock(&t->lock);
 }
 
 void nc_trigger_close(struct nc_trigger *t)

@@ -1,6 +1,6 @@
 /* albedo_map.c - loading (through image_io) and bilinear sampling of
  * equirectangular albedo maps. */
-#include "albedo_map.h"
+#include "render/albedo_map.h"
 
 #include <errno.h>
 #include <libgen.h>
@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
-#include "image_io.h"
+#include "core/error.h"
+#include "render/image_io.h"
 
 int nc_albedo_map_load(const char *path, double lon_left_deg, int east, double scale, struct nc_albedo_map **out)
 {

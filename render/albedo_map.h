@@ -11,8 +11,8 @@
 #ifndef NC_ALBEDO_MAP_H
 #define NC_ALBEDO_MAP_H
 
-#include "config.h"
-#include "vec.h"
+#include "core/config.h"
+#include "core/vec.h"
 
 struct nc_albedo_map {
     int width_px, height_px;

@@ -13,8 +13,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "material.h"
-#include "vmath.h"
+#include "render/material.h"
+#include "render/vmath.h"
 
 #define INV_PI (1.0 / M_PI)
 

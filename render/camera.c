@@ -1,11 +1,11 @@
 /* camera.c - reading the camera section of a scene configuration. */
-#include "camera.h"
+#include "render/camera.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "error.h"
+#include "core/error.h"
 
 int nc_camera_intrinsics_from_config(struct nc_cfg_node *map, struct nc_camera *c)
 {

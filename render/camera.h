@@ -9,8 +9,8 @@
 #ifndef NC_CAMERA_H
 #define NC_CAMERA_H
 
-#include "config.h"
-#include "vec.h"
+#include "core/config.h"
+#include "core/vec.h"
 
 struct nc_camera {
     int width_px, height_px;

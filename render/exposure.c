@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
-#include "render.h"
+#include "core/error.h"
+#include "render/render.h"
 
 double nc_render_motion_px(const struct nc_scene *s, double T)
 {

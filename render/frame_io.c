@@ -1,12 +1,12 @@
 /* frame_io.c - frame + scene -> image file with metadata. */
-#include "frame_io.h"
+#include "render/frame_io.h"
 
 #include <stdio.h>
 #include <string.h>
 
-#include "error.h"
-#include "image_io.h"
-#include "version.h"
+#include "core/error.h"
+#include "render/image_io.h"
+#include "core/version.h"
 
 const char *const nc_quantity_names[] = {"radiance", "iof", "range", "electrons", "dn", NULL};
 

@@ -4,9 +4,9 @@
 #ifndef NC_FRAME_IO_H
 #define NC_FRAME_IO_H
 
-#include "image_io.h"
-#include "render.h"
-#include "scene.h"
+#include "render/image_io.h"
+#include "render/render.h"
+#include "render/scene.h"
 
 /* radiance, iof and range come from the renderer; electrons (noise-free
  * photo-electrons) and dn (a digitised frame) need the camera model. */

@@ -17,8 +17,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
-#include "image_io_impl.h"
+#include "core/error.h"
+#include "render/image_io_impl.h"
 
 static const char *const fits_keys[][2] = {
     {"Software", "CREATOR"},

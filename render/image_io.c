@@ -2,7 +2,7 @@
  * given, PNG gets a 16-bit linear preview with its scale in the metadata.
  * NaN and Inf never reach a file. Metadata also goes, as one JSON object, into
  * ImageDescription, the one field every format here keeps. */
-#include "image_io.h"
+#include "render/image_io.h"
 
 #include <errno.h>
 #include <math.h>
@@ -12,8 +12,8 @@
 #include <string.h>
 #include <strings.h>
 
-#include "error.h"
-#include "image_io_impl.h"
+#include "core/error.h"
+#include "render/image_io_impl.h"
 
 enum fmt { FMT_NONE, FMT_EXR, FMT_TIFF, FMT_FITS, FMT_PNG };
 

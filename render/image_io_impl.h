@@ -3,7 +3,7 @@
 #ifndef NC_IMAGE_IO_IMPL_H
 #define NC_IMAGE_IO_IMPL_H
 
-#include "image_io.h"
+#include "render/image_io.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -8,9 +8,9 @@
 #include <string>
 
 extern "C" {
-#include "error.h"
+#include "core/error.h"
 }
-#include "image_io_impl.h"
+#include "render/image_io_impl.h"
 
 using namespace OIIO;
 

@@ -1,14 +1,14 @@
 /* material.c - the reflectance model registry, presets, and materials from
  * configuration. The models themselves are in brdf.c. */
-#include "material.h"
+#include "render/material.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "albedo_map.h"
-#include "error.h"
+#include "render/albedo_map.h"
+#include "core/error.h"
 
 extern const struct nc_brdf_model nc_brdf_lambert, nc_brdf_lommel_seeliger, nc_brdf_hapke, nc_brdf_mcewen;
 

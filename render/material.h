@@ -14,7 +14,7 @@
 
 #include <stddef.h>
 
-#include "config.h"
+#include "core/config.h"
 
 #define NC_BRDF_MAX_PARAMS 12
 #define NC_BRDF_MAX_DERIVED 12

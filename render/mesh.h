@@ -11,7 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "vec.h"
+#include "core/vec.h"
 
 struct nc_mesh {
     double *v;      /* xyz per vertex, metres, body-fixed frame */

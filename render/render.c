@@ -1,6 +1,6 @@
 /* render.c - tiles, threads and shading. Hot path: one function,
  * shade_tile(); nothing here allocates per pixel or per packet. */
-#include "render.h"
+#include "render/render.h"
 
 #include <errno.h>
 #include <math.h>
@@ -11,8 +11,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "albedo_map.h"
-#include "error.h"
+#include "render/albedo_map.h"
+#include "core/error.h"
 
 #define TILE NC_TILE
 

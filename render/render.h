@@ -8,8 +8,8 @@
 #ifndef NC_RENDER_H
 #define NC_RENDER_H
 
-#include "rt.h"
-#include "scene.h"
+#include "render/rt.h"
+#include "render/scene.h"
 
 /* Tiles of NC_TILE x NC_TILE pixels are the unit of work (and of
  * nc_render_rows); a tile is (NC_TILE/4)^2 ray packets of 4x4 pixels. */

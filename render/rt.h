@@ -9,7 +9,7 @@
 #ifndef NC_RT_H
 #define NC_RT_H
 
-#include "scene.h"
+#include "render/scene.h"
 
 #define NC_PACKET 16
 

@@ -4,7 +4,7 @@
  * Every Embree call in NavCam is in this file (Embree 4 changes the API).
  * Nothing here knows about reflectance, cameras or images.
  */
-#include "rt.h"
+#include "render/rt.h"
 
 #include <embree3/rtcore.h>
 #include <errno.h>
@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
+#include "core/error.h"
 
 struct rt_body {
     const struct nc_body *src;

@@ -1,12 +1,12 @@
 /* scene.c - building a scene from configuration, and the built-in default. */
-#include "scene.h"
+#include "render/scene.h"
 
 #include <libgen.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "error.h"
+#include "core/error.h"
 
 const char nc_default_scene_yaml[] =
     "# NavCam built-in default scene: a procedural cratered asteroid about 500 m\n"

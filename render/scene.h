@@ -11,10 +11,11 @@
 
 #include <stdint.h>
 
-#include "camera.h"
-#include "config.h"
-#include "material.h"
-#include "mesh.h"
+#include "core/config.h"
+#include "core/pose.h"
+#include "render/camera.h"
+#include "render/material.h"
+#include "render/mesh.h"
 
 #define NC_AU_M 149597870700.0     /* IAU 2012, exact */
 #define NC_SOLAR_CONSTANT_W_M2 1361.0 /* total solar irradiance at 1 au */
@@ -81,5 +82,11 @@ struct nc_quat nc_quat_propagate(struct nc_quat q, struct nc_vec3 w, double dt);
 /* Sun, in the scene frame, seen from scene point p: unit direction toward the
  * Sun and the solar irradiance there (W m^-2). */
 void nc_scene_sun_at(const struct nc_scene *s, struct nc_vec3 p, struct nc_vec3 *dir, double *irradiance_w_m2);
+
+/* The scene's configured pose at time t_ns (the emulator's pose before any
+ * has arrived), and a pose applied to the scene: camera, Sun and bodies[0]
+ * (scene_pose.c). A pose's Sun position keeps the configured irradiance law. */
+void nc_scene_pose(const struct nc_scene *s, int64_t t_ns, struct nc_pose *p);
+void nc_scene_apply_pose(struct nc_scene *s, const struct nc_pose *p);
 
 #endif

@@ -1,7 +1,7 @@
 /* vmath_libm.c - vmath.h with the C library: the portable fallback. */
 #include <math.h>
 
-#include "vmath.h"
+#include "render/vmath.h"
 
 void nc_vexp(double *x, size_t n)
 {

@@ -6,7 +6,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "vmath.h"
+#include "render/vmath.h"
 
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")

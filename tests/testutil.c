@@ -5,7 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "error.h"
+#include "core/error.h"
 
 int nc_test_failed, nc_test_passed;
 

@@ -5,8 +5,8 @@
 
 #include <stdio.h>
 
-#include "render.h"
-#include "scene.h"
+#include "render/render.h"
+#include "render/scene.h"
 
 extern int nc_test_failed, nc_test_passed;
 

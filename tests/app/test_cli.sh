@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # test_cli.sh - the navcam program through its real command line: help,
-# version, renders to every format, overrides, and error messages/exit codes.
-# Usage: test_cli.sh NAVCAM TMPDIR
+# version, renders to every format, overrides, and error messages/exit codes;
+# each command linking only what it uses; docs/drivers.md as the drivers'
+# tables print it.
+# Usage: test_cli.sh NAVCAM TMPDIR SOURCE_DIR
 set -u
 navcam=$1
 tmp=$2
+src=$3
 rm -rf "$tmp" && mkdir -p "$tmp"
 pass=0
 fail=0
@@ -29,7 +32,31 @@ expect 0 "--set KEY=VALUE" -- "$navcam" render --help
 expect 2 "Usage: navcam" -- "$navcam"
 expect 2 "unknown command 'paint'" -- "$navcam" paint
 # serve: the drivers this build has, and trigger configuration errors.
-expect 0 "timer     a pulse train" -- "$navcam" serve --help
+expect 0 "timer: a pulse train" -- "$navcam" serve --help
+expect 0 "rate_hz                default 10; 0.001..10000 Hz: pulses per second" -- "$navcam" serve --help
+expect 0 "strobe.active" -- "$navcam" serve --help
+# docs/drivers.md is generated from the same tables (make docs).
+"$navcam" serve --driver-docs > "$tmp/drivers.md"
+diff -u "$src/docs/drivers.md" "$tmp/drivers.md" > "$tmp/drivers.diff" && ok ||
+  bad "docs/drivers.md differs from \`navcam serve --driver-docs\` (run make docs): $(head -20 "$tmp/drivers.diff")"
+# Unknown driver keys: file, line, key and what the driver takes, before any device is touched.
+printf 'base: builtin:default\noutputs:\n  - driver: file\n    patern: f_%%06llu.png\n' > "$tmp/outs.yaml"
+expect 1 "outs.yaml:4: outputs[0].patern: unknown key for output driver 'file' (it takes: driver, directory, pattern, sidecar)" -- \
+  "$navcam" serve "$tmp/outs.yaml"
+expect 1 "serve.trigger.strobe.levle: unknown key for trigger driver 'gpio'" -- "$navcam" serve --set serve.mode=trigger \
+  --set "serve.trigger={driver: gpio, line: X, strobe: {line: Y, levle: low}}"
+expect 1 "trigger source 'software' gives commands, not line edges" -- "$navcam" serve --set serve.mode=trigger \
+  --set "serve.trigger={driver: software, debounce_s: 0.01}"
+# Each command is its own program and loads only the libraries it uses.
+libexec=$(dirname "$navcam")/libexec/navcam
+needed() { readelf -d "$1" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | tr '\n' ' '; }
+case "$(needed "$navcam")" in *OpenImageIO*|*embree*|*aravis*|*gpiod*) bad "navcam itself links $(needed "$navcam")" ;; *) ok ;; esac
+for c in render expose brdf scene replay pose; do
+  case "$(needed "$libexec/navcam-$c")" in *aravis*|*gpiod*) bad "navcam-$c links a driver's library: $(needed "$libexec/navcam-$c")" ;; *) ok ;; esac
+done
+for c in replay pose; do
+  case "$(needed "$libexec/navcam-$c")" in *OpenImageIO*|*embree*|*yaml*) bad "navcam-$c links the renderer: $(needed "$libexec/navcam-$c")" ;; *) ok ;; esac
+done
 expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
 expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"

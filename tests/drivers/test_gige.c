@@ -25,8 +25,8 @@
 #include <unistd.h>
 #include <zlib.h>
 
-#include "error.h"
-#include "image_io.h"
+#include "core/error.h"
+#include "render/image_io.h"
 #include "testutil.h"
 
 #define W 128

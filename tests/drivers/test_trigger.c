@@ -1,16 +1,18 @@
-/* test_trigger.c - the trigger gate (activation edge, lock-out debounce,
- * commands) on hand-made edge sequences, and the timer trigger driver
- * through the registry: edges alternate, lie exactly on the period grid with
- * the configured pulse width, and stop() returns at once even between edges
+/* test_trigger.c - the trigger gate (activation edge, lock-out debounce) on
+ * hand-made edge sequences, and the timer trigger driver through the
+ * registry and the gate: edges lie exactly on the period grid with the
+ * configured pulse width, the gate's delay moves the exposure start, the
+ * activation filters edges, and stop() returns at once even between edges
  * many seconds apart. Configuration errors name the key. */
 #include <stdatomic.h>
 #include <string.h>
 #include <time.h>
 
-#include "config.h"
-#include "error.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "drivers/registry.h"
+#include "emulator/trigger.h"
 #include "testutil.h"
-#include "trigger.h"
 
 #define MS 1000000LL
 
@@ -37,9 +39,8 @@ static void test_gate(void)
     /* A pulse train 10 ms apart, 2 ms wide, whose first rising edge bounces
      * three times within 0.3 ms. */
     struct nc_trigger_edge e[] = {
-        {0, 1, 0, NULL},       {100000, 0, 0, NULL}, {200000, 1, 0, NULL}, {300000, 0, 0, NULL},
-        {310000, 1, 0, NULL},  {2 * MS, 0, 0, NULL}, {10 * MS, 1, 0, NULL}, {12 * MS, 0, 0, NULL},
-        {20 * MS, 1, 0, NULL}, {22 * MS, 0, 0, NULL},
+        {0, 1},       {100000, 0}, {200000, 1}, {300000, 0}, {310000, 1},
+        {2 * MS, 0},  {10 * MS, 1}, {12 * MS, 0}, {20 * MS, 1}, {22 * MS, 0},
     };
     int n = (int)(sizeof e / sizeof e[0]), acc[16];
     int k = gate_run(NC_TRIGGER_RISING, 0, e, n, acc);
@@ -53,46 +54,43 @@ static void test_gate(void)
           "falling, 1 ms debounce: %d accepted (want 1, 5, 7, 9)", k);
     k = gate_run(NC_TRIGGER_ANY, 1 * MS, e, n, acc);
     CHECK(k == 6 && acc[1] == 5 && acc[2] == 6, "any edge, 1 ms debounce: %d accepted (want 0, 5, 6, 7, 8, 9)", k);
-    /* Commands (software triggers) pass activation and debounce. */
-    struct nc_trigger_gate g = {.activation = NC_TRIGGER_FALLING, .debounce_ns = 1000 * MS};
-    struct nc_trigger_edge c = {.mono_ns = 0, .rising = 1, .command = 1};
-    int all = 1;
-    for (int i = 0; i < 5; i++, c.mono_ns += MS)
-        all &= nc_trigger_gate_accept(&g, &c);
-    CHECK(all && g.accepted == 5 && g.debounced == 0 && g.wrong_edge == 0, "commands filtered");
     /* Counters add up. */
-    g = (struct nc_trigger_gate){.activation = NC_TRIGGER_RISING, .debounce_ns = 1 * MS};
+    struct nc_trigger_gate g = (struct nc_trigger_gate){.activation = NC_TRIGGER_RISING, .debounce_ns = 1 * MS};
     for (int i = 0; i < n; i++)
         nc_trigger_gate_accept(&g, &e[i]);
     CHECK(g.edges == 10 && g.wrong_edge == 5 && g.debounced == 2 && g.accepted == 3,
           "counters: edges %lu wrong %lu debounced %lu accepted %lu", g.edges, g.wrong_edge, g.debounced, g.accepted);
 }
 
-/* Edges recorded by the timer test's sink. */
+/* Events recorded by the timer test's sink: what passed the gate. */
 struct rec {
-    struct nc_trigger_edge e[64];
+    struct nc_trigger_event e[64];
     int64_t fired_at[64];
     atomic_int n;
 };
 
-static void record(void *sink, const struct nc_trigger_edge *edge)
+static void record(void *sink, const struct nc_trigger_event *ev)
 {
     struct rec *r = sink;
     int i = atomic_load(&r->n);
     if (i < 64) {
-        r->e[i] = *edge;
+        r->e[i] = *ev;
         r->fired_at[i] = now_ns();
         atomic_store(&r->n, i + 1);
     }
 }
 
+/* A trigger from YAML through this build's registry, as `navcam serve` opens one. */
 static int open_yaml(struct nc_cfg *cfg, struct nc_trigger *t, const char *yaml, struct rec *r)
 {
+    memset(t, 0, sizeof *t);
     nc_cfg_init(cfg);
     int rc = nc_cfg_load_string(cfg, yaml, "trigger.yaml");
-    struct nc_trigger_ctx ctx = {record, r};
+    const struct nc_trigger_driver *d = NULL;
     if (rc >= 0)
-        rc = nc_trigger_open(t, cfg->root, &ctx);
+        d = nc_registry_select_trigger(&nc_drivers, cfg->root, NULL, NULL, &rc);
+    if (d)
+        rc = nc_trigger_open(t, d, cfg->root, record, r);
     return rc;
 }
 
@@ -101,13 +99,14 @@ static void test_timer(void)
     struct nc_cfg cfg;
     struct nc_trigger t;
     static struct rec r;
-    int rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 200\npulse_width_s: 0.001\nactivation: falling_edge\n"
+    /* Every edge passes (any_edge): rising on the 5 ms grid, falling 1 ms later. */
+    int rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 200\npulse_width_s: 0.001\nactivation: any_edge\n"
                                  "delay_s: 0.004\n", &r);
     CHECK(rc == 0, "open: %s", nc_errmsg());
     if (rc < 0)
         return;
     CHECK(nc_cfg_check_unused(&cfg) == 0, "timer options left unread: %s", nc_errmsg());
-    CHECK(t.gate.activation == NC_TRIGGER_FALLING && t.gate.delay_ns == 4 * MS, "gate options not applied");
+    CHECK(nc_trigger_activation(&t) == NC_TRIGGER_ANY && nc_trigger_delay_ns(&t) == 4 * MS, "gate options not applied");
     CHECK(nc_trigger_start(&t) == 0, "start: %s", nc_errmsg());
     while (atomic_load(&r.n) < 20)
         nanosleep(&(struct timespec){0, 1000000}, NULL);
@@ -115,16 +114,40 @@ static void test_timer(void)
     int n = atomic_load(&r.n);
     int64_t worst_late = 0;
     for (int i = 0; i < n; i++) {
-        CHECK(r.e[i].rising == !(i & 1), "edge %d: rising=%d", i, r.e[i].rising);
-        int64_t want = r.e[0].mono_ns + (i / 2) * 5 * MS + (i & 1) * MS;
-        CHECK(r.e[i].mono_ns == want, "edge %d at %lld ns, want the grid time %lld", i, (long long)r.e[i].mono_ns,
-              (long long)want);
-        CHECK(r.fired_at[i] >= r.e[i].mono_ns, "edge %d fired before its time", i);
-        if (r.fired_at[i] - r.e[i].mono_ns > worst_late)
-            worst_late = r.fired_at[i] - r.e[i].mono_ns;
+        int64_t want = r.e[0].edge_mono_ns + (i / 2) * 5 * MS + (i & 1) * MS;
+        CHECK(r.e[i].edge_mono_ns == want, "edge %d at %lld ns, want the grid time %lld", i,
+              (long long)r.e[i].edge_mono_ns, (long long)want);
+        CHECK(r.e[i].start_mono_ns == r.e[i].edge_mono_ns + 4 * MS, "edge %d: exposure start not edge + delay", i);
+        CHECK(r.fired_at[i] >= r.e[i].edge_mono_ns, "edge %d fired before its time", i);
+        if (r.fired_at[i] - r.e[i].edge_mono_ns > worst_late)
+            worst_late = r.fired_at[i] - r.e[i].edge_mono_ns;
     }
+    struct nc_trigger_counts c;
+    nc_trigger_counts(&t, &c);
+    CHECK(c.accepted == (unsigned long)n && c.wrong_edge == 0, "counts: %lu accepted, %d recorded", c.accepted, n);
     printf("timer: %d edges on a 5 ms grid, 1 ms pulses; fired at most %.3f ms after the edge time\n", n,
            worst_late * 1e-6);
+    nc_trigger_close(&t);
+    nc_cfg_free(&cfg);
+
+    /* Falling edges only, then rising only after a run-time change: the gate
+     * filters, and counts what it filtered. */
+    static struct rec rf;
+    rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 200\nactivation: falling_edge\n", &rf);
+    CHECK(rc == 0, "open: %s", nc_errmsg());
+    if (rc < 0)
+        return;
+    nc_trigger_start(&t);
+    while (atomic_load(&rf.n) < 6)
+        nanosleep(&(struct timespec){0, 1000000}, NULL);
+    nc_trigger_stop(&t);
+    int nf = atomic_load(&rf.n);
+    for (int i = 1; i < nf; i++)
+        CHECK(rf.e[i].edge_mono_ns - rf.e[i - 1].edge_mono_ns == 5 * MS, "falling edges %d, %d not one period apart",
+              i - 1, i);
+    nc_trigger_counts(&t, &c);
+    CHECK(c.wrong_edge >= c.accepted - 1 && c.accepted == (unsigned long)nf, "falling only: %lu wrong edges, %lu accepted",
+          c.wrong_edge, c.accepted);
     nc_trigger_close(&t);
     nc_cfg_free(&cfg);
 
@@ -163,12 +186,12 @@ int main(void)
 {
     test_gate();
     test_timer();
-    expect_error("driver: gpio9\n", "this build has: software, timer");
+    expect_error("driver: gpio9\n", "this build has: timer");
     expect_error("rate_hz: 3\n", "driver");
     expect_error("driver: timer\nrate_hz: 100\npulse_width_s: 0.02\n", "shorter than the period");
     expect_error("driver: timer\nactivation: sideways\n", "activation");
-    expect_error("driver: software\ndebounce_s: 0.01\n", "do not apply");
-    expect_error("driver: timer\nrate_hz: 10\nrate: 3\n", "rate");
+    /* Unknown keys are refused by the driver's table, with file and line. */
+    expect_error("driver: timer\nrate_hz: 10\nrate: 3\n", "trigger.yaml:3: rate: unknown key for trigger driver 'timer'");
     expect_error("driver: timer\nrate_hz: -1\n", "rate_hz");
     return nc_test_end();
 }

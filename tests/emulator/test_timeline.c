@@ -6,9 +6,9 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "scene.h"
+#include "render/scene.h"
 #include "testutil.h"
-#include "timeline.h"
+#include "emulator/timeline.h"
 
 static const struct nc_vec3 V = {12.5, -3.0, 0.75}, W_AXIS = {0.267261241912424, 0.534522483824849, 0.801783725737273};
 static const double OMEGA = 0.3; /* rad/s */

@@ -4,9 +4,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "albedo_map.h"
-#include "error.h"
-#include "image_io.h"
+#include "render/albedo_map.h"
+#include "core/error.h"
+#include "render/image_io.h"
 #include "testutil.h"
 
 /* 8 x 4 map: western hemisphere (columns 0-3 when the left edge is -180 deg

@@ -8,8 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
-#include "material.h"
+#include "core/error.h"
+#include "render/material.h"
 #include "testutil.h"
 
 static struct nc_material make(const char *model_or_preset, const char *params)

@@ -6,9 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
-#include "frame_io.h"
-#include "image_io.h"
+#include "core/error.h"
+#include "render/frame_io.h"
+#include "render/image_io.h"
 #include "testutil.h"
 
 static const char yaml[] =

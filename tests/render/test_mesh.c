@@ -5,8 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "error.h"
-#include "mesh.h"
+#include "core/error.h"
+#include "render/mesh.h"
 #include "testutil.h"
 
 static const char *write_tmp(const char *name, const char *text)

@@ -6,7 +6,7 @@
 #include <stdio.h>
 
 #include "testutil.h"
-#include "vmath.h"
+#include "render/vmath.h"
 
 static double ulps(double a, double b)
 {

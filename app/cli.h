@@ -1,0 +1,15 @@
+/* cli.h - what the `navcam` commands share: naming the program in log lines
+ * and error messages, and reporting the library's last error. Each command
+ * is its own small executable (app/cmd_*.c) that links only the layers it
+ * uses; app/navcam.c dispatches to them. */
+#ifndef NC_APP_CLI_H
+#define NC_APP_CLI_H
+
+/* "navcam render" etc.: the log prefix and the error prefix. */
+void nc_cli_init(const char *command);
+/* Prints "navcam CMD: <last error>" and returns 1 (the exit status). */
+int nc_cli_fail(void);
+/* The program name set by nc_cli_init. */
+const char *nc_cli_name(void);
+
+#endif

@@ -1,0 +1,112 @@
+/* cmd_pose.c - `navcam pose send`: one POSE or TRIGGER message to `navcam
+ * serve`. Links the client library only. */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "app/cli.h"
+#include "core/error.h"
+#include "core/vec.h"
+#include "navcam/client.h"
+
+static const char pose_help[] =
+    "Usage: navcam pose send --position X,Y,Z --attitude W,X,Y,Z --sun X,Y,Z [options]\n"
+    "\n"
+    "Send one POSE (or, with --trigger, one software TRIGGER) to `navcam serve`.\n"
+    "  -P, --position X,Y,Z   camera position, m, scene frame\n"
+    "  -A, --attitude W,X,Y,Z camera -> scene quaternion (default 1,0,0,0)\n"
+    "  -S, --sun X,Y,Z        Sun direction, body frame (default 1,0,0)\n"
+    "  -t, --time S           simulation time, s (default 0)\n"
+    "  -c, --capture          ask for a frame (lock-step or trigger mode)\n"
+    "      --trigger          send a TRIGGER instead of a POSE\n"
+    "  -e, --exposure S       exposure for the requested frame, s\n"
+    "  -g, --gain DB          analog gain for the requested frame, dB\n"
+    "      --tcp              over TCP, waiting for the FRAME answer when capturing\n"
+    "  -H, --host ADDR        default 127.0.0.1;  -p, --port N  default 5750 (UDP) / 5751 (TCP)\n";
+
+static int parse_vec(const char *s, double *v, int n)
+{
+    char *end;
+    for (int i = 0; i < n; i++) {
+        v[i] = strtod(s, &end);
+        if (end == s || !isfinite(v[i]))
+            return -1;
+        s = end + (*end == ',');
+    }
+    return *end ? -1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    nc_cli_init("pose send");
+    if (argc < 2 || strcmp(argv[1], "send") != 0) {
+        fputs(argc > 1 && !strcmp(argv[1], "--help") ? pose_help : "Usage: navcam pose send ... (navcam pose send --help)\n",
+              argc > 1 && !strcmp(argv[1], "--help") ? stdout : stderr);
+        return argc > 1 && !strcmp(argv[1], "--help") ? 0 : 2;
+    }
+    static const struct option opts[] = {
+        {"position", required_argument, NULL, 'P'}, {"attitude", required_argument, NULL, 'A'},
+        {"sun", required_argument, NULL, 'S'},      {"time", required_argument, NULL, 't'},
+        {"capture", no_argument, NULL, 'c'},        {"trigger", no_argument, NULL, 'R'},
+        {"exposure", required_argument, NULL, 'e'}, {"gain", required_argument, NULL, 'g'},
+        {"tcp", no_argument, NULL, 'C'},            {"host", required_argument, NULL, 'H'},
+        {"port", required_argument, NULL, 'p'},     {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+    };
+    double pos[3] = {0, 0, 0}, att[4] = {1, 0, 0, 0}, sun[3] = {1, 0, 0}, t = 0, v;
+    struct nc_pose_msg m = {.type = NC_MSG_POSE};
+    int tcp = 0, port = 0, c, have_pos = 0;
+    const char *host = "127.0.0.1";
+    optind = 1;
+    while ((c = getopt_long(argc - 1, argv + 1, "P:A:S:t:ce:g:H:p:h", opts, NULL)) != -1) {
+        switch (c) {
+        case 'P': have_pos = parse_vec(optarg, pos, 3) == 0; if (!have_pos) goto bad; break;
+        case 'A': if (parse_vec(optarg, att, 4) < 0) goto bad; break;
+        case 'S': if (parse_vec(optarg, sun, 3) < 0) goto bad; break;
+        case 't': if (parse_vec(optarg, &t, 1) < 0) goto bad; break;
+        case 'c': m.flags |= NC_MSG_CAPTURE; break;
+        case 'R': m.type = NC_MSG_TRIGGER; m.flags |= NC_MSG_CAPTURE; break;
+        case 'e': if (parse_vec(optarg, &v, 1) < 0) goto bad; m.exposure_s = v; m.flags |= NC_MSG_EXPOSURE; break;
+        case 'g': if (parse_vec(optarg, &v, 1) < 0) goto bad; m.gain_db = v; m.flags |= NC_MSG_GAIN; break;
+        case 'C': tcp = 1; break;
+        case 'H': host = optarg; break;
+        case 'p': port = atoi(optarg); break;
+        case 'h': fputs(pose_help, stdout); return 0;
+        default: fputs("Try 'navcam pose send --help'.\n", stderr); return 2;
+        }
+    }
+    if (m.type == NC_MSG_POSE && !have_pos) {
+        fprintf(stderr, "navcam pose send: --position X,Y,Z is required\n");
+        return 2;
+    }
+    m.sim_time_ns = (int64_t)llround(t * 1e9);
+    m.cam_position_m = nc_v3(pos[0], pos[1], pos[2]);
+    m.cam_attitude_q = (struct nc_quat){att[0], att[1], att[2], att[3]};
+    m.sun = nc_v3(sun[0], sun[1], sun[2]);
+    struct nc_client *cl;
+    if (nc_client_connect(host, port ? port : tcp ? 5751 : 5750, tcp, &cl) < 0) {
+        fprintf(stderr, "navcam pose send: %s\n", nc_errmsg());
+        return 1;
+    }
+    long seq = nc_client_send(cl, &m);
+    int rc = seq < 0;
+    if (!rc && tcp && (m.flags & NC_MSG_CAPTURE)) {
+        uint64_t frame;
+        uint32_t status;
+        rc = nc_client_wait_frame(cl, (uint32_t)seq, 60000, &frame, &status) < 0;
+        if (!rc)
+            printf("frame %llu %s\n", (unsigned long long)frame, status == NC_FRAME_DELIVERED ? "delivered" : "dropped");
+    }
+    if (rc)
+        fprintf(stderr, "navcam pose send: %s\n", nc_errmsg());
+    nc_client_close(cl);
+    return rc;
+bad:
+    fprintf(stderr, "navcam pose send: bad value '%s' for --%s\n", optarg, opts[0].name);
+    return 2;
+}

@@ -1,0 +1,208 @@
+/* cmd_render.c - `navcam render`: one frame of a scene to an image file
+ * (radiance, I/F, range, electrons or DN). Argument parsing only; links the
+ * renderer and the camera model, never the emulator. */
+#include <errno.h>
+#include <getopt.h>
+#include <libgen.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "app/cli.h"
+#include "camera/camsys.h"
+#include "camera/load.h"
+#include "core/error.h"
+#include "render/frame_io.h"
+#include "render/image_io.h"
+#include "render/render.h"
+#include "render/scene.h"
+
+static const char render_help[] =
+    "Usage: navcam render [SCENE.yaml] -o OUT [--set KEY=VALUE]... [options]\n"
+    "\n"
+    "Render one frame of SCENE.yaml (or of the built-in default scene) to OUT.\n"
+    "\n"
+    "  -o, --output FILE      output image; the extension picks the format:\n"
+    "                           .exr .tif .fits  float32 physical values\n"
+    "                           .png             16-bit linear preview, 65535 = the\n"
+    "                                            brightest pixel; the scale is in the\n"
+    "                                            file's metadata (navcam:preview_scale)\n"
+    "  -q, --quantity Q       radiance   W m^-2 sr^-1 (default)\n"
+    "                         iof        I/F = pi * radiance / solar irradiance\n"
+    "                         range      distance camera-surface, m (0 = sky)\n"
+    "                         electrons  noise-free photo-electrons through the optics\n"
+    "                                    and PSF: the ground truth of a DN frame\n"
+    "                         dn         the digitised frame: noise, full well, gain,\n"
+    "                                    bias, ADC (16-bit files; 8-bit for an 8-bit ADC)\n"
+    "  -e, --exposure T       exposure time in seconds (default: exposure.time_s)\n"
+    "  -f, --frame N          frame number: keys the noise (default 0)\n"
+    "  -s, --set KEY=VALUE    override any configuration key by its dotted path;\n"
+    "                         VALUE is YAML. Repeatable. Lists index by number:\n"
+    "                           --set camera.position_m=[0,0,-5000]\n"
+    "                           --set bodies.0.material.w=0.07\n"
+    "                           --set render.samples_per_pixel=16\n"
+    "  -j, --threads N        render threads (default: render.threads, else all\n"
+    "                         cores); the image does not depend on N\n"
+    "  -h, --help             this help\n"
+    "\n"
+    "Conventions: positions in metres (double precision); quaternions scalar-first\n"
+    "[w, x, y, z] rotating camera (or body) frame vectors into the scene frame;\n"
+    "camera +Z is the boresight, +X right and +Y down in the image.\n"
+    "Pose, Sun, units and the NavCam version are written into the file's metadata.\n";
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* Electrons (float) or a digitised frame of a rendered radiance image. */
+static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
+                              const struct nc_camsys *cs, double exposure, unsigned long long frame_no, double *scale)
+{
+    size_t n = (size_t)f->width_px * (size_t)f->height_px;
+    float *e = malloc(n * sizeof *e);
+    uint16_t *dn = malloc(n * sizeof *dn);
+    struct nc_image_attr attrs[32];
+    char text[32][200];
+    int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
+    int na = nc_frame_meta(s, q, attrs, text, 32);
+    na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 32 - na);
+    if (rc >= 0 && q == NC_Q_ELECTRONS)
+        rc = nc_image_write(out, e, f->width_px, f->height_px, attrs, na, scale);
+    else if (rc >= 0 && (rc = nc_camsys_digitise(cs, e, exposure, frame_no, dn)) >= 0)
+        rc = nc_image_write_dn(out, dn, f->width_px, f->height_px, cs->sensor.adc_bits, attrs, na);
+    free(e);
+    free(dn);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    nc_cli_init("render");
+    static const struct option opts[] = {
+        {"output", required_argument, NULL, 'o'}, {"quantity", required_argument, NULL, 'q'},
+        {"set", required_argument, NULL, 's'},    {"threads", required_argument, NULL, 'j'},
+        {"exposure", required_argument, NULL, 'e'}, {"frame", required_argument, NULL, 'f'},
+        {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+    };
+    const char *out = NULL, *scene_path = NULL;
+    double exposure = -1;
+    unsigned long long frame_no = 0;
+    const char **sets = calloc((size_t)argc, sizeof *sets);
+    int nsets = 0, threads = 0, c;
+    enum nc_quantity q = NC_Q_RADIANCE;
+    if (!sets)
+        return 1;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "o:q:s:j:e:f:h", opts, NULL)) != -1) {
+        switch (c) {
+        case 'o': out = optarg; break;
+        case 'e':
+        case 'f': {
+            char *end;
+            double v = strtod(optarg, &end);
+            if (*end || !(v >= 0) || !isfinite(v) || (c == 'e' && v > 3600) || (c == 'f' && v != floor(v))) {
+                fprintf(stderr, "navcam render: --%s expects %s, got '%s'\n", c == 'e' ? "exposure" : "frame",
+                        c == 'e' ? "seconds in 0..3600" : "a whole number >= 0", optarg);
+                free(sets);
+                return 2;
+            }
+            if (c == 'e')
+                exposure = v;
+            else
+                frame_no = (unsigned long long)v;
+            break;
+        }
+        case 's': sets[nsets++] = optarg; break;
+        case 'j': {
+            char *end;
+            long v = strtol(optarg, &end, 10);
+            if (*end || v < 1 || v > 1024) {
+                fprintf(stderr, "navcam render: --threads expects 1..1024, got '%s'\n", optarg);
+                free(sets);
+                return 2;
+            }
+            threads = (int)v;
+            break;
+        }
+        case 'q':
+            if (nc_quantity_parse(optarg, &q) < 0) {
+                free(sets);
+                fprintf(stderr, "navcam render: %s\n", nc_errmsg());
+                return 2;
+            }
+            break;
+        case 'h': fputs(render_help, stdout); free(sets); return 0;
+        default: fputs("Try 'navcam render --help'.\n", stderr); free(sets); return 2;
+        }
+    }
+    if (optind < argc)
+        scene_path = argv[optind++];
+    if (optind < argc || !out) {
+        fprintf(stderr, "navcam render: %s\nTry 'navcam render --help'.\n",
+                !out ? "missing -o OUT" : "more than one scene file given");
+        free(sets);
+        return 2;
+    }
+    if (!nc_image_format_ok(out, NULL)) {
+        fprintf(stderr, "navcam render: %s: unsupported output format (use .exr, .tif, .fits or .png)\n", out);
+        free(sets);
+        return 2;
+    }
+    /* Fail before rendering, not after, when OUT cannot be written. */
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", out);
+    if (access(dirname(dir), W_OK) != 0) {
+        fprintf(stderr, "navcam render: %s: cannot write into directory '%s': %s\n", out, dir, strerror(errno));
+        free(sets);
+        return 1;
+    }
+    struct nc_scene scene;
+    struct nc_camsys cs;
+    int rc = nc_setup_load(scene_path, sets, nsets, &scene, &cs);
+    free(sets);
+    if (rc < 0)
+        return nc_cli_fail();
+    if (exposure < 0)
+        exposure = cs.exposure_s;
+    struct nc_renderer r;
+    struct nc_frame f = {0};
+    double t0 = now_ms();
+    if ((rc = nc_renderer_init(&r, &scene, threads)) < 0) {
+        nc_scene_free(&scene);
+        return nc_cli_fail();
+    }
+    double t1 = now_ms();
+    rc = nc_frame_alloc(&f, scene.camera.width_px, scene.camera.height_px);
+    /* Motion during the exposure (camera and body rates) and a rolling
+     * shutter are integrated over the exposure window. */
+    struct nc_exposure ex = {.exposure_s = exposure, .rolling = cs.sensor.shutter == NC_SHUTTER_ROLLING,
+                             .line_time_s = cs.sensor.line_time_s};
+    int tsamples = 1;
+    if (rc >= 0)
+        rc = nc_render_exposure(&r, &scene, &ex, &f, &tsamples);
+    double t2 = now_ms(), scale = 0;
+    if (rc >= 0 && q <= NC_Q_RANGE)
+        rc = nc_frame_write(out, &f, q, &scene, &scale);
+    else if (rc >= 0)
+        rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, &scale);
+    if (rc >= 0) {
+        printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene setup %.1f ms, "
+               "render %.1f ms\n",
+               out, f.width_px, f.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
+               tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
+        if (scale > 0)
+            printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));
+    }
+    nc_frame_free(&f);
+    nc_renderer_free(&r);
+    nc_scene_free(&scene);
+    nc_camsys_free(&cs);
+    return rc < 0 ? nc_cli_fail() : 0;
+}

@@ -1,0 +1,351 @@
+/* camsys_config.c - the camera model from its configuration (camsys.h):
+ * optics (aperture, passband, vignetting, PSF), the sensor's parameters,
+ * and the per-pixel response and fixed patterns they imply. */
+#include "camera/camsys.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera/rng.h"
+#include "core/error.h"
+
+/* Solar spectrum for tabulated passbands: a 5772 K black body (IAU 2015
+ * nominal solar effective temperature), normalised to the total irradiance. */
+#define SUN_TEFF_K 5772.0
+
+static double planck_lambda(double lambda_m, double t_k)
+{
+    const double h = NC_PLANCK_J_S, c = NC_LIGHT_M_S, kb = 1.380649e-23;
+    return 2.0 * h * c * c / pow(lambda_m, 5) / expm1(h * c / (lambda_m * kb * t_k));
+}
+
+/* band_fraction = int B T / int B; wavelength = int B T lambda / int B T. */
+static int passband_table(struct nc_cfg_node *tab, struct nc_optics *o)
+{
+    size_t n = tab->nchild;
+    if (n < 2)
+        return nc_cfg_error(tab, "expected at least two [wavelength_m, transmission] rows");
+    double prev = 0, num = 0, den = 0, wsum = 0;
+    double (*row)[2] = calloc(n, sizeof *row);
+    if (!row)
+        return nc_error(-ENOMEM, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+        struct nc_cfg_node *r = tab->child[i];
+        r->used = 1;
+        if (r->kind != NC_CFG_SEQ || r->nchild != 2) {
+            free(row);
+            return nc_cfg_error(r, "expected [wavelength_m, transmission]");
+        }
+        for (int k = 0; k < 2; k++) {
+            char *end;
+            r->child[k]->used = 1;
+            row[i][k] = strtod(r->child[k]->value ? r->child[k]->value : "", &end);
+            if (!r->child[k]->value || *end || !isfinite(row[i][k])) {
+                free(row);
+                return nc_cfg_error(r->child[k], "expected a number");
+            }
+        }
+        if (!(row[i][0] > 1e-8 && row[i][0] < 1e-4) || !(row[i][1] >= 0 && row[i][1] <= 1) || row[i][0] <= prev) {
+            free(row);
+            return nc_cfg_error(r, "expected increasing wavelengths in metres (1e-8..1e-4) and transmission in 0..1");
+        }
+        prev = row[i][0];
+    }
+    /* Trapezoids on a fine grid inside each table interval. */
+    for (size_t i = 0; i + 1 < n; i++)
+        for (int s = 0; s < 64; s++) {
+            double a = (s + 0.5) / 64, l = row[i][0] + a * (row[i + 1][0] - row[i][0]);
+            double t = row[i][1] + a * (row[i + 1][1] - row[i][1]), dl = (row[i + 1][0] - row[i][0]) / 64;
+            double b = planck_lambda(l, SUN_TEFF_K) * dl;
+            num += b * t;
+            wsum += b * t * l;
+        }
+    /* The whole spectrum, 50 nm to 100 um, on a logarithmic grid. */
+    for (int s = 0; s < 20000; s++) {
+        double l0 = 5e-8 * pow(2000.0, s / 20000.0), l1 = 5e-8 * pow(2000.0, (s + 1) / 20000.0);
+        den += planck_lambda(0.5 * (l0 + l1), SUN_TEFF_K) * (l1 - l0);
+    }
+    free(row);
+    if (!(num > 0))
+        return nc_cfg_error(tab, "the passband transmits nothing");
+    o->band_fraction = num / den;
+    o->wavelength_m = wsum / num;
+    return 0;
+}
+
+static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, struct nc_optics *o)
+{
+    int rc, hn, hd;
+    double d = 0;
+    o->f_number = 8.0;
+    o->transmission = 1.0;
+    o->band_fraction = 1.0;
+    o->wavelength_m = 550e-9;
+    o->vignetting = NC_VIGNETTING_COS4;
+    if (!m)
+        return 0;
+    if ((hn = nc_cfg_double(m, "f_number", 0.3, 1000, &o->f_number)) < 0)
+        return hn;
+    if ((hd = nc_cfg_double(m, "aperture_diameter_m", 1e-6, 100, &d)) < 0)
+        return hd;
+    if (hn && hd)
+        return nc_cfg_error(nc_cfg_get(m, "aperture_diameter_m"), "give either f_number or aperture_diameter_m, not both");
+    if (hd) {
+        if (!(focal_length_m > 0))
+            return nc_cfg_error(nc_cfg_get(m, "aperture_diameter_m"),
+                                "needs camera.focal_length_m (the camera gives fx_px); give f_number instead");
+        o->f_number = focal_length_m / d;
+    }
+    if ((rc = nc_cfg_double(m, "transmission", 0, 1, &o->transmission)) < 0)
+        return rc;
+    struct nc_cfg_node *pb, *tab;
+    int hp = nc_cfg_map(m, "passband", &pb), ht = nc_cfg_seq(m, "passband_table", &tab);
+    if (hp < 0 || ht < 0)
+        return hp < 0 ? hp : ht;
+    if (hp && ht)
+        return nc_cfg_error(tab, "give either passband or passband_table, not both");
+    if (hp && ((rc = nc_cfg_double(pb, "band_fraction", 0, 1, &o->band_fraction)) < 0 ||
+               (rc = nc_cfg_double(pb, "wavelength_m", 1e-8, 1e-4, &o->wavelength_m)) < 0))
+        return rc;
+    if (ht && (rc = passband_table(tab, o)) < 0)
+        return rc;
+    struct nc_cfg_node *vig = nc_cfg_get(m, "vignetting");
+    if (vig && vig->kind == NC_CFG_SCALAR) {
+        static const char *const kinds[] = {"none", "cos4", NULL};
+        int k;
+        if ((rc = nc_cfg_enum(m, "vignetting", kinds, &k)) < 0)
+            return rc;
+        o->vignetting = k == 0 ? NC_VIGNETTING_NONE : NC_VIGNETTING_COS4;
+    } else if (vig) {
+        if (vig->kind != NC_CFG_SEQ || vig->nchild < 2)
+            return nc_cfg_error(vig, "expected none, cos4, or a table [[field_angle_deg, factor], ...]");
+        o->vignetting = NC_VIGNETTING_TABLE;
+        o->nvig = (int)vig->nchild;
+        o->vig_angle_rad = calloc(vig->nchild, sizeof(double));
+        o->vig_factor = calloc(vig->nchild, sizeof(double));
+        if (!o->vig_angle_rad || !o->vig_factor)
+            return nc_error(-ENOMEM, "out of memory");
+        for (size_t i = 0; i < vig->nchild; i++) {
+            struct nc_cfg_node *r = vig->child[i];
+            r->used = 1;
+            double a, f;
+            char *e1 = NULL, *e2 = NULL;
+            if (r->kind != NC_CFG_SEQ || r->nchild != 2 || !r->child[0]->value || !r->child[1]->value ||
+                ((a = strtod(r->child[0]->value, &e1)), *e1) || ((f = strtod(r->child[1]->value, &e2)), *e2) ||
+                !(a >= 0 && a < 90) || !(f >= 0 && f <= 10) || (i && a * M_PI / 180 <= o->vig_angle_rad[i - 1]))
+                return nc_cfg_error(r, "expected [field_angle_deg, factor] with increasing angles in 0..90");
+            r->child[0]->used = r->child[1]->used = 1;
+            o->vig_angle_rad[i] = a * M_PI / 180;
+            o->vig_factor[i] = f;
+        }
+    }
+    struct nc_cfg_node *psf;
+    if ((rc = nc_cfg_map(m, "psf", &psf)) < 0)
+        return rc;
+    if (rc) {
+        static const char *const kinds[] = {"none", "gaussian", "airy", "image", NULL};
+        int k = 0;
+        if ((rc = nc_cfg_enum(psf, "type", kinds, &k)) <= 0)
+            return rc ? rc : nc_cfg_missing(psf, "type", "none, gaussian, airy or image");
+        o->psf.kind = (enum nc_psf_kind)k;
+        if (k == NC_PSF_GAUSSIAN) {
+            if ((rc = nc_cfg_double(psf, "sigma_px", 0.01, 100, &o->psf.sigma_px)) <= 0)
+                return rc ? rc : nc_cfg_missing(psf, "sigma_px", "the Gaussian's standard deviation in pixels");
+        } else if (k == NC_PSF_IMAGE) {
+            const char *file;
+            if ((rc = nc_cfg_string(psf, "file", &file)) <= 0)
+                return rc ? rc : nc_cfg_missing(psf, "file", "a kernel image (odd width and height)");
+            if ((rc = nc_psf_image(file, &o->psf)) < 0) {
+                char why[600];
+                snprintf(why, sizeof why, "%s", nc_errmsg());
+                return nc_cfg_error(nc_cfg_get(psf, "file"), "%s", why);
+            }
+        }
+    }
+    return 0;
+}
+
+static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geom, double pitch_m, struct nc_sensor *s)
+{
+    int rc;
+    long v;
+    memset(s, 0, sizeof *s);
+    s->pixel_pitch_m = pitch_m;
+    s->qe = 1.0;
+    s->shot_noise = 1;
+    s->dark_ref_temp_k = 293.15;
+    s->dark_doubling_k = 6.0;
+    s->temperature_k = s->dark_ref_temp_k;
+    s->full_well_e = 1e5;
+    s->gain_e_per_dn = 1.0;
+    s->adc_bits = 16;
+    s->seed = 1;
+    s->cosmic_track_px = 5;
+    s->cosmic_e_per_px = 1000;
+    if (!m) { /* an ideal noise-free sensor; without a known pitch, no radiometry */
+        s->shot_noise = 0;
+        return 0;
+    }
+    static const char *const bools[] = {"false", "true", NULL};
+    int b;
+    if ((rc = nc_cfg_double(m, "pixel_pitch_m", 1e-8, 1e-2, &s->pixel_pitch_m)) < 0)
+        return rc;
+    if (!(s->pixel_pitch_m > 0))
+        return nc_cfg_missing(m, "pixel_pitch_m", "the pixel pitch in metres (the camera gives fx_px)");
+    if ((rc = nc_cfg_double(m, "qe", 0, 1, &s->qe)) < 0)
+        return rc;
+    if ((rc = nc_cfg_enum(m, "shot_noise", bools, &b)) < 0)
+        return rc;
+    if (rc)
+        s->shot_noise = b;
+    if ((rc = nc_cfg_double(m, "dark_current_e_s", 0, 1e9, &s->dark_current_e_s)) < 0 ||
+        (rc = nc_cfg_double(m, "dark_ref_temp_k", 1, 1000, &s->dark_ref_temp_k)) < 0 ||
+        (rc = nc_cfg_double(m, "dark_doubling_k", 0.1, 1000, &s->dark_doubling_k)) < 0)
+        return rc;
+    s->temperature_k = s->dark_ref_temp_k;
+    if ((rc = nc_cfg_double(m, "temperature_k", 1, 1000, &s->temperature_k)) < 0 ||
+        (rc = nc_cfg_double(m, "dsnu_e_s", 0, 1e9, &s->dsnu_e_s)) < 0 ||
+        (rc = nc_cfg_double(m, "prnu", 0, 1, &s->prnu)) < 0 ||
+        (rc = nc_cfg_double(m, "hot_pixel_fraction", 0, 1, &s->hot_pixel_fraction)) < 0 ||
+        (rc = nc_cfg_double(m, "hot_pixel_dark_e_s", 0, 1e9, &s->hot_pixel_dark_e_s)) < 0 ||
+        (rc = nc_cfg_double(m, "read_noise_e", 0, 1e6, &s->read_noise_e)) < 0 ||
+        (rc = nc_cfg_double(m, "full_well_e", 1, 1e9, &s->full_well_e)) < 0 ||
+        (rc = nc_cfg_double(m, "gain_e_per_dn", 1e-6, 1e9, &s->gain_e_per_dn)) < 0 ||
+        (rc = nc_cfg_double(m, "analog_gain_db", -60, 60, &s->analog_gain_db)) < 0 ||
+        (rc = nc_cfg_double(m, "bias_dn", 0, 65535, &s->bias_dn)) < 0)
+        return rc;
+    if ((rc = nc_cfg_enum(m, "blooming", bools, &b)) < 0)
+        return rc;
+    if (rc)
+        s->blooming = b;
+    if ((rc = nc_cfg_int(m, "adc_bits", 8, 16, &v)) < 0)
+        return rc;
+    if (rc)
+        s->adc_bits = (int)v;
+    if ((rc = nc_cfg_int(m, "seed", 0, 0x7fffffffL, &v)) < 0)
+        return rc;
+    if (rc)
+        s->seed = (uint64_t)v;
+    struct nc_cfg_node *cr;
+    if ((rc = nc_cfg_map(m, "cosmic_rays", &cr)) < 0)
+        return rc;
+    if (rc && ((rc = nc_cfg_double(cr, "rate_cm2_s", 0, 1e6, &s->cosmic_rate_cm2_s)) < 0 ||
+               (rc = nc_cfg_double(cr, "track_length_px", 0, 1e4, &s->cosmic_track_px)) < 0 ||
+               (rc = nc_cfg_double(cr, "e_per_px", 0, 1e9, &s->cosmic_e_per_px)) < 0))
+        return rc;
+    static const char *const shutters[] = {"global", "rolling", NULL};
+    int sh = 0;
+    if ((rc = nc_cfg_enum(m, "shutter", shutters, &sh)) < 0)
+        return rc;
+    s->shutter = (enum nc_shutter)sh;
+    if ((rc = nc_cfg_double(m, "line_time_s", 0, 1, &s->line_time_s)) < 0)
+        return rc;
+    if (s->shutter == NC_SHUTTER_ROLLING && !(s->line_time_s > 0))
+        return nc_cfg_missing(m, "line_time_s", "the delay between successive rows of a rolling shutter, seconds");
+    if (s->bias_dn > ldexp(1.0, s->adc_bits) - 1)
+        return nc_cfg_error(nc_cfg_get(m, "bias_dn"), "bias %g DN does not fit a %d-bit ADC", s->bias_dn, s->adc_bits);
+    (void)geom;
+    return 0;
+}
+
+/* Vignetting factor at field angle theta (rad). */
+static double vignette(const struct nc_optics *o, double theta)
+{
+    if (o->vignetting == NC_VIGNETTING_NONE)
+        return 1.0;
+    if (o->vignetting == NC_VIGNETTING_COS4) {
+        double c = cos(theta);
+        return c * c * c * c;
+    }
+    const double *a = o->vig_angle_rad, *f = o->vig_factor;
+    int n = o->nvig;
+    if (theta <= a[0])
+        return f[0];
+    if (theta >= a[n - 1])
+        return f[n - 1];
+    int i = 1;
+    while (a[i] < theta)
+        i++;
+    double t = (theta - a[i - 1]) / (a[i] - a[i - 1]);
+    return f[i - 1] + t * (f[i] - f[i - 1]);
+}
+
+int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom, double focal_length_m,
+                          struct nc_camsys *cs)
+{
+    memset(cs, 0, sizeof *cs);
+    cs->width_px = geom->width_px;
+    cs->height_px = geom->height_px;
+    cs->exposure_s = 0.01;
+    struct nc_cfg_node *om = NULL, *sm = NULL, *em = NULL;
+    int rc;
+    if ((rc = nc_cfg_map(root, "optics", &om)) < 0 || (rc = nc_cfg_map(root, "sensor", &sm)) < 0 ||
+        (rc = nc_cfg_map(root, "exposure", &em)) < 0)
+        return rc;
+    double pitch = focal_length_m > 0 ? focal_length_m / geom->fx_px : 0;
+    if ((rc = optics_from_config(om, focal_length_m, &cs->optics)) < 0 ||
+        (rc = sensor_from_config(sm, geom, pitch, &cs->sensor)) < 0)
+        goto fail;
+    if (em && (rc = nc_cfg_double(em, "time_s", 0, 3600, &cs->exposure_s)) < 0)
+        goto fail;
+    if (cs->optics.psf.kind == NC_PSF_GAUSSIAN)
+        rc = nc_psf_gaussian(cs->optics.psf.sigma_px, &cs->optics.psf);
+    else if (cs->optics.psf.kind == NC_PSF_AIRY)
+        rc = nc_psf_airy(cs->optics.wavelength_m, cs->optics.f_number, cs->sensor.pixel_pitch_m, &cs->optics.psf);
+    if (rc < 0)
+        goto fail;
+
+    size_t n = (size_t)cs->width_px * (size_t)cs->height_px;
+    cs->response = malloc(n * sizeof(float));
+    cs->prnu_map = malloc(n * sizeof(float));
+    cs->dark_map = malloc(n * sizeof(float));
+    cs->scratch[0] = malloc(n * sizeof(float));
+    cs->scratch[1] = malloc(n * sizeof(float));
+    if (!cs->response || !cs->prnu_map || !cs->dark_map || !cs->scratch[0] || !cs->scratch[1]) {
+        rc = nc_error(-ENOMEM, "out of memory");
+        goto fail;
+    }
+    const struct nc_optics *o = &cs->optics;
+    const struct nc_sensor *s = &cs->sensor;
+    /* Camera equation for an object at infinity: focal-plane irradiance
+     * E = L tau pi / (4 N^2) V(theta); electrons/s = QE E A_pix lambda/(h c). */
+    double k = s->qe * o->band_fraction * o->transmission * M_PI / (4.0 * o->f_number * o->f_number) *
+               s->pixel_pitch_m * s->pixel_pitch_m * o->wavelength_m / (NC_PLANCK_J_S * NC_LIGHT_M_S);
+    double dark = s->dark_current_e_s * exp2((s->temperature_k - s->dark_ref_temp_k) / s->dark_doubling_k);
+    for (int y = 0; y < cs->height_px; y++)
+        for (int x = 0; x < cs->width_px; x++) {
+            size_t p = (size_t)y * (size_t)cs->width_px + (size_t)x;
+            struct nc_vec3 d = nc_camera_ray(geom, x, y);
+            double theta = acos(d.z / nc_v3_norm(d));
+            cs->response[p] = (float)(k * vignette(o, theta));
+            /* Fixed patterns: keyed by the sensor seed only. */
+            double u[4], z1, z2;
+            nc_rng4(s->seed, NC_RNG_FIXED_PATTERN, 0, (uint32_t)p, 0, u);
+            nc_normal2(u[0], u[1], &z1, &z2);
+            cs->prnu_map[p] = (float)fmax(0.0, 1.0 + s->prnu * z1);
+            double dp = fmax(0.0, dark + s->dsnu_e_s * z2);
+            if (u[2] < s->hot_pixel_fraction)
+                dp += s->hot_pixel_dark_e_s;
+            cs->dark_map[p] = (float)dp;
+        }
+    return 0;
+fail:
+    nc_camsys_free(cs);
+    return rc;
+}
+
+void nc_camsys_free(struct nc_camsys *cs)
+{
+    free(cs->response);
+    free(cs->prnu_map);
+    free(cs->dark_map);
+    free(cs->scratch[0]);
+    free(cs->scratch[1]);
+    free(cs->optics.vig_angle_rad);
+    free(cs->optics.vig_factor);
+    nc_psf_free(&cs->optics.psf);
+    memset(cs, 0, sizeof *cs);
+}

@@ -1,0 +1,77 @@
+/* config.h - NavCam configuration tree: YAML files read with libyaml, plus
+ * command-line overrides (--set a.b.c=VALUE), with typed readers.
+ *
+ * Every node remembers the file and line it came from, and whether a reader
+ * consumed it, so that errors name file, line, key and what was expected, and
+ * keys nobody read are reported as unknown. This module knows nothing about
+ * scenes: it must not grow scene-specific logic.
+ */
+#ifndef NC_CONFIG_H
+#define NC_CONFIG_H
+
+#include <stddef.h>
+
+#include "core/vec.h"
+
+enum nc_cfg_kind { NC_CFG_SCALAR, NC_CFG_MAP, NC_CFG_SEQ };
+
+struct nc_cfg_node {
+    enum nc_cfg_kind kind;
+    char *key;   /* key within the parent map, NULL for sequence items and root */
+    char *value; /* scalar text; NULL otherwise */
+    const char *origin; /* file name or "--set ..." (owned by struct nc_cfg) */
+    int line;           /* 1-based; 0 when not from a file */
+    int used;
+    struct nc_cfg_node *parent;
+    struct nc_cfg_node **child;
+    size_t nchild;
+};
+
+struct nc_cfg {
+    struct nc_cfg_node *root;
+    char **origins;
+    size_t norigins;
+};
+
+void nc_cfg_init(struct nc_cfg *cfg);
+void nc_cfg_free(struct nc_cfg *cfg);
+/* Load a whole document; it replaces what was loaded before. */
+int nc_cfg_load_file(struct nc_cfg *cfg, const char *path);
+int nc_cfg_load_string(struct nc_cfg *cfg, const char *text, const char *origin);
+/* Apply "dotted.key=VALUE"; VALUE is YAML (a scalar or a flow list/map).
+ * Sequence items are addressed by index: bodies.0.shape or bodies[0].shape. */
+int nc_cfg_set(struct nc_cfg *cfg, const char *assignment);
+/* Lay top over base: maps merge key by key, scalars and sequences replace.
+ * top's nodes (with their file and line) move into base; top is freed. */
+int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top);
+
+/* Child of a map by key without marking it used (internal to config*.c). */
+struct nc_cfg_node *nc__cfg_find(struct nc_cfg_node *map, const char *key);
+/* Child of a map by key, or NULL. Marks it used. */
+struct nc_cfg_node *nc_cfg_get(struct nc_cfg_node *map, const char *key);
+/* Readers: return 1 when the key was present and valid, 0 when absent
+ * (*out untouched), negative with a message when present but invalid. */
+int nc_cfg_map(struct nc_cfg_node *parent, const char *key, struct nc_cfg_node **out);
+int nc_cfg_seq(struct nc_cfg_node *parent, const char *key, struct nc_cfg_node **out);
+int nc_cfg_double(struct nc_cfg_node *parent, const char *key, double min, double max, double *out);
+int nc_cfg_int(struct nc_cfg_node *parent, const char *key, long min, long max, long *out);
+int nc_cfg_string(struct nc_cfg_node *parent, const char *key, const char **out);
+int nc_cfg_enum(struct nc_cfg_node *parent, const char *key, const char *const *names, int *out);
+int nc_cfg_doubles(struct nc_cfg_node *parent, const char *key, double *out, size_t n);
+int nc_cfg_vec3(struct nc_cfg_node *parent, const char *key, struct nc_vec3 *out);
+/* A unit quaternion [w, x, y, z]; within 1e-3 of unit length it is normalised. */
+int nc_cfg_quat(struct nc_cfg_node *parent, const char *key, struct nc_quat *out);
+
+/* Error helpers that prefix "origin:line: path:" for a node (or the place a
+ * missing key should have been). */
+int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected);
+/* Dotted path of a node, e.g. "bodies[0].shape.radius_m". */
+void nc_cfg_path(const struct nc_cfg_node *node, char *buf, size_t len);
+/* Mark a node and everything below it as consumed (sections a reader
+ * deliberately ignores). */
+void nc_cfg_mark_used(struct nc_cfg_node *node);
+/* First node (depth-first, in file order) that no reader consumed: an error. */
+int nc_cfg_check_unused(struct nc_cfg *cfg);
+
+#endif

@@ -1,0 +1,209 @@
+/* config_read.c - the typed readers of the configuration tree (config.h):
+ * each checks kind, syntax and range and names file, line and key on error,
+ * and marks what it read, so unread keys can be reported as unknown. */
+#include "core/config.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "core/error.h"
+
+/* ---- readers ---------------------------------------------------------- */
+
+struct nc_cfg_node *nc_cfg_get(struct nc_cfg_node *map, const char *key)
+{
+    if (!map || map->kind != NC_CFG_MAP)
+        return NULL;
+    struct nc_cfg_node *n = nc__cfg_find(map, key);
+    if (n)
+        n->used = 1;
+    return n;
+}
+
+static const char *kind_name(enum nc_cfg_kind k)
+{
+    return k == NC_CFG_MAP ? "a map" : k == NC_CFG_SEQ ? "a list" : "a single value";
+}
+
+int nc_cfg_map(struct nc_cfg_node *parent, const char *key, struct nc_cfg_node **out)
+{
+    struct nc_cfg_node *n = nc_cfg_get(parent, key);
+    if (!n)
+        return 0;
+    if (n->kind != NC_CFG_MAP)
+        return nc_cfg_error(n, "expected a map of keys, got %s", kind_name(n->kind));
+    *out = n;
+    return 1;
+}
+
+int nc_cfg_seq(struct nc_cfg_node *parent, const char *key, struct nc_cfg_node **out)
+{
+    struct nc_cfg_node *n = nc_cfg_get(parent, key);
+    if (!n)
+        return 0;
+    if (n->kind != NC_CFG_SEQ)
+        return nc_cfg_error(n, "expected a list, got %s", kind_name(n->kind));
+    *out = n;
+    return 1;
+}
+
+static int scalar_double(struct nc_cfg_node *n, double *out)
+{
+    if (n->kind != NC_CFG_SCALAR)
+        return nc_cfg_error(n, "expected a number, got %s", kind_name(n->kind));
+    char *end;
+    errno = 0;
+    /* YAML spells non-finite floats .nan and .inf: name them as such. */
+    const char *t = n->value + (n->value[0] == '-' || n->value[0] == '+');
+    if (!strcasecmp(t, ".nan") || !strcasecmp(t, ".inf"))
+        return nc_cfg_error(n, "expected a finite number, got \"%s\"", n->value);
+    double v = strtod(n->value, &end);
+    while (*end == ' ')
+        end++;
+    if (end == n->value || *end || errno == ERANGE)
+        return nc_cfg_error(n, "expected a number, got \"%s\"", n->value);
+    if (!isfinite(v))
+        return nc_cfg_error(n, "expected a finite number, got \"%s\"", n->value);
+    n->used = 1;
+    *out = v;
+    return 1;
+}
+
+int nc_cfg_double(struct nc_cfg_node *parent, const char *key, double min, double max, double *out)
+{
+    struct nc_cfg_node *n = nc_cfg_get(parent, key);
+    if (!n)
+        return 0;
+    double v;
+    int rc = scalar_double(n, &v);
+    if (rc < 0)
+        return rc;
+    if (v < min || v > max)
+        return nc_cfg_error(n, "expected a number in [%g, %g], got %s", min, max, n->value);
+    *out = v;
+    return 1;
+}
+
+int nc_cfg_int(struct nc_cfg_node *parent, const char *key, long min, long max, long *out)
+{
+    struct nc_cfg_node *n = nc_cfg_get(parent, key);
+    if (!n)
+        return 0;
+    if (n->kind != NC_CFG_SCALAR)
+        return nc_cfg_error(n, "expected a whole number, got %s", kind_name(n->kind));
+    char *end;
+    errno = 0;
+    long v = strtol(n->value, &end, 10);
+    if (end == n->value || *end || errno)
+        return nc_cfg_error(n, "expected a whole number, got \"%s\"", n->value);
+    if (v < min || v > max)
+        return nc_cfg_error(n, "expected a whole number in [%ld, %ld], got %ld", min, max, v);
+    *out = v;
+    return 1;
+}
+
+int nc_cfg_string(struct nc_cfg_node *parent, const char *key, const char **out)
+{
+    struct nc_cfg_node *n = nc_cfg_get(parent, key);
+    if (!n)
+        return 0;
+    if (n->kind != NC_CFG_SCALAR || !n->value[0])
+        return nc_cfg_error(n, "expected a non-empty text value, got %s", n->kind == NC_CFG_SCALAR ? "nothing" : kind_name(n->kind));
+    *out = n->value;
+    return 1;
+}
+
+int nc_cfg_enum(struct nc_cfg_node *parent, const char *key, const char *const *names, int *out)
+{
+    const char *s = "";
+    int rc = nc_cfg_string(parent, key, &s);
+    if (rc <= 0)
+        return rc;
+    char list[256] = "";
+    for (int i = 0; names[i]; i++) {
+        if (strcmp(names[i], s) == 0) {
+            *out = i;
+            return 1;
+        }
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", names[i]);
+    }
+    return nc_cfg_error(nc_cfg_get(parent, key), "expected one of: %s; got \"%s\"", list, s);
+}
+
+int nc_cfg_doubles(struct nc_cfg_node *parent, const char *key, double *out, size_t n)
+{
+    struct nc_cfg_node *s = nc_cfg_get(parent, key);
+    if (!s)
+        return 0;
+    if (s->kind != NC_CFG_SEQ || s->nchild != n)
+        return nc_cfg_error(s, "expected a list of %zu numbers, got %s", n,
+                            s->kind == NC_CFG_SEQ ? "a list of another length" : kind_name(s->kind));
+    double tmp[16];
+    for (size_t i = 0; i < n && i < 16; i++) {
+        int rc = scalar_double(s->child[i], &tmp[i]);
+        if (rc < 0)
+            return rc;
+    }
+    memcpy(out, tmp, n * sizeof *out);
+    return 1;
+}
+
+int nc_cfg_vec3(struct nc_cfg_node *parent, const char *key, struct nc_vec3 *out)
+{
+    double v[3] = {0};
+    int rc = nc_cfg_doubles(parent, key, v, 3);
+    if (rc == 1)
+        *out = nc_v3(v[0], v[1], v[2]);
+    return rc;
+}
+
+int nc_cfg_quat(struct nc_cfg_node *parent, const char *key, struct nc_quat *out)
+{
+    double v[4] = {0};
+    int rc = nc_cfg_doubles(parent, key, v, 4);
+    if (rc <= 0)
+        return rc;
+    struct nc_quat q = {v[0], v[1], v[2], v[3]};
+    double n = nc_quat_norm(q);
+    if (fabs(n - 1.0) > 1e-3)
+        return nc_cfg_error(nc_cfg_get(parent, key),
+                            "expected a unit quaternion [w, x, y, z] (scalar first), got norm %.9g", n);
+    *out = (struct nc_quat){q.w / n, q.x / n, q.y / n, q.z / n};
+    return 1;
+}
+
+static struct nc_cfg_node *first_unused(struct nc_cfg_node *n)
+{
+    if (!n->used)
+        return n;
+    if (n->kind == NC_CFG_SCALAR)
+        return NULL;
+    for (size_t i = 0; i < n->nchild; i++) {
+        struct nc_cfg_node *u = first_unused(n->child[i]);
+        if (u)
+            return u;
+    }
+    return NULL;
+}
+
+int nc_cfg_check_unused(struct nc_cfg *cfg)
+{
+    if (!cfg->root)
+        return 0;
+    cfg->root->used = 1;
+    struct nc_cfg_node *u = first_unused(cfg->root);
+    if (!u)
+        return 0;
+    return nc_cfg_error(u, "unknown key (see docs/config.md for the keys this section takes)");
+}
+
+void nc_cfg_mark_used(struct nc_cfg_node *n)
+{
+    n->used = 1;
+    for (size_t i = 0; i < n->nchild; i++)
+        nc_cfg_mark_used(n->child[i]);
+}

@@ -1,0 +1,160 @@
+/* serve_internal.h - the emulator's shared state, for the files that make up
+ * `navcam serve` (serve.h) and for nothing else:
+ *   serve.c         life cycle: set-up, the supervising loop, shutdown
+ *   serve_config.c  the `serve:` and `outputs:` sections, opening drivers
+ *   serve_net.c     network input: UDP datagrams, TCP clients, messages
+ *   serve_jobs.c    triggers to frame jobs, the job queue, drops and answers,
+ *                   the camera controls output drivers call
+ *   serve_render.c  the render thread: pose, render, camera model
+ *   serve_output.c  the output thread: drivers, FRAME answers
+ *   serve_stats.c   counters, percentiles, the summary
+ */
+#ifndef NC_SERVE_INTERNAL_H
+#define NC_SERVE_INTERNAL_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "camera/camsys.h"
+#include "emulator/output.h"
+#include "emulator/serve.h"
+#include "emulator/timeline.h"
+#include "emulator/trigger.h"
+#include "navcam/protocol.h"
+#include "render/render.h"
+#include "render/scene.h"
+
+#define NC_SERVE_MAX_OUTPUTS 8
+#define NC_SERVE_MAX_CLIENTS 16
+#define NC_SERVE_LAT_SAMPLES 4096
+
+enum nc__serve_mode { NC__MODE_LOCKSTEP, NC__MODE_FREERUN, NC__MODE_TRIGGER };
+extern const char *const nc__serve_mode_names[];
+
+/* DROP_IGNORED: a capture request the acquisition mode does not take
+ * (free-run, or a software trigger while the trigger source is a line). */
+enum nc__drop_reason {
+    NC__DROP_QUEUE_FULL,
+    NC__DROP_STALE_POSE,
+    NC__DROP_NO_POSE,
+    NC__DROP_OUTPUT_BUSY,
+    NC__DROP_SHUTDOWN,
+    NC__DROP_IGNORED,
+    NC__DROP_COUNT
+};
+extern const char *const nc__serve_drop_names[];
+
+struct nc__job {
+    int64_t trigger_sim_ns, mid_sim_ns, trigger_mono_ns;
+    int64_t ready_mono_ns; /* the earliest a camera could read the frame out: the
+                            * request's arrival (lock-step) or the exposure's end */
+    uint32_t sequence;
+    int client; /* TCP client slot to answer, or -1 */
+    unsigned client_gen;
+    const char *source;
+    double exposure_s, gain_db;
+    int before_poses; /* triggered before any pose: not on the simulator's clock */
+};
+
+struct nc__slot {
+    struct nc_frame_record rec;
+    struct nc__job job;
+    uint16_t *dn;
+};
+
+struct nc__client {
+    int fd;
+    unsigned gen;
+    uint8_t buf[4 + NC_PROTO_MAX_BYTES];
+    size_t have;
+};
+
+struct nc__emu {
+    /* configuration */
+    enum nc__serve_mode mode;
+    double frame_rate_hz, stats_interval_s;
+    int64_t pose_wait_ns; /* triggered frames: wait this long past the exposure for a later pose */
+    int queue_frames, drop_oldest, stale_render, no_pose_scene;
+    char bind[64];
+    int udp_port, tcp_port;
+    const struct nc_driver_registry *drivers;
+    /* the camera */
+    struct nc_scene scene;
+    struct nc_camsys cs;
+    struct nc_renderer renderer;
+    struct nc_output out[NC_SERVE_MAX_OUTPUTS];
+    int nout;
+    int64_t out_msg_ns[NC_SERVE_MAX_OUTPUTS];     /* last failure message, for rate limiting */
+    unsigned long out_quiet[NC_SERVE_MAX_OUTPUTS]; /* failures not printed since */
+    /* trigger sources (not in lock-step): the free-run timer, the line of
+     * serve.trigger when it names a driver, and software commands (built
+     * in: they go straight to the job queue) */
+    struct nc_trigger freerun, line;
+    int have_freerun, have_line;
+    int software_configured;        /* serve.trigger is {driver: software, ...} */
+    struct nc_trigger_counts software_counts; /* under acq_lock */
+    /* acquisition settings (output drivers may change them) */
+    struct nc_acquisition acq;
+    pthread_mutex_t acq_lock;
+    struct nc_camera_control control;
+    /* poses */
+    struct nc_timeline tl;
+    pthread_mutex_t tl_lock;
+    pthread_cond_t tl_cond; /* a pose arrived; CLOCK_MONOTONIC */
+    int64_t sim_anchor_ns, mono_anchor_ns; /* the simulation clock follows the newest pose */
+    int have_anchor;
+    /* jobs */
+    struct nc__job *jobs;
+    int jhead, jcount;
+    pthread_mutex_t jlock;
+    pthread_cond_t jcond;
+    /* finished frames */
+    struct nc__slot *slots;
+    int nslots, shead, scount;
+    pthread_mutex_t slock;
+    pthread_cond_t scond;
+    /* network */
+    int udp_fd, tcp_fd;
+    struct nc__client clients[NC_SERVE_MAX_CLIENTS];
+    pthread_mutex_t client_lock;
+    /* state */
+    atomic_int stop; /* 1: stop taking input; 2: render exits; 3: output exits */
+    uint64_t next_frame;
+    int64_t start_mono_ns;
+    /* statistics */
+    atomic_ulong received, rejected[NC_REJECT_COUNT], dropped[NC__DROP_COUNT], delivered;
+    double lat_ms[NC_SERVE_LAT_SAMPLES], render_ms[NC_SERVE_LAT_SAMPLES];
+    unsigned long nlat;
+    pthread_mutex_t stat_lock;
+    int64_t last_reject_log_ns;
+};
+
+/* serve_config.c */
+int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir);
+
+/* serve_net.c */
+int nc__serve_open_sockets(struct nc__emu *e);
+void nc__serve_close_sockets(struct nc__emu *e);
+void *nc__serve_net_thread(void *arg);
+
+/* serve_jobs.c */
+void nc__serve_lockstep(struct nc__emu *e, const struct nc_pose_msg *m, int client, unsigned gen, int64_t mono);
+void nc__serve_software(struct nc__emu *e, const struct nc_pose_msg *m, int client, unsigned gen, int64_t mono);
+void nc__serve_on_freerun(void *arg, const struct nc_trigger_event *ev);
+void nc__serve_on_line(void *arg, const struct nc_trigger_event *ev);
+void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame, uint32_t status);
+void nc__serve_drop(struct nc__emu *e, const struct nc__job *j, enum nc__drop_reason why);
+void nc__serve_acq_get(struct nc__emu *e, struct nc_acquisition *a);
+void nc__serve_init_control(struct nc__emu *e);
+
+/* serve_render.c, serve_output.c */
+void *nc__serve_render_thread(void *arg);
+void *nc__serve_output_thread(void *arg);
+
+/* serve_stats.c */
+void nc__serve_stats_line(struct nc__emu *e, double elapsed_s);
+void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f);
+
+#endif

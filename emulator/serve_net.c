@@ -1,0 +1,209 @@
+/* serve_net.c - network input (serve_internal.h): one thread polls the UDP
+ * socket, the TCP listener and the TCP clients; it decodes messages, counts
+ * and logs rejections, feeds the pose timeline and hands capture requests
+ * on. It never waits for the render or the outputs. */
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "core/clock.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "emulator/serve_internal.h"
+
+static void log_reject(struct nc__emu *e, enum nc_reject r, const char *from)
+{
+    atomic_fetch_add(&e->rejected[r], 1);
+    int64_t now = nc_mono_ns();
+    if (now - e->last_reject_log_ns > 1000000000) { /* at most one line a second */
+        e->last_reject_log_ns = now;
+        nc_log_warn("emulator/net", "rejected a message from %s: %s (counting; further rejections this second not logged)",
+                    from, nc_reject_name(r));
+    }
+}
+
+static void handle_message(struct nc__emu *e, const uint8_t *buf, size_t len, int client, unsigned gen, const char *from)
+{
+    struct nc_pose_msg m;
+    int64_t now = nc_mono_ns();
+    atomic_fetch_add(&e->received, 1);
+    enum nc_reject r = nc_msg_decode(buf, len, &m);
+    if (r == NC_REJECT_NONE && m.type == NC_MSG_FRAME)
+        r = NC_REJECT_BAD_TYPE; /* FRAME goes the other way */
+    if (r != NC_REJECT_NONE) {
+        log_reject(e, r, from);
+        return;
+    }
+    if (m.type == NC_MSG_POSE) {
+        struct nc_pose p;
+        nc_pose_from_msg(&m, &p);
+        pthread_mutex_lock(&e->tl_lock);
+        r = nc_timeline_push(&e->tl, &p);
+        if (r == NC_REJECT_NONE) {
+            e->sim_anchor_ns = m.sim_time_ns;
+            e->mono_anchor_ns = now;
+            e->have_anchor = 1;
+            pthread_cond_broadcast(&e->tl_cond);
+        }
+        pthread_mutex_unlock(&e->tl_lock);
+        if (r != NC_REJECT_NONE) {
+            log_reject(e, r, from);
+            return;
+        }
+    }
+    if (!(m.flags & NC_MSG_CAPTURE))
+        return; /* a pose alone, or a TRIGGER that asks for nothing */
+    if (m.type == NC_MSG_POSE && e->mode == NC__MODE_LOCKSTEP)
+        nc__serve_lockstep(e, &m, client, gen, now);
+    else
+        nc__serve_software(e, &m, client, gen, now);
+}
+
+int nc__serve_open_sockets(struct nc__emu *e)
+{
+    e->udp_fd = e->tcp_fd = -1;
+    for (int i = 0; i < NC_SERVE_MAX_CLIENTS; i++)
+        e->clients[i].fd = -1;
+    struct sockaddr_in a = {.sin_family = AF_INET};
+    if (inet_pton(AF_INET, e->bind, &a.sin_addr) != 1)
+        return nc_error(NC_ECONFIG, "serve.bind: '%s' is not an IPv4 address", e->bind);
+    int one = 1;
+    if (e->udp_port) {
+        e->udp_fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+        a.sin_port = htons((uint16_t)e->udp_port);
+        if (e->udp_fd < 0 || bind(e->udp_fd, (struct sockaddr *)&a, sizeof a) < 0)
+            return nc_error(-errno, "serve: UDP %s:%d: bind: %s", e->bind, e->udp_port, strerror(errno));
+    }
+    if (e->tcp_port) {
+        e->tcp_fd = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+        a.sin_port = htons((uint16_t)e->tcp_port);
+        if (e->tcp_fd < 0 || setsockopt(e->tcp_fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) < 0 ||
+            bind(e->tcp_fd, (struct sockaddr *)&a, sizeof a) < 0 || listen(e->tcp_fd, 8) < 0)
+            return nc_error(-errno, "serve: TCP %s:%d: %s", e->bind, e->tcp_port, strerror(errno));
+    }
+    return 0;
+}
+
+void nc__serve_close_sockets(struct nc__emu *e)
+{
+    for (int i = 0; i < NC_SERVE_MAX_CLIENTS; i++)
+        if (e->clients[i].fd >= 0) {
+            close(e->clients[i].fd);
+            e->clients[i].fd = -1;
+        }
+    if (e->udp_fd >= 0)
+        close(e->udp_fd);
+    if (e->tcp_fd >= 0)
+        close(e->tcp_fd);
+    e->udp_fd = e->tcp_fd = -1;
+}
+
+static void close_client(struct nc__emu *e, int i)
+{
+    pthread_mutex_lock(&e->client_lock);
+    close(e->clients[i].fd);
+    e->clients[i].fd = -1;
+    e->clients[i].gen++;
+    e->clients[i].have = 0;
+    pthread_mutex_unlock(&e->client_lock);
+}
+
+/* Consume whole length-prefixed messages from a client's buffer. */
+static void client_read(struct nc__emu *e, int i)
+{
+    struct nc__client *c = &e->clients[i];
+    ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
+    if (n <= 0) {
+        if (n == 0 || (errno != EAGAIN && errno != EINTR))
+            close_client(e, i);
+        return;
+    }
+    c->have += (size_t)n;
+    for (;;) {
+        if (c->have < 4)
+            return;
+        uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
+                       (uint32_t)c->buf[3] << 24;
+        if (len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) {
+            /* The stream cannot be resynchronised: count and disconnect. */
+            log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
+            atomic_fetch_add(&e->received, 1);
+            close_client(e, i);
+            return;
+        }
+        if (c->have < 4 + len)
+            return;
+        handle_message(e, c->buf + 4, len, i, c->gen, "a TCP client");
+        memmove(c->buf, c->buf + 4 + len, c->have - 4 - len);
+        c->have -= 4 + len;
+    }
+}
+
+static void read_datagrams(struct nc__emu *e)
+{
+    uint8_t dgram[NC_PROTO_MAX_BYTES + 64];
+    for (;;) { /* drain every datagram; MSG_TRUNC reports a datagram's real size */
+        ssize_t got = recv(e->udp_fd, dgram, sizeof dgram, MSG_TRUNC);
+        if (got < 0)
+            break;
+        if ((size_t)got > sizeof dgram) {
+            atomic_fetch_add(&e->received, 1);
+            log_reject(e, NC_REJECT_OVERSIZED, "UDP");
+            continue;
+        }
+        handle_message(e, dgram, (size_t)got, -1, 0, "UDP");
+    }
+}
+
+static void accept_client(struct nc__emu *e)
+{
+    int fd = accept4(e->tcp_fd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd < 0)
+        return;
+    int slot = -1;
+    for (int i = 0; i < NC_SERVE_MAX_CLIENTS && slot < 0; i++)
+        if (e->clients[i].fd < 0)
+            slot = i;
+    if (slot < 0) {
+        nc_log_warn("emulator/net", "refused a TCP client: all %d client slots are in use", NC_SERVE_MAX_CLIENTS);
+        close(fd);
+        return;
+    }
+    pthread_mutex_lock(&e->client_lock);
+    e->clients[slot].fd = fd;
+    e->clients[slot].have = 0;
+    pthread_mutex_unlock(&e->client_lock);
+}
+
+void *nc__serve_net_thread(void *arg)
+{
+    struct nc__emu *e = arg;
+    while (atomic_load(&e->stop) == 0) {
+        struct pollfd pf[2 + NC_SERVE_MAX_CLIENTS];
+        int map[2 + NC_SERVE_MAX_CLIENTS], n = 0;
+        if (e->udp_fd >= 0)
+            pf[n] = (struct pollfd){e->udp_fd, POLLIN, 0}, map[n++] = -1;
+        if (e->tcp_fd >= 0)
+            pf[n] = (struct pollfd){e->tcp_fd, POLLIN, 0}, map[n++] = -2;
+        for (int i = 0; i < NC_SERVE_MAX_CLIENTS; i++)
+            if (e->clients[i].fd >= 0)
+                pf[n] = (struct pollfd){e->clients[i].fd, POLLIN, 0}, map[n++] = i;
+        if (poll(pf, (nfds_t)n, 50) <= 0)
+            continue;
+        for (int k = 0; k < n; k++) {
+            if (!(pf[k].revents & (POLLIN | POLLHUP | POLLERR)))
+                continue;
+            if (map[k] == -1)
+                read_datagrams(e);
+            else if (map[k] == -2)
+                accept_client(e);
+            else
+                client_read(e, map[k]);
+        }
+    }
+    return NULL;
+}

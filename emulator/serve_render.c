@@ -1,0 +1,143 @@
+/* serve_render.c - the render thread (serve_internal.h): a job -> the pose
+ * at mid-exposure -> render with motion smear -> camera model -> a slot for
+ * the output thread. The only thread that renders. */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "core/clock.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "emulator/serve_internal.h"
+
+/* The next job, or 0 when the thread is to end. */
+static int next_job(struct nc__emu *e, struct nc__job *j)
+{
+    pthread_mutex_lock(&e->jlock);
+    while (e->jcount == 0 && atomic_load(&e->stop) < 2)
+        pthread_cond_wait(&e->jcond, &e->jlock);
+    if (e->jcount == 0) {
+        pthread_mutex_unlock(&e->jlock);
+        return 0;
+    }
+    *j = e->jobs[e->jhead];
+    e->jhead = (e->jhead + 1) % e->queue_frames;
+    e->jcount--;
+    pthread_mutex_unlock(&e->jlock);
+    return 1;
+}
+
+/* Triggered frames are made after the exposure has ended, as in a camera;
+ * with serve.pose_wait_s a pose stream lagging the clock gets that much
+ * longer to pass mid-exposure, so the pose is interpolated. Returns 0 when
+ * shutting down. */
+static int pose_for(struct nc__emu *e, const struct nc__job *j, struct nc_pose *pose, enum nc_pose_quality *q,
+                    int64_t *gap)
+{
+    pthread_mutex_lock(&e->tl_lock);
+    for (;;) {
+        int64_t now = nc_mono_ns(), until = j->ready_mono_ns;
+        if (now >= until && e->mode != NC__MODE_LOCKSTEP && !j->before_poses && e->sim_anchor_ns < j->mid_sim_ns)
+            until += e->pose_wait_ns;
+        if (now >= until || atomic_load(&e->stop) >= 2)
+            break;
+        until = until < now + 50000000 ? until : now + 50000000; /* look at stop now and then */
+        struct timespec ts = {(time_t)(until / 1000000000), (long)(until % 1000000000)};
+        pthread_cond_timedwait(&e->tl_cond, &e->tl_lock, &ts);
+    }
+    if (atomic_load(&e->stop) >= 2) {
+        pthread_mutex_unlock(&e->tl_lock);
+        return 0;
+    }
+    *gap = 0;
+    *q = j->before_poses ? NC_POSE_NONE : nc_timeline_at(&e->tl, j->mid_sim_ns, pose, gap);
+    pthread_mutex_unlock(&e->tl_lock);
+    if (*q == NC_POSE_NONE && e->no_pose_scene) {
+        nc_scene_pose(&e->scene, j->mid_sim_ns, pose);
+        *q = NC_POSE_SCENE;
+    }
+    return 1;
+}
+
+void *nc__serve_render_thread(void *arg)
+{
+    struct nc__emu *e = arg;
+    const int W = e->scene.camera.width_px, H = e->scene.camera.height_px;
+    const size_t n = (size_t)W * (size_t)H;
+    struct nc_frame f;
+    float *el = malloc(n * sizeof *el);
+    if (nc_frame_alloc(&f, W, H) < 0 || !el) {
+        nc_log_error("emulator/render", "out of memory for frames");
+        atomic_store(&e->stop, 2);
+        free(el);
+        return NULL;
+    }
+    struct nc__job j;
+    while (next_job(e, &j)) {
+        struct nc_pose pose;
+        enum nc_pose_quality q;
+        int64_t gap;
+        if (atomic_load(&e->stop) >= 2 || !pose_for(e, &j, &pose, &q, &gap)) {
+            nc__serve_drop(e, &j, NC__DROP_SHUTDOWN);
+            continue;
+        }
+        if (q == NC_POSE_NONE) {
+            nc__serve_drop(e, &j, NC__DROP_NO_POSE);
+            continue;
+        }
+        if (q == NC_POSE_STALE && !e->stale_render) {
+            nc__serve_drop(e, &j, NC__DROP_STALE_POSE);
+            continue;
+        }
+        struct nc_scene at = e->scene; /* shallow: shares meshes and materials */
+        nc_scene_apply_pose(&at, &pose);
+        struct nc_exposure ex = {.exposure_s = j.exposure_s, .rolling = e->cs.sensor.shutter == NC_SHUTTER_ROLLING,
+                                 .line_time_s = e->cs.sensor.line_time_s};
+        int ts = 1;
+        int64_t t0 = nc_mono_ns();
+        int rc = nc_render_exposure(&e->renderer, &at, &ex, &f, &ts);
+        int64_t t1 = nc_mono_ns();
+        /* A free slot for the digitised frame, or drop by policy. */
+        pthread_mutex_lock(&e->slock);
+        if (e->scount == e->nslots) {
+            pthread_mutex_unlock(&e->slock);
+            nc__serve_drop(e, &j, NC__DROP_OUTPUT_BUSY);
+            continue;
+        }
+        struct nc__slot *sl = &e->slots[(e->shead + e->scount) % e->nslots];
+        pthread_mutex_unlock(&e->slock);
+        struct nc_camsys cs = e->cs; /* per-frame gain */
+        cs.sensor.analog_gain_db = j.gain_db;
+        uint64_t frame = e->next_frame++;
+        if (rc >= 0)
+            rc = nc_camsys_electrons(&cs, f.radiance, j.exposure_s, el);
+        if (rc >= 0)
+            rc = nc_camsys_digitise(&cs, el, j.exposure_s, frame, sl->dn);
+        int64_t t2 = nc_mono_ns();
+        if (rc < 0) {
+            nc_log_error("emulator/render", "frame %llu: %s", (unsigned long long)frame, nc_errmsg());
+            nc__serve_drop(e, &j, NC__DROP_OUTPUT_BUSY);
+            continue;
+        }
+        int64_t exp_ns = (int64_t)llround(j.exposure_s * 1e9);
+        int64_t start_sim = j.mid_sim_ns - (int64_t)llround(0.5 * j.exposure_s * 1e9);
+        int64_t start_mono = j.trigger_mono_ns + (start_sim - j.trigger_sim_ns);
+        sl->job = j;
+        sl->rec = (struct nc_frame_record){
+            .frame = frame, .request_sequence = j.sequence, .trigger_source = j.source,
+            .trigger_sim_ns = j.trigger_sim_ns, .exposure_start_sim_ns = start_sim,
+            .exposure_end_sim_ns = start_sim + exp_ns, .trigger_mono_ns = j.trigger_mono_ns,
+            .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = pose,
+            .pose_quality = q, .pose_gap_ns = gap, .exposure_s = j.exposure_s, .gain_db = j.gain_db,
+            .time_samples = ts, .render_ms = (t1 - t0) * 1e-6, .camera_ms = (t2 - t1) * 1e-6, .width_px = W,
+            .height_px = H, .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
+        pthread_mutex_lock(&e->slock);
+        e->scount++;
+        pthread_cond_signal(&e->scond);
+        pthread_mutex_unlock(&e->slock);
+    }
+    nc_frame_free(&f);
+    free(el);
+    return NULL;
+}

@@ -1,0 +1,91 @@
+/* protocol.h - the NavCam pose protocol, version 1 (docs/protocol.md): the
+ * binary messages a dynamics simulator sends. Little-endian, fixed header,
+ * optional blocks selected by flags, CRC-32 trailer. UDP carries one message
+ * per datagram; TCP prefixes each message with its length (u32).
+ *
+ * This module only encodes and decodes; it keeps no state and does no I/O.
+ * Decoding never trusts the input: every way a message can be wrong has its
+ * own reason code, so that the emulator can count and log rejections.
+ */
+#ifndef NC_PROTOCOL_H
+#define NC_PROTOCOL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "navcam/types.h"
+
+#define NC_PROTO_MAGIC 0x4D41434Eu /* bytes "NCAM" */
+#define NC_PROTO_VERSION 1
+#define NC_PROTO_HEADER_BYTES 24
+#define NC_PROTO_MAX_BYTES 1024 /* any valid message is smaller */
+#define NC_PROTO_QUAT_TOL 1e-6  /* | |q| - 1 | allowed, then normalised */
+
+/* POSE and TRIGGER: simulator -> NavCam. FRAME: NavCam -> simulator over
+ * TCP, one per captured request, once the frame is with every output. */
+enum nc_msg_type { NC_MSG_POSE = 1, NC_MSG_TRIGGER = 2, NC_MSG_FRAME = 3 };
+enum nc_frame_status { NC_FRAME_DELIVERED = 0, NC_FRAME_DROPPED = 1 };
+
+enum nc_msg_flags {
+    NC_MSG_SUN_POSITION = 1u << 0, /* sun vector is a position (m), else a direction */
+    NC_MSG_BODY_POSE = 1u << 1,    /* body position and attitude follow */
+    NC_MSG_CAMERA_RATES = 1u << 2, /* camera velocity (m/s, scene) and angular velocity (rad/s, camera) */
+    NC_MSG_BODY_RATES = 1u << 3,   /* body velocity (m/s, scene) and angular velocity (rad/s, body) */
+    NC_MSG_CAPTURE = 1u << 4,      /* capture a frame with this pose (lock-step, software trigger) */
+    NC_MSG_EXPOSURE = 1u << 5,     /* exposure time (s) for the requested frame */
+    NC_MSG_GAIN = 1u << 6,         /* analog gain (dB) for the requested frame */
+};
+#define NC_MSG_KNOWN_FLAGS 0x7Fu
+
+/* Why a message was rejected: one counter each in the emulator. */
+#define NC_REJECT_REASONS(X)                                                                                   \
+    X(TRUNCATED, "truncated")                                                                                  \
+    X(OVERSIZED, "oversized")                                                                                  \
+    X(BAD_MAGIC, "bad magic")                                                                                  \
+    X(BAD_VERSION, "unsupported version")                                                                      \
+    X(BAD_TYPE, "unknown message type")                                                                        \
+    X(BAD_LENGTH, "length field disagrees with the message")                                                   \
+    X(BAD_FLAGS, "unknown flags")                                                                              \
+    X(BAD_CRC, "bad CRC")                                                                                      \
+    X(NOT_FINITE, "NaN or infinite value")                                                                     \
+    X(BAD_QUATERNION, "quaternion not of unit length")                                                         \
+    X(BAD_VALUE, "value out of range")                                                                         \
+    X(TIME_BACKWARDS, "simulation time went backwards")
+
+enum nc_reject {
+    NC_REJECT_NONE = 0,
+#define NC__XREJ(name, text) NC_REJECT_##name,
+    NC_REJECT_REASONS(NC__XREJ)
+#undef NC__XREJ
+        NC_REJECT_COUNT
+};
+
+const char *nc_reject_name(enum nc_reject r);
+
+struct nc_pose_msg {
+    enum nc_msg_type type;
+    uint32_t sequence;
+    uint32_t flags;
+    int64_t sim_time_ns;
+    struct nc_vec3 cam_position_m;    /* scene frame */
+    struct nc_quat cam_attitude_q;    /* camera -> scene */
+    struct nc_vec3 sun;               /* body-fixed frame of bodies[0]: direction, or position (m) */
+    struct nc_vec3 body_position_m;   /* bodies[0], scene frame */
+    struct nc_quat body_attitude_q;   /* bodies[0], body -> scene */
+    struct nc_vec3 cam_velocity_m_s, cam_angular_velocity_rad_s;
+    struct nc_vec3 body_velocity_m_s, body_angular_velocity_rad_s;
+    double exposure_s;
+    double gain_db;
+    uint64_t frame;    /* FRAME: frame number */
+    uint32_t status;   /* FRAME: enum nc_frame_status */
+};
+
+/* Bytes of an encoded message with these flags. */
+size_t nc_msg_size(enum nc_msg_type type, uint32_t flags);
+/* Encode into buf (cap bytes); returns the size, or 0 if cap is too small. */
+size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap);
+/* Decode and validate one message of exactly len bytes. Returns
+ * NC_REJECT_NONE and fills *m, or the reason of the rejection. */
+enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg *m);
+
+#endif

@@ -1,0 +1,119 @@
+/* client.c - navcam/client.h: sockets and framing for simulators. */
+#include "navcam/client.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "core/error.h"
+
+struct nc_client {
+    int fd, tcp;
+    uint32_t next_sequence;
+    uint8_t buf[4 + NC_PROTO_MAX_BYTES];
+    size_t have;
+};
+
+int nc_client_connect(const char *host, int port, int tcp, struct nc_client **out)
+{
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    if (inet_pton(AF_INET, host, &a.sin_addr) != 1)
+        return nc_error(NC_EUSAGE, "'%s' is not a numeric IPv4 address", host);
+    struct nc_client *c = calloc(1, sizeof *c);
+    if (!c)
+        return nc_error(-ENOMEM, "out of memory");
+    c->tcp = tcp;
+    c->next_sequence = 1;
+    c->fd = socket(AF_INET, (tcp ? SOCK_STREAM : SOCK_DGRAM) | SOCK_CLOEXEC, 0);
+    int one = 1;
+    if (c->fd < 0 || (tcp && setsockopt(c->fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one) < 0) ||
+        connect(c->fd, (struct sockaddr *)&a, sizeof a) < 0) {
+        int rc = nc_error(-errno, "%s %s:%d: connect: %s", tcp ? "TCP" : "UDP", host, port, strerror(errno));
+        if (c->fd >= 0)
+            close(c->fd);
+        free(c);
+        return rc;
+    }
+    *out = c;
+    return 0;
+}
+
+long nc_client_send(struct nc_client *c, struct nc_pose_msg *m)
+{
+    uint8_t buf[4 + NC_PROTO_MAX_BYTES];
+    m->sequence = c->next_sequence++;
+    size_t n = nc_msg_encode(m, buf + 4, NC_PROTO_MAX_BYTES);
+    if (!n)
+        return nc_error(NC_ERANGE, "message too large");
+    for (int i = 0; i < 4; i++)
+        buf[i] = (uint8_t)(n >> (8 * i));
+    const uint8_t *p = c->tcp ? buf : buf + 4;
+    size_t len = c->tcp ? n + 4 : n;
+    while (len > 0) {
+        ssize_t w = send(c->fd, p, len, MSG_NOSIGNAL);
+        if (w < 0) {
+            if (errno == EINTR)
+                continue;
+            return nc_error(-errno, "send: %s", strerror(errno));
+        }
+        p += w;
+        len -= (size_t)w;
+    }
+    return (long)m->sequence;
+}
+
+int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms, uint64_t *frame, uint32_t *status)
+{
+    if (!c->tcp)
+        return nc_error(NC_EUNSUPPORTED, "frames are answered over TCP only");
+    struct timespec t0;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (;;) {
+        while (c->have >= 4) {
+            uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
+                           (uint32_t)c->buf[3] << 24;
+            if (len > NC_PROTO_MAX_BYTES)
+                return nc_error(-EPROTO, "bad frame answer length %u", len);
+            if (c->have < 4 + len)
+                break;
+            struct nc_pose_msg m;
+            enum nc_reject r = nc_msg_decode(c->buf + 4, len, &m);
+            memmove(c->buf, c->buf + 4 + len, c->have - 4 - len);
+            c->have -= 4 + len;
+            if (r == NC_REJECT_NONE && m.type == NC_MSG_FRAME && m.sequence == sequence) {
+                *frame = m.frame;
+                *status = m.status;
+                return 0;
+            }
+        }
+        struct timespec t1;
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        long left = timeout_ms - ((t1.tv_sec - t0.tv_sec) * 1000 + (t1.tv_nsec - t0.tv_nsec) / 1000000);
+        if (left <= 0)
+            return nc_error(-ETIMEDOUT, "no frame for request %u within %d ms", sequence, timeout_ms);
+        struct pollfd pf = {c->fd, POLLIN, 0};
+        if (poll(&pf, 1, (int)left) <= 0)
+            continue;
+        ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
+        if (n <= 0)
+            return nc_error(n == 0 ? -ECONNRESET : -errno, "connection closed while waiting for frame %u", sequence);
+        c->have += (size_t)n;
+    }
+}
+
+void nc_client_close(struct nc_client *c)
+{
+    if (!c)
+        return;
+    close(c->fd);
+    free(c);
+}
+
+const char *nc_client_errmsg(void) { return nc_errmsg(); }

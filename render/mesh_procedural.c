@@ -1,0 +1,167 @@
+/* mesh_procedural.c - the built-in procedural asteroid (mesh.h): a
+ * subdivided icosahedron displaced by seeded random relief and craters.
+ * Deterministic from its parameters; no file I/O. */
+#include "render/mesh.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+/* ---- procedural asteroid ---------------------------------------------- */
+
+static uint64_t splitmix64(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static double uniform01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
+
+static struct nc_vec3 random_dir(uint64_t *s)
+{
+    double z = 2 * uniform01(s) - 1, phi = 2 * M_PI * uniform01(s), r = sqrt(1 - z * z);
+    return nc_v3(r * cos(phi), r * sin(phi), z);
+}
+
+/* Edge -> midpoint vertex map, open addressing. */
+struct edge_map {
+    uint64_t *key;
+    uint32_t *val;
+    size_t mask;
+};
+
+static uint32_t midpoint(struct edge_map *em, struct nc_mesh *m, uint32_t a, uint32_t b)
+{
+    uint64_t k = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
+    size_t h = (size_t)((k * 0x9e3779b97f4a7c15ull) >> 20) & em->mask;
+    while (em->key[h] != UINT64_MAX) {
+        if (em->key[h] == k)
+            return em->val[h];
+        h = (h + 1) & em->mask;
+    }
+    double *p = m->v + 3 * m->nv;
+    for (int i = 0; i < 3; i++)
+        p[i] = 0.5 * (m->v[3 * a + i] + m->v[3 * b + i]);
+    double n = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int i = 0; i < 3; i++)
+        p[i] /= n;
+    em->key[h] = k;
+    em->val[h] = (uint32_t)m->nv;
+    return (uint32_t)m->nv++;
+}
+
+int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    if (ap->subdivisions < 0 || ap->subdivisions > 9)
+        return nc_error(NC_ERANGE, "asteroid subdivisions must be 0..9, got %d", ap->subdivisions);
+    size_t nt = 20, nv = 12, ne = 30;
+    for (int i = 0; i < ap->subdivisions; i++) {
+        nv += ne;
+        ne = 2 * ne + 3 * nt;
+        nt *= 4;
+    }
+    struct nc_mesh m = {0};
+    m.v = malloc(nv * 3 * sizeof *m.v);
+    m.tri = malloc(nt * 3 * sizeof *m.tri);
+    uint32_t *tmp = malloc(nt * 3 * sizeof *tmp);
+    struct edge_map em = {0};
+    size_t cap = 64;
+    while (cap < 2 * ne)
+        cap *= 2;
+    em.key = malloc(cap * sizeof *em.key);
+    em.val = malloc(cap * sizeof *em.val);
+    em.mask = cap - 1;
+    if (!m.v || !m.tri || !tmp || !em.key || !em.val) {
+        free(tmp);
+        free(em.key);
+        free(em.val);
+        nc_mesh_free(&m);
+        return nc_error(-ENOMEM, "asteroid: out of memory for %zu triangles", nt);
+    }
+    /* Icosahedron. */
+    const double t = (1 + sqrt(5.0)) / 2;
+    const double iv[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                              {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    const uint32_t it[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                                {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                                {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    double n0 = sqrt(1 + t * t);
+    for (int i = 0; i < 12; i++)
+        for (int k = 0; k < 3; k++)
+            m.v[3 * i + k] = iv[i][k] / n0;
+    memcpy(m.tri, it, sizeof it);
+    m.nv = 12;
+    m.nt = 20;
+    for (int s = 0; s < ap->subdivisions; s++) {
+        memset(em.key, 0xff, cap * sizeof *em.key);
+        size_t n = 0;
+        for (size_t f = 0; f < m.nt; f++) {
+            uint32_t a = m.tri[3 * f], b = m.tri[3 * f + 1], c = m.tri[3 * f + 2];
+            uint32_t ab = midpoint(&em, &m, a, b), bc = midpoint(&em, &m, b, c), ca = midpoint(&em, &m, c, a);
+            const uint32_t nf[4][3] = {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}};
+            memcpy(tmp + 3 * n, nf, sizeof nf);
+            n += 4;
+        }
+        memcpy(m.tri, tmp, n * 3 * sizeof *tmp);
+        m.nt = n;
+    }
+    free(tmp);
+    free(em.key);
+    free(em.val);
+
+    /* Features: centre direction, angular radius (rad), kind. */
+    uint64_t rng = ap->seed ^ 0x4e6176436d417374ull;
+    int nlump = 24, ncr = ap->craters;
+    struct feature { struct nc_vec3 c; double a, amp, cos_reach; } *ft = malloc((size_t)(nlump + ncr) * sizeof *ft);
+    if (!ft) {
+        nc_mesh_free(&m);
+        return nc_error(-ENOMEM, "asteroid: out of memory");
+    }
+    for (int i = 0; i < nlump; i++) {
+        ft[i].c = random_dir(&rng);
+        ft[i].a = 0.35 + 0.65 * uniform01(&rng);
+        ft[i].amp = ap->lump_amplitude * (2 * uniform01(&rng) - 1);
+        ft[i].cos_reach = cos(fmin(M_PI, 3 * ft[i].a));
+    }
+    for (int i = nlump; i < nlump + ncr; i++) {
+        ft[i].c = random_dir(&rng);
+        /* Power-law sizes: many small craters, few large (cumulative ~ a^-1.5). */
+        ft[i].a = fmin(0.5, 0.03 * pow(1 - uniform01(&rng), -1 / 1.5));
+        ft[i].amp = 0.2 * ft[i].a; /* depth/diameter ~ 0.1 */
+        ft[i].cos_reach = cos(fmin(M_PI, 1.8 * ft[i].a));
+    }
+    for (size_t v = 0; v < m.nv; v++) {
+        struct nc_vec3 d = nc_v3(m.v[3 * v], m.v[3 * v + 1], m.v[3 * v + 2]);
+        double h = 0;
+        for (int i = 0; i < nlump + ncr; i++) {
+            double cs = nc_v3_dot(d, ft[i].c);
+            if (cs < ft[i].cos_reach)
+                continue;
+            double x = acos(fmin(1.0, cs)) / ft[i].a;
+            if (i < nlump)
+                h += ft[i].amp * exp(-x * x);
+            else {
+                double bowl = x < 1 ? (x * x - 1) : 0;
+                double rim = 0.25 * exp(-((x - 1) * (x - 1)) / (0.3 * 0.3));
+                h += ft[i].amp * (bowl + rim);
+            }
+        }
+        /* Radius of the ellipsoid along d, then the relative relief. */
+        double q = d.x * d.x / (ap->radii_m.x * ap->radii_m.x) + d.y * d.y / (ap->radii_m.y * ap->radii_m.y) +
+                   d.z * d.z / (ap->radii_m.z * ap->radii_m.z);
+        double r = (1 + h) / sqrt(q);
+        m.v[3 * v] = d.x * r;
+        m.v[3 * v + 1] = d.y * r;
+        m.v[3 * v + 2] = d.z * r;
+    }
+    free(ft);
+    *out = m;
+    return 0;
+}

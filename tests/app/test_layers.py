@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""test_layers.py - the folders are layers, and the build keeps them so.
+
+Checks, on the source tree and the built static libraries:
+  1. includes: every #include "..." of a file in a layer folder resolves to a
+     file in the same or a lower layer (core < render < camera < proto <
+     emulator < drivers < app; include/navcam, the public headers, lowest,
+     and they include nothing internal);
+  2. links: every undefined symbol of a layer's library is defined in a
+     library of the same or a lower layer (no upward call, no link cycle);
+  3. library code never prints to stderr itself (core/log.c does) and never
+     installs a signal handler;
+  4. no source file is over 520 lines, but the render hot path.
+Usage: test_layers.py SOURCE_DIR BUILD_DIR
+"""
+import os
+import re
+import subprocess
+import sys
+
+LAYERS = ["include", "core", "render", "camera", "proto", "emulator", "drivers", "app"]
+RANK = {name: i for i, name in enumerate(LAYERS)}
+LIBS = {"navcam_core": "core", "navcam_render": "render", "navcam_camera": "camera", "navcam_proto": "proto",
+        "navcam_client": "proto", "navcam_emulator": "emulator", "navcam_drivers": "drivers", "navcam_cli": "app"}
+HOT_PATH = {"render/render.c", "render/rt_embree.c"}
+MAX_LINES = 520
+GENERATED = {"core/version.h", "drivers/navcam_genicam_xml.h"}
+
+src, build = sys.argv[1], sys.argv[2]
+failures = []
+checked = 0
+
+
+def layer_of(rel):
+    top = rel.split("/")[0]
+    return top if top in RANK else None
+
+
+def sources():
+    for layer in LAYERS:
+        for root, _, files in os.walk(os.path.join(src, layer)):
+            for f in sorted(files):
+                if f.endswith((".c", ".h", ".cpp", ".c.in", ".h.in")):
+                    yield os.path.relpath(os.path.join(root, f), src)
+
+
+def resolve(rel, inc):
+    here = os.path.dirname(rel)
+    for cand in (os.path.join(here, inc), inc, os.path.join("include", inc)):
+        if os.path.isfile(os.path.join(src, cand)):
+            return os.path.normpath(cand)
+    if inc in GENERATED:
+        return inc
+    return None
+
+
+for rel in sources():
+    layer = layer_of(rel)
+    text = open(os.path.join(src, rel), encoding="utf-8").read()
+    for n, line in enumerate(text.splitlines(), 1):
+        m = re.match(r'\s*#\s*include\s+"([^"]+)"', line)
+        if not m:
+            continue
+        checked += 1
+        target = resolve(rel, m.group(1))
+        if target is None:
+            failures.append(f"{rel}:{n}: #include \"{m.group(1)}\" does not name a file of the tree")
+            continue
+        tl = layer_of(target)
+        if tl is None or RANK[tl] > RANK[layer]:
+            failures.append(f"{rel}:{n}: {layer}/ includes {target} from the higher layer {tl}/")
+    lines = text.count("\n")
+    if lines > MAX_LINES and rel not in HOT_PATH:
+        failures.append(f"{rel}: {lines} lines (at most {MAX_LINES} outside the render hot path)")
+    if layer not in ("app",) and rel != "core/log.c":
+        code = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
+        if re.search(r"\bstderr\b|\bperror\s*\(", code):
+            failures.append(f"{rel}: a library writes to stderr itself (use core/log.h)")
+        if re.search(r"\bsigaction\s*\(|\bsignal\s*\(", code):
+            failures.append(f"{rel}: a library installs a signal handler (the program does that)")
+
+# Links: who defines what, then who needs what.
+defined, needs = {}, {}
+for lib, layer in LIBS.items():
+    path = os.path.join(build, f"lib{lib}.a")
+    if not os.path.isfile(path):
+        failures.append(f"{path}: missing (build first)")
+        continue
+    out = subprocess.run(["nm", "-g", path], capture_output=True, text=True, check=True).stdout
+    needs[lib] = set()
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[1] in "TDBRVWCG":
+            defined.setdefault(parts[2], set()).add(lib)
+        elif len(parts) == 2 and parts[0] == "U":
+            needs[lib].add(parts[1])
+links = 0
+for lib, syms in needs.items():
+    for sym in sorted(syms):
+        for owner in sorted(defined.get(sym, ())):
+            if owner == lib:
+                continue
+            links += 1
+            if RANK[LIBS[owner]] > RANK[LIBS[lib]]:
+                failures.append(f"lib{lib}.a ({LIBS[lib]}/) calls {sym} of lib{owner}.a ({LIBS[owner]}/), a higher layer")
+
+for f in failures:
+    print("FAIL:", f)
+print(f"{checked} includes and {links} cross-library symbol uses checked")
+print(f"{1 if not failures else 0} passed, {1 if failures else 0} failed")
+sys.exit(1 if failures else 0)

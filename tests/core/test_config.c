@@ -1,0 +1,194 @@
+/* test_config.c - configuration errors name file, line, key and what was
+ * expected; unknown keys are errors; --set overrides any key. */
+#include <stdio.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "testutil.h"
+
+static const char base[] =
+    "bodies:\n"
+    "  - shape: {type: sphere, radius_m: 500}\n"
+    "    material: {model: lambert, A: 0.1}\n"
+    "sun:\n"
+    "  direction: [1, 0, 0]\n"
+    "camera:\n"
+    "  width_px: 64\n"
+    "  height_px: 48\n"
+    "  focal_length_m: 0.05\n"
+    "  pixel_pitch_m: 1e-5\n"
+    "  position_m: [0, 0, -5000]\n"
+    "  attitude_q: [1, 0, 0, 0]\n";
+
+/* Load base with one line replaced (or appended), expect an error containing
+ * every needle. */
+static void expect_error(const char *what, const char *find, const char *repl, const char *const *sets, int nsets,
+                         const char *n1, const char *n2)
+{
+    char yaml[4096];
+    const char *at = find ? strstr(base, find) : NULL;
+    if (find && !at) {
+        CHECK(0, "%s: test setup, '%s' not in base", what, find);
+        return;
+    }
+    if (at)
+        snprintf(yaml, sizeof yaml, "%.*s%s%s", (int)(at - base), base, repl, at + strlen(find));
+    else
+        snprintf(yaml, sizeof yaml, "%s%s", base, repl ? repl : "");
+    struct nc_scene s;
+    int rc = nc_test_scene_rc(yaml, sets, nsets, &s);
+    const char *msg = nc_errmsg();
+    CHECK(rc < 0, "%s: expected an error", what);
+    if (rc >= 0) {
+        nc_scene_free(&s);
+        return;
+    }
+    CHECK(nc_test_contains(msg, n1), "%s: message '%s' lacks '%s'", what, msg, n1);
+    if (n2)
+        CHECK(nc_test_contains(msg, n2), "%s: message '%s' lacks '%s'", what, msg, n2);
+    printf("ok  %-28s -> %s\n", what, msg);
+}
+
+int main(void)
+{
+    struct nc_scene s;
+    CHECK(nc_test_scene_rc(base, NULL, 0, &s) == 0, "base scene: %s", nc_errmsg());
+    CHECK(s.camera.fx_px == 5000.0, "fx from focal length / pitch = %g", s.camera.fx_px);
+    CHECK(s.camera.cx_px == 31.5 && s.camera.cy_px == 23.5, "centred principal point (%g, %g)", s.camera.cx_px,
+          s.camera.cy_px);
+    CHECK(s.sun.irradiance_w_m2 == 1361.0, "1 au irradiance %g", s.sun.irradiance_w_m2);
+    nc_scene_free(&s);
+
+    expect_error("unknown key", "  width_px: 64\n", "  width_px: 64\n  exposure: 3\n", NULL, 0,
+                 "test.yaml:8: camera.exposure", "unknown key");
+    expect_error("unknown top-level key", NULL, "lights: 1\n", NULL, 0, "test.yaml:13: lights", "unknown key");
+    expect_error("wrong type", "  position_m: [0, 0, -5000]\n", "  position_m: [0, zero, -5000]\n", NULL, 0,
+                 "test.yaml:11: camera.position_m", "expected a number, got \"zero\"");
+    expect_error("wrong length", "  position_m: [0, 0, -5000]\n", "  position_m: [0, -5000]\n", NULL, 0,
+                 "camera.position_m", "expected a list of 3 numbers");
+    expect_error("missing key", "  width_px: 64\n", "", NULL, 0, "camera.width_px", "missing required key");
+    expect_error("out of range", "A: 0.1}", "A: 1.5}", NULL, 0, "test.yaml:3: bodies[0].material.A",
+                 "expected a number in [0, 1]");
+    expect_error("unknown model", "model: lambert", "model: phong", NULL, 0, "bodies[0].material.model",
+                 "expected one of: lambert");
+    expect_error("non-unit quaternion", "[1, 0, 0, 0]", "[1, 1, 0, 0]", NULL, 0, "camera.attitude_q",
+                 "unit quaternion");
+    expect_error("NaN", "radius_m: 500", "radius_m: .nan", NULL, 0, "bodies[0].shape.radius_m", "finite");
+    expect_error("both intrinsics", "  pixel_pitch_m: 1e-5\n", "  pixel_pitch_m: 1e-5\n  fx_px: 100\n  fy_px: 100\n",
+                 NULL, 0, "camera.", "not both");
+    expect_error("duplicate key", "  height_px: 48\n", "  height_px: 48\n  height_px: 49\n", NULL, 0,
+                 "test.yaml:9", "appears twice");
+    expect_error("YAML syntax", "  height_px: 48\n", "  height_px: [48\n", NULL, 0, "test.yaml:", "YAML syntax error");
+    expect_error("sun both ways", "  direction: [1, 0, 0]\n", "  direction: [1, 0, 0]\n  position_m: [1e11, 0, 0]\n",
+                 NULL, 0, "sun.position_m", "not both");
+    expect_error("missing mesh file", "{type: sphere, radius_m: 500}", "{type: mesh, file: nowhere.obj, unit: km}",
+                 NULL, 0, "test.yaml:2: bodies[0].shape.file", "nowhere.obj: cannot open mesh");
+    expect_error("mesh without unit", "{type: sphere, radius_m: 500}", "{type: mesh, file: x.obj}", NULL, 0,
+                 "bodies[0].shape.unit", "m or km");
+    expect_error("not a square spp", NULL, "render: {samples_per_pixel: 5}\n", NULL, 0, "render.samples_per_pixel",
+                 "square number");
+    {
+        const char *sets[] = {"camera.exposure_s=0.1"};
+        expect_error("--set unknown key", NULL, NULL, sets, 1, "--set camera.exposure_s=0.1", "unknown key");
+    }
+    {
+        const char *sets[] = {"camera.position_m=[0,0"};
+        expect_error("--set bad YAML", NULL, NULL, sets, 1, "--set camera.position_m", "YAML syntax error");
+    }
+    {
+        const char *sets[] = {"bodies.3.material.A=0.5"};
+        expect_error("--set bad index", NULL, NULL, sets, 1, "--set bodies.3", "not an index");
+    }
+
+    /* Materials: presets, overrides of a preset, and their errors. */
+    {
+        const char *sets[] = {"bodies.0.material={preset: comet_67p, theta_bar: 20}"};
+        CHECK(nc_test_scene_rc(base, sets, 1, &s) == 0, "preset: %s", nc_errmsg());
+        CHECK(!strcmp(s.body[0].material.model->name, "hapke") && s.body[0].material.p[0] == 0.055 &&
+                  s.body[0].material.p[7] == 20,
+              "preset comet_67p with theta_bar override");
+        nc_scene_free(&s);
+    }
+    {
+        const char *sets[] = {"bodies.0.material={preset: vesta}"};
+        expect_error("unknown preset", NULL, NULL, sets, 1, "bodies[0].material.preset", "unknown preset 'vesta'");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={preset: moon, model: lambert}"};
+        expect_error("preset vs model", NULL, NULL, sets, 1, "bodies[0].material.model", "is a hapke material");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={model: hapke, b: 0.2}"};
+        expect_error("hapke without w", NULL, NULL, sets, 1, "bodies[0].material", "parameter w is required");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={model: hapke, w: 0.2, B_C0: 1, h_C: 0}"};
+        expect_error("h_C used but 0", NULL, NULL, sets, 1, "bodies[0].material", "h_C must be > 0 when B_C0 > 0");
+    }
+    {
+        const char *sets[] = {"bodies.0.material={model: lommel_seeliger, w: 0.2, A: 0.1}"};
+        expect_error("key of another model", NULL, NULL, sets, 1, "bodies[0].material.A", "unknown key");
+    }
+
+    /* Overrides: dotted paths into maps and lists; new keys; whole subtrees. */
+    const char *sets[] = {"camera.position_m=[0,0,-7000]", "bodies.0.material.A=0.25", "bodies[0].position_m=[1,2,3]",
+                          "sun={direction: [0, 1, 0], distance_au: 2}", "render.samples_per_pixel=9"};
+    CHECK(nc_test_scene_rc(base, sets, 5, &s) == 0, "overrides: %s", nc_errmsg());
+    CHECK(s.camera.position_m.z == -7000.0, "camera.position_m override");
+    CHECK(s.body[0].material.p[0] == 0.25, "material override");
+    CHECK(s.body[0].position_m.y == 2.0, "bodies[0] index syntax");
+    CHECK(s.sun.direction.y == 1.0 && s.sun.irradiance_w_m2 == 1361.0 / 4, "sun subtree override, 1/d^2: %g",
+          s.sun.irradiance_w_m2);
+    CHECK(s.render.samples_per_pixel == 9, "new section created by --set");
+    nc_scene_free(&s);
+
+    /* look_at: the target lands on the principal point. */
+    const char *look[] = {"camera.attitude_q=null", "camera.look_at_m=[300, 200, 100]", "camera.up=[0, 1, 0]"};
+    struct nc_cfg cfg;
+    nc_cfg_init(&cfg);
+    nc_cfg_load_string(&cfg, base, "test.yaml");
+    /* Replacing attitude_q by null leaves a key nobody reads: it must be reported. */
+    for (int i = 0; i < 3; i++)
+        nc_cfg_set(&cfg, look[i]);
+    int rc = nc_scene_from_config(&cfg, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "attitude_q"), "null attitude_q not flagged: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
+    char yaml[4096];
+    const char *at = strstr(base, "  attitude_q");
+    snprintf(yaml, sizeof yaml, "%.*s  look_at_m: [300, 200, 100]\n  up: [0, 1, 0]\n", (int)(at - base), base);
+    CHECK(nc_test_scene_rc(yaml, NULL, 0, &s) == 0, "look_at scene: %s", nc_errmsg());
+    struct nc_vec3 boresight = nc_quat_rotate(s.camera.attitude_q, nc_v3(0, 0, 1));
+    struct nc_vec3 want = nc_v3_unit(nc_v3_sub(nc_v3(300, 200, 100), s.camera.position_m));
+    CHECK(nc_v3_norm(nc_v3_sub(boresight, want)) < 1e-12, "look_at boresight");
+    struct nc_vec3 img_up = nc_quat_rotate(s.camera.attitude_q, nc_v3(0, -1, 0));
+    CHECK(nc_v3_dot(img_up, nc_v3(0, 1, 0)) > 0.9, "look_at 'up' appears up in the image");
+    nc_scene_free(&s);
+
+    /* base: builtin:default - a file laid over the built-in scene; errors
+     * still name the file and line they come from. */
+    char path[4096];
+    snprintf(path, sizeof path, "%s", nc_test_path("over.yaml"));
+    nc_test_write(path, "base: builtin:default\ncamera:\n  width_px: 64\n  height_px: 40\n");
+    /* Read like `navcam render` does: the scene, then the camera model's
+     * sections (optics, sensor, exposure) are the camera model's to check. */
+    nc_cfg_init(&cfg);
+    rc = nc_cfg_load_scene(&cfg, path, NULL, 0);
+    if (rc >= 0)
+        rc = nc_scene_read(&cfg, &s);
+    CHECK(rc == 0, "overlay: %s", nc_errmsg());
+    if (rc == 0) {
+        CHECK(s.camera.width_px == 64 && s.camera.height_px == 40, "overlay: camera size %dx%d", s.camera.width_px,
+              s.camera.height_px);
+        CHECK(s.nbodies == 1 && s.camera.position_m.y == -6000, "overlay: the default scene's body and camera kept");
+        CHECK(nc_cfg_get(cfg.root, "optics") != NULL, "overlay: the default camera model kept");
+        nc_scene_free(&s);
+    }
+    nc_cfg_free(&cfg);
+    nc_test_write(path, "base: builtin:default\ncamera:\n  width_px: 64\n  height_px: forty\n");
+    rc = nc_scene_load(path, NULL, 0, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:4: camera.height_px"), "overlay error: %s", nc_errmsg());
+    nc_test_write(path, "base: builtin:nothing\n");
+    rc = nc_scene_load(path, NULL, 0, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:1: base: unknown base"), "bad base: %s", nc_errmsg());
+    return nc_test_end();
+}

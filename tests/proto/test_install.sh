@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# test_install.sh - NavCam installed into a fresh prefix, used as a lab would:
+# a simulator written against the public header only builds with
+# `pkg-config --cflags --libs navcam-client`, and talks to the installed
+# `navcam serve` (lock-step, loopback): its capture is answered by a FRAME.
+# Usage: test_install.sh BUILD_DIR TMP_DIR NAVCAM(unused: the installed one is run)
+set -euo pipefail
+build=$1 tmp=$2
+pass=0 fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+rm -rf "$tmp"
+mkdir -p "$tmp"
+prefix=$tmp/prefix
+cmake --install "$build" --prefix "$prefix" >"$tmp/install.log"
+pc=$(find "$prefix" -name navcam-client.pc | head -1)
+[ -n "$pc" ] && ok || { bad "no navcam-client.pc installed"; echo "$pass passed, $fail failed"; exit 1; }
+export PKG_CONFIG_PATH=$(dirname "$pc")
+[ -x "$prefix/bin/navcam" ] && [ -x "$prefix/libexec/navcam/navcam-serve" ] && ok || bad "programs not installed"
+# The public headers pull in nothing internal.
+for h in "$prefix"/include/navcam/*.h; do
+  grep -h '#include "' "$h" | grep -vq 'navcam/' && bad "$h includes an internal header" || ok
+done
+
+cat >"$tmp/sim.c" <<'SIM'
+/* A simulator: one lock-step capture, its answer printed. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+#include <navcam/client.h>
+int main(int argc, char **argv)
+{
+    struct nc_client *c = NULL;
+    int port = atoi(argv[1]);
+    for (int i = 0; i < 200 && nc_client_connect("127.0.0.1", port, 1, &c) < 0; i++) {
+        struct timespec ts = {0, 50000000};
+        nanosleep(&ts, NULL);
+    }
+    if (!c) {
+        fprintf(stderr, "sim: %s\n", nc_client_errmsg());
+        return 1;
+    }
+    struct nc_pose_msg m = {.type = NC_MSG_POSE, .flags = NC_MSG_CAPTURE, .sim_time_ns = 1000000000,
+                            .cam_position_m = {0, -6000, 0}, .cam_attitude_q = {0.70710678, -0.70710678, 0, 0},
+                            .sun = {1, 0, 0}};
+    long seq = nc_client_send(c, &m);
+    uint64_t frame = 0;
+    uint32_t status = 9;
+    if (seq < 0 || nc_client_wait_frame(c, (uint32_t)seq, 60000, &frame, &status) < 0) {
+        fprintf(stderr, "sim: %s\n", nc_client_errmsg());
+        return 1;
+    }
+    printf("frame %llu status %u\n", (unsigned long long)frame, status);
+    nc_client_close(c);
+    return status == NC_FRAME_DELIVERED ? 0 : 1;
+}
+SIM
+cc -std=c11 -D_POSIX_C_SOURCE=200809L -Wall -Werror -o "$tmp/sim" "$tmp/sim.c" $(pkg-config --cflags --libs navcam-client) \
+  2>"$tmp/cc.log" && ok || { bad "the simulator does not build against the installed library: $(cat "$tmp/cc.log")"; }
+
+port=$((20000 + RANDOM % 20000))
+"$prefix/bin/navcam" serve --set serve.mode=lockstep --set serve.tcp_port=$port --set serve.udp_port=0 \
+  --set 'outputs=[{driver: null}]' --set camera.width_px=64 --set camera.height_px=48 -n 1 -t 60 \
+  >"$tmp/serve.out" 2>"$tmp/serve.log" &
+serve=$!
+if [ -x "$tmp/sim" ]; then
+  timeout 60 "$tmp/sim" $port >"$tmp/sim.out" 2>&1 && grep -q "frame 0 status 0" "$tmp/sim.out" && ok ||
+    bad "simulator against the installed navcam serve: $(cat "$tmp/sim.out")"
+fi
+wait $serve && ok || bad "installed navcam serve: $(tail -3 "$tmp/serve.log")"
+echo "$pass passed, $fail failed"
+[ $fail -eq 0 ]
