@@ -153,5 +153,6 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
             return rc;
         e->have_freerun = 1;
     }
+    nc__serve_enable_sources(e);
     return open_outputs(cfg, e, config_dir);
 }

@@ -147,6 +147,9 @@ void nc__serve_on_line(void *arg, const struct nc_trigger_event *ev);
 void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame, uint32_t status);
 void nc__serve_drop(struct nc__emu *e, const struct nc__job *j, enum nc__drop_reason why);
 void nc__serve_acq_get(struct nc__emu *e, struct nc_acquisition *a);
+/* Enable the source the acquisition settings name, disable the others
+ * (called with acq_lock held, or before the threads start). */
+void nc__serve_enable_sources(struct nc__emu *e);
 void nc__serve_init_control(struct nc__emu *e);
 
 /* serve_render.c, serve_output.c */

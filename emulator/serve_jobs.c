@@ -132,7 +132,8 @@ void nc__serve_software(struct nc__emu *e, const struct nc_pose_msg *m, int clie
 }
 
 /* Accepted edges of the free-run timer and of the trigger line (their gates
- * have filtered them); each makes a frame only under its acquisition mode. */
+ * have filtered them, and only the source the acquisition is set to is
+ * enabled); the check below covers an edge racing a change of settings. */
 static void on_event(struct nc__emu *e, const struct nc_trigger_event *ev, int line)
 {
     struct nc_acquisition a;
@@ -175,11 +176,21 @@ static int control_set(void *emu, const struct nc_acquisition *a)
         rc = nc_trigger_control(&e->freerun, "rate_hz", (void *)&a->frame_rate_hz);
     if (rc >= 0) {
         e->acq = *a;
-        if (e->have_line)
-            nc_trigger_set_gate(&e->line, a->activation, llround(a->trigger_delay_s * 1e9));
+        nc__serve_enable_sources(e);
     }
     pthread_mutex_unlock(&e->acq_lock);
     return rc;
+}
+
+void nc__serve_enable_sources(struct nc__emu *e)
+{
+    const struct nc_acquisition *a = &e->acq;
+    if (e->have_freerun)
+        nc_trigger_enable(&e->freerun, !a->triggered);
+    if (e->have_line) {
+        nc_trigger_set_gate(&e->line, a->activation, llround(a->trigger_delay_s * 1e9));
+        nc_trigger_enable(&e->line, a->triggered && a->source == NC_SOURCE_LINE);
+    }
 }
 
 static void control_software_trigger(void *emu) { nc__serve_software(emu, NULL, -1, 0, nc_mono_ns()); }

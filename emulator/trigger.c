@@ -43,7 +43,7 @@ static void on_edge(void *sink, const struct nc_trigger_edge *edge)
 {
     struct nc_trigger *t = sink;
     pthread_mutex_lock(&t->lock);
-    int ok = nc_trigger_gate_accept(&t->gate, edge);
+    int ok = t->enabled && nc_trigger_gate_accept(&t->gate, edge);
     int64_t delay = t->gate.delay_ns;
     pthread_mutex_unlock(&t->lock);
     if (ok) {
@@ -69,6 +69,7 @@ int nc_trigger_open(struct nc_trigger *t, const struct nc_trigger_driver *drv, s
     t->drv = drv;
     t->sink = sink;
     t->sink_arg = arg;
+    t->enabled = 1;
     t->gate.activation = (enum nc_trigger_activation)act;
     t->gate.delay_ns = llround(delay_s * 1e9);
     t->gate.debounce_ns = llround(debounce_s * 1e9);
@@ -104,6 +105,13 @@ int nc_trigger_control(struct nc_trigger *t, const char *request, void *arg)
     if (!t->drv->control)
         return NC_EUNSUPPORTED;
     return t->drv->control(t->priv, request, arg);
+}
+
+void nc_trigger_enable(struct nc_trigger *t, int enabled)
+{
+    pthread_mutex_lock(&t->lock);
+    t->enabled = enabled;
+    pthread_mutex_unlock(&t->lock);
 }
 
 void nc_trigger_set_gate(struct nc_trigger *t, enum nc_trigger_activation activation, int64_t delay_ns)

@@ -102,6 +102,7 @@ struct nc_trigger {
     nc_trigger_sink_fn sink;
     void *sink_arg;
     int started;
+    int enabled; /* 0: edges are ignored before the gate (and not counted) */
 };
 
 /* Opens drv with opts (`serve.trigger`, checked against the common keys and
@@ -112,6 +113,10 @@ int nc_trigger_open(struct nc_trigger *t, const struct nc_trigger_driver *drv, s
 int nc_trigger_start(struct nc_trigger *t);
 void nc_trigger_stop(struct nc_trigger *t);
 int nc_trigger_control(struct nc_trigger *t, const char *request, void *arg);
+/* Whether the camera listens to this source now (a camera set to free-run,
+ * or to another trigger source, ignores the line's edges without counting
+ * them). Opened enabled. */
+void nc_trigger_enable(struct nc_trigger *t, int enabled);
 /* Change the gate at run time (camera settings: TriggerActivation, TriggerDelay). */
 void nc_trigger_set_gate(struct nc_trigger *t, enum nc_trigger_activation activation, int64_t delay_ns);
 enum nc_trigger_activation nc_trigger_activation(struct nc_trigger *t);

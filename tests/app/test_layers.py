@@ -10,7 +10,8 @@ Checks, on the source tree and the built static libraries:
      library of the same or a lower layer (no upward call, no link cycle);
   3. library code never prints to stderr itself (core/log.c does) and never
      installs a signal handler;
-  4. no source file is over 520 lines, but the render hot path.
+  4. no source file (tests and benchmarks too) is over 520 lines, but the
+     render hot path.
 Usage: test_layers.py SOURCE_DIR BUILD_DIR
 """
 import os
@@ -78,6 +79,16 @@ for rel in sources():
             failures.append(f"{rel}: a library writes to stderr itself (use core/log.h)")
         if re.search(r"\bsigaction\s*\(|\bsignal\s*\(", code):
             failures.append(f"{rel}: a library installs a signal handler (the program does that)")
+
+# Tests and benchmarks: the same size limit.
+for top in ("tests", "bench"):
+    for root, _, files in os.walk(os.path.join(src, top)):
+        for f in sorted(files):
+            if f.endswith((".c", ".h", ".py", ".sh")):
+                rel = os.path.relpath(os.path.join(root, f), src)
+                lines = open(os.path.join(src, rel), encoding="utf-8").read().count("\n")
+                if lines > MAX_LINES:
+                    failures.append(f"{rel}: {lines} lines (at most {MAX_LINES})")
 
 # Links: who defines what, then who needs what.
 defined, needs = {}, {}

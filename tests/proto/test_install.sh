@@ -55,7 +55,10 @@ int main(int argc, char **argv)
     return status == NC_FRAME_DELIVERED ? 0 : 1;
 }
 SIM
-cc -std=c11 -D_POSIX_C_SOURCE=200809L -Wall -Werror -o "$tmp/sim" "$tmp/sim.c" $(pkg-config --cflags --libs navcam-client) \
+# A sanitizer build installs an instrumented library: the simulator must be too.
+san=()
+grep -q '^CMAKE_BUILD_TYPE:STRING=Asan' "$build/CMakeCache.txt" && san=(-fsanitize=address,undefined)
+cc -std=c11 -D_POSIX_C_SOURCE=200809L -Wall -Werror "${san[@]}" -o "$tmp/sim" "$tmp/sim.c" $(pkg-config --cflags --libs navcam-client) \
   2>"$tmp/cc.log" && ok || { bad "the simulator does not build against the installed library: $(cat "$tmp/cc.log")"; }
 
 port=$((20000 + RANDOM % 20000))
@@ -66,6 +69,8 @@ serve=$!
 if [ -x "$tmp/sim" ]; then
   timeout 60 "$tmp/sim" $port >"$tmp/sim.out" 2>&1 && grep -q "frame 0 status 0" "$tmp/sim.out" && ok ||
     bad "simulator against the installed navcam serve: $(cat "$tmp/sim.out")"
+else
+  kill $serve 2>/dev/null || true
 fi
 wait $serve && ok || bad "installed navcam serve: $(tail -3 "$tmp/serve.log")"
 echo "$pass passed, $fail failed"
