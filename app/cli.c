@@ -14,8 +14,6 @@ void nc_cli_init(const char *command)
     nc_log_set_program(name);
 }
 
-const char *nc_cli_name(void) { return name; }
-
 int nc_cli_fail(void)
 {
     fprintf(stderr, "%s: %s\n", name, nc_errmsg());

@@ -9,7 +9,5 @@
 void nc_cli_init(const char *command);
 /* Prints "navcam CMD: <last error>" and returns 1 (the exit status). */
 int nc_cli_fail(void);
-/* The program name set by nc_cli_init. */
-const char *nc_cli_name(void);
 
 #endif

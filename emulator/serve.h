@@ -28,11 +28,6 @@ struct nc_serve_options {
     const volatile sig_atomic_t *stop; /* non-zero: shut down (set from a signal handler); may be NULL */
 };
 
-/* The built-in trigger source: software commands (TRIGGER messages, POSE
- * with CAPTURE, a client's TriggerSoftware); `serve.trigger: {driver:
- * software}` selects it. Its keys: */
-extern const struct nc_param nc_serve_software_params[];
-
 /* Runs until *opt->stop (or a limit above); returns 0 after a clean
  * shutdown, negative with a message on a setup error. */
 int nc_serve(const struct nc_serve_options *opt);

@@ -12,7 +12,9 @@
 
 const char *const nc__serve_mode_names[] = {"lockstep", "freerun", "trigger", NULL};
 
-const struct nc_param nc_serve_software_params[] = {NC_P_END};
+/* The built-in software source (TRIGGER messages, POSE with CAPTURE, a
+ * client's TriggerSoftware) takes only the common keys. */
+static const struct nc_param software_params[] = {NC_P_END};
 
 /* `serve.trigger`: a line driver, or the built-in software source. */
 static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr)
@@ -21,7 +23,7 @@ static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr)
     const struct nc_trigger_driver *d = nc_registry_select_trigger(e->drivers, tr, "software", &builtin, &rc);
     if (builtin) {
         /* Software commands: no line, so no activation or debounce. */
-        const struct nc_param *const tables[] = {nc_trigger_common_params, nc_serve_software_params};
+        const struct nc_param *const tables[] = {nc_trigger_common_params, software_params};
         double delay_s = 0;
         if ((rc = nc_params_check(tr, tables, 2, "trigger source 'software'")) < 0)
             return rc;

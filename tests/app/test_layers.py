@@ -30,6 +30,7 @@ GENERATED = {"core/version.h", "drivers/navcam_genicam_xml.h"}
 src, build = sys.argv[1], sys.argv[2]
 failures = []
 checked = 0
+edges = {}  # (from layer, to layer) -> number of includes: the include graph
 
 
 def layer_of(rel):
@@ -68,6 +69,8 @@ for rel in sources():
             failures.append(f"{rel}:{n}: #include \"{m.group(1)}\" does not name a file of the tree")
             continue
         tl = layer_of(target)
+        if tl is not None and tl != layer:
+            edges[(layer, tl)] = edges.get((layer, tl), 0) + 1
         if tl is None or RANK[tl] > RANK[layer]:
             failures.append(f"{rel}:{n}: {layer}/ includes {target} from the higher layer {tl}/")
     lines = text.count("\n")
@@ -115,6 +118,9 @@ for lib, syms in needs.items():
             if RANK[LIBS[owner]] > RANK[LIBS[lib]]:
                 failures.append(f"lib{lib}.a ({LIBS[lib]}/) calls {sym} of lib{owner}.a ({LIBS[owner]}/), a higher layer")
 
+print("include graph between folders (from -> to: includes):")
+for (a, b), n in sorted(edges.items(), key=lambda e: (RANK[e[0][0]], RANK[e[0][1]])):
+    print(f"  {a:9s} -> {b:9s} {n:3d}{'' if RANK[b] < RANK[a] else '   UPWARD'}")
 for f in failures:
     print("FAIL:", f)
 print(f"{checked} includes and {links} cross-library symbol uses checked")
