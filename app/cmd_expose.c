@@ -106,11 +106,13 @@ int main(int argc, char **argv)
         T = cs.exposure_s;
     if (dark)
         L = 0;
+    /* The uniform field fills the PSF's margin too, as a lens sees it. */
     size_t n = (size_t)geom.width_px * (size_t)geom.height_px, nf = (size_t)nframes;
-    float *rad = malloc(n * sizeof *rad), *e = malloc(n * sizeof *e);
+    size_t nr = (size_t)cs.render_width_px * (size_t)cs.render_height_px;
+    float *rad = malloc(nr * sizeof *rad), *e = malloc(n * sizeof *e);
     uint16_t *dn = malloc(n * nf * sizeof *dn);
     int ok = rad && e && dn;
-    for (size_t i = 0; ok && i < n; i++)
+    for (size_t i = 0; ok && i < nr; i++)
         rad[i] = (float)L;
     ok = ok && nc_camsys_electrons(&cs, rad, T, e) >= 0;
     int is_fits = strstr(out, ".fits") || strstr(out, ".fit") || strstr(out, ".fts");

@@ -61,11 +61,13 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-/* Electrons (float) or a digitised frame of a rendered radiance image. */
+/* Electrons (float) or a digitised frame of a rendered radiance image (the
+ * camera model's render size: the sensor plus the PSF's margin). */
 static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
                               const struct nc_camsys *cs, double exposure, unsigned long long frame_no, double *scale)
 {
-    size_t n = (size_t)f->width_px * (size_t)f->height_px;
+    const int W = cs->width_px, H = cs->height_px;
+    size_t n = (size_t)W * (size_t)H;
     float *e = malloc(n * sizeof *e);
     uint16_t *dn = malloc(n * sizeof *dn);
     struct nc_image_attr attrs[32];
@@ -74,9 +76,9 @@ static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc
     int na = nc_frame_meta(s, q, attrs, text, 32);
     na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 32 - na);
     if (rc >= 0 && q == NC_Q_ELECTRONS)
-        rc = nc_image_write(out, e, f->width_px, f->height_px, attrs, na, scale);
+        rc = nc_image_write(out, e, W, H, attrs, na, scale);
     else if (rc >= 0 && (rc = nc_camsys_digitise(cs, e, exposure, frame_no, dn)) >= 0)
-        rc = nc_image_write_dn(out, dn, f->width_px, f->height_px, cs->sensor.adc_bits, attrs, na);
+        rc = nc_image_write_dn(out, dn, W, H, cs->sensor.adc_bits, attrs, na);
     free(e);
     free(dn);
     return rc;
@@ -179,14 +181,19 @@ int main(int argc, char **argv)
         return nc_cli_fail();
     }
     double t1 = now_ms();
-    rc = nc_frame_alloc(&f, scene.camera.width_px, scene.camera.height_px);
+    /* Electrons and DN go through the camera model, whose PSF needs the
+     * light from a margin around the field: render that larger image. */
+    struct nc_scene drawn = scene;
+    if (q > NC_Q_RANGE)
+        nc_camsys_render_camera(&cs, &scene.camera, &drawn.camera);
+    rc = nc_frame_alloc(&f, drawn.camera.width_px, drawn.camera.height_px);
     /* Motion during the exposure (camera and body rates) and a rolling
      * shutter are integrated over the exposure window. */
     struct nc_exposure ex = {.exposure_s = exposure, .rolling = cs.sensor.shutter == NC_SHUTTER_ROLLING,
                              .line_time_s = cs.sensor.line_time_s};
     int tsamples = 1;
     if (rc >= 0)
-        rc = nc_render_exposure(&r, &scene, &ex, &f, &tsamples);
+        rc = nc_render_exposure(&r, &drawn, &ex, &f, &tsamples);
     double t2 = now_ms(), scale = 0;
     if (rc >= 0 && q <= NC_Q_RANGE)
         rc = nc_frame_write(out, &f, q, &scene, &scale);
@@ -195,7 +202,7 @@ int main(int argc, char **argv)
     if (rc >= 0) {
         printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene setup %.1f ms, "
                "render %.1f ms\n",
-               out, f.width_px, f.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
+               out, scene.camera.width_px, scene.camera.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
                tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
         if (scale > 0)
             printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));

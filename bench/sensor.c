@@ -52,11 +52,13 @@ int main(int argc, char **argv)
         return 1;
     }
     const size_t n = 1024 * 1024;
-    float *rad = malloc(n * sizeof *rad), *e = malloc(n * sizeof *e);
+    const int RW = cs.render_width_px; /* the sensor and the PSF's margin */
+    const size_t nr = (size_t)RW * (size_t)cs.render_height_px;
+    float *rad = malloc(nr * sizeof *rad), *e = malloc(n * sizeof *e);
     uint16_t *dn = malloc(n * sizeof *dn);
     /* A radiance image with structure: a disk with a gradient, dark sky. */
-    for (size_t i = 0; i < n; i++) {
-        double x = (double)(i % 1024) - 512, y = (double)(i / 1024) - 512;
+    for (size_t i = 0; i < nr; i++) {
+        double x = (double)(i % RW) - RW / 2, y = (double)(i / RW) - RW / 2;
         rad[i] = x * x + y * y < 300.0 * 300.0 ? (float)(2.0 + 3.0 * (x + 300) / 600) : 0.0f;
     }
     double *te = calloc((size_t)frames, sizeof *te), *td = calloc((size_t)frames, sizeof *td),

@@ -37,11 +37,18 @@ int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, doubl
     if (!(cs->sensor.pixel_pitch_m > 0))
         return nc_error(NC_ECONFIG, "electrons and DN need the pixel pitch: set camera.focal_length_m with "
                                     "camera.pixel_pitch_m, or sensor.pixel_pitch_m");
-    size_t n = (size_t)cs->width_px * (size_t)cs->height_px;
-    float *tmp = cs->optics.psf.size > 1 ? cs->scratch[0] : electrons;
-    scale_row(radiance, cs->response, exposure_s, n, tmp);
-    if (tmp != electrons)
-        return nc_psf_apply_scratch(&cs->optics.psf, tmp, electrons, cs->width_px, cs->height_px, cs->scratch[1]);
+    const int RW = cs->render_width_px, RH = cs->render_height_px, m = cs->margin_px;
+    if (cs->optics.psf.size <= 1) { /* no margin: straight into the sensor's image */
+        scale_row(radiance, cs->response, exposure_s, (size_t)RW * (size_t)RH, electrons);
+        return 0;
+    }
+    scale_row(radiance, cs->response, exposure_s, (size_t)RW * (size_t)RH, cs->scratch[0]);
+    int rc = nc_psf_apply_scratch(&cs->optics.psf, cs->scratch[0], cs->scratch[2], RW, RH, cs->scratch[1]);
+    if (rc < 0)
+        return rc;
+    for (int y = 0; y < cs->height_px; y++)
+        memcpy(electrons + (size_t)y * cs->width_px, cs->scratch[2] + (size_t)(y + m) * RW + m,
+               (size_t)cs->width_px * sizeof *electrons);
     return 0;
 }
 

@@ -66,12 +66,16 @@ struct nc_sensor {
 struct nc_camsys {
     struct nc_optics optics;
     struct nc_sensor sensor;
-    int width_px, height_px;
+    int width_px, height_px;     /* the sensor */
+    /* The radiance image the renderer draws for it: margin_px (the PSF's half
+     * width) more on every side, so light from just outside the field
+     * reaches the edge pixels as through a real lens. */
+    int margin_px, render_width_px, render_height_px;
     double exposure_s;           /* default exposure (config `exposure.time_s`) */
-    float *response;             /* e- per (W m^-2 sr^-1) per second, per pixel (optics, QE, vignetting) */
-    float *prnu_map;             /* 1 + PRNU pattern */
-    float *dark_map;             /* e-/s per pixel at the operating temperature */
-    float *scratch[2];           /* frame-sized work buffers: a camsys serves one thread at a time */
+    float *response;             /* e- per (W m^-2 sr^-1) per second, per rendered pixel (optics, QE, vignetting) */
+    float *prnu_map;             /* 1 + PRNU pattern, per sensor pixel */
+    float *dark_map;             /* e-/s per sensor pixel at the operating temperature */
+    float *scratch[3];           /* render-sized work buffers: a camsys serves one thread at a time */
 };
 
 /* Read `optics`, `sensor` and `exposure` under root (each optional; defaults
@@ -81,7 +85,13 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
                           struct nc_camsys *cs);
 void nc_camsys_free(struct nc_camsys *cs);
 
-/* Noise-free photo-electrons (after optics and PSF): the ground truth. */
+/* The camera the renderer draws with for this camera model: geom with the
+ * margin on every side (size render_width_px x render_height_px, principal
+ * point moved by margin_px); out may be geom. */
+void nc_camsys_render_camera(const struct nc_camsys *cs, const struct nc_camera *geom, struct nc_camera *out);
+/* Noise-free photo-electrons (after optics and PSF): the ground truth.
+ * radiance is render_width_px x render_height_px (nc_camsys_render_camera);
+ * electrons is width_px x height_px. */
 int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, double exposure_s, float *electrons);
 /* A frame in DN from noise-free photo-electrons: fixed patterns, dark current,
  * shot noise, cosmic rays, full well and blooming, read noise, gain, bias and

@@ -22,13 +22,37 @@ static double planck_lambda(double lambda_m, double t_k)
     return 2.0 * h * c * c / pow(lambda_m, 5) / expm1(h * c / (lambda_m * kb * t_k));
 }
 
-/* band_fraction = int B T / int B; wavelength = int B T lambda / int B T. */
+/* A passband through the solar spectrum: band_fraction = int B T / int B,
+ * wavelength = int B T lambda / int B T (the energy-weighted effective
+ * wavelength, which turns in-band power into photons). row[i] = {lambda_m,
+ * transmission}, linear between rows; n >= 2, wavelengths increasing. */
+static void passband_integrate(const double (*row)[2], size_t n, struct nc_optics *o)
+{
+    double num = 0, den = 0, wsum = 0;
+    /* Midpoints of a fine grid inside each table interval. */
+    for (size_t i = 0; i + 1 < n; i++)
+        for (int s = 0; s < 64; s++) {
+            double a = (s + 0.5) / 64, l = row[i][0] + a * (row[i + 1][0] - row[i][0]);
+            double t = row[i][1] + a * (row[i + 1][1] - row[i][1]), dl = (row[i + 1][0] - row[i][0]) / 64;
+            double b = planck_lambda(l, SUN_TEFF_K) * dl;
+            num += b * t;
+            wsum += b * t * l;
+        }
+    /* The whole spectrum, 50 nm to 100 um, on a logarithmic grid. */
+    for (int s = 0; s < 20000; s++) {
+        double l0 = 5e-8 * pow(2000.0, s / 20000.0), l1 = 5e-8 * pow(2000.0, (s + 1) / 20000.0);
+        den += planck_lambda(0.5 * (l0 + l1), SUN_TEFF_K) * (l1 - l0);
+    }
+    o->band_fraction = num / den;
+    o->wavelength_m = num > 0 ? wsum / num : 0;
+}
+
 static int passband_table(struct nc_cfg_node *tab, struct nc_optics *o)
 {
     size_t n = tab->nchild;
     if (n < 2)
         return nc_cfg_error(tab, "expected at least two [wavelength_m, transmission] rows");
-    double prev = 0, num = 0, den = 0, wsum = 0;
+    double prev = 0;
     double (*row)[2] = calloc(n, sizeof *row);
     if (!row)
         return nc_error(-ENOMEM, "out of memory");
@@ -54,25 +78,39 @@ static int passband_table(struct nc_cfg_node *tab, struct nc_optics *o)
         }
         prev = row[i][0];
     }
-    /* Trapezoids on a fine grid inside each table interval. */
-    for (size_t i = 0; i + 1 < n; i++)
-        for (int s = 0; s < 64; s++) {
-            double a = (s + 0.5) / 64, l = row[i][0] + a * (row[i + 1][0] - row[i][0]);
-            double t = row[i][1] + a * (row[i + 1][1] - row[i][1]), dl = (row[i + 1][0] - row[i][0]) / 64;
-            double b = planck_lambda(l, SUN_TEFF_K) * dl;
-            num += b * t;
-            wsum += b * t * l;
-        }
-    /* The whole spectrum, 50 nm to 100 um, on a logarithmic grid. */
-    for (int s = 0; s < 20000; s++) {
-        double l0 = 5e-8 * pow(2000.0, s / 20000.0), l1 = 5e-8 * pow(2000.0, (s + 1) / 20000.0);
-        den += planck_lambda(0.5 * (l0 + l1), SUN_TEFF_K) * (l1 - l0);
-    }
+    passband_integrate((const double (*)[2])row, n, o);
     free(row);
-    if (!(num > 0))
+    if (!(o->band_fraction > 0))
         return nc_cfg_error(tab, "the passband transmits nothing");
-    o->band_fraction = num / den;
-    o->wavelength_m = wsum / num;
+    return 0;
+}
+
+/* `optics.passband`: either the band as it acts on the Sun (band_fraction
+ * and wavelength_m, computed elsewhere), or its edges (from_m, to_m: a flat
+ * filter, integrated here through the 5772 K solar spectrum). */
+static int passband_map(struct nc_cfg_node *pb, struct nc_optics *o)
+{
+    double from = 0, to = 0;
+    int hb, hw, hf, ht;
+    if ((hb = nc_cfg_double(pb, "band_fraction", 0, 1, &o->band_fraction)) < 0)
+        return hb;
+    if ((hw = nc_cfg_double(pb, "wavelength_m", 1e-8, 1e-4, &o->wavelength_m)) < 0)
+        return hw;
+    if ((hf = nc_cfg_double(pb, "from_m", 1e-8, 1e-4, &from)) < 0)
+        return hf;
+    if ((ht = nc_cfg_double(pb, "to_m", 1e-8, 1e-4, &to)) < 0)
+        return ht;
+    if ((hb || hw) && (hf || ht))
+        return nc_cfg_error(pb, "give either band_fraction and wavelength_m, or from_m and to_m (the band's edges), "
+                                "not both");
+    if (!(hf || ht))
+        return 0;
+    if (!hf || !ht)
+        return nc_cfg_missing(pb, hf ? "to_m" : "from_m", "both edges of the band, in metres");
+    if (!(to > from))
+        return nc_cfg_error(nc_cfg_get(pb, "to_m"), "expected to_m > from_m, got %g <= %g", to, from);
+    const double row[2][2] = {{from, 1}, {to, 1}};
+    passband_integrate(row, 2, o);
     return 0;
 }
 
@@ -107,8 +145,7 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
         return hp < 0 ? hp : ht;
     if (hp && ht)
         return nc_cfg_error(tab, "give either passband or passband_table, not both");
-    if (hp && ((rc = nc_cfg_double(pb, "band_fraction", 0, 1, &o->band_fraction)) < 0 ||
-               (rc = nc_cfg_double(pb, "wavelength_m", 1e-8, 1e-4, &o->wavelength_m)) < 0))
+    if (hp && (rc = passband_map(pb, o)) < 0)
         return rc;
     if (ht && (rc = passband_table(tab, o)) < 0)
         return rc;
@@ -193,6 +230,13 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
     int b;
     if ((rc = nc_cfg_double(m, "pixel_pitch_m", 1e-8, 1e-2, &s->pixel_pitch_m)) < 0)
         return rc;
+    /* One pitch for geometry and radiometry: the camera's (focal_length_m /
+     * fx_px) when it has one. */
+    if (rc && pitch_m > 0 && fabs(s->pixel_pitch_m - pitch_m) > 1e-9 * pitch_m)
+        return nc_cfg_error(nc_cfg_get(m, "pixel_pitch_m"),
+                            "%g m disagrees with the camera's pixel pitch %g m (camera.pixel_pitch_m, or "
+                            "focal_length_m / fx_px); give the pitch once, in camera",
+                            s->pixel_pitch_m, pitch_m);
     if (!(s->pixel_pitch_m > 0))
         return nc_cfg_missing(m, "pixel_pitch_m", "the pixel pitch in metres (the camera gives fx_px)");
     if ((rc = nc_cfg_double(m, "qe", 0, 1, &s->qe)) < 0)
@@ -207,8 +251,12 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
         return rc;
     s->temperature_k = s->dark_ref_temp_k;
     if ((rc = nc_cfg_double(m, "temperature_k", 1, 1000, &s->temperature_k)) < 0 ||
-        (rc = nc_cfg_double(m, "dsnu_e_s", 0, 1e9, &s->dsnu_e_s)) < 0 ||
-        (rc = nc_cfg_double(m, "prnu", 0, 1, &s->prnu)) < 0 ||
+        (rc = nc_cfg_double(m, "dsnu_e_s", 0, 1e9, &s->dsnu_e_s)) < 0)
+        return rc;
+    if (s->dsnu_e_s > 0 && !(s->dark_current_e_s > 0))
+        return nc_cfg_error(nc_cfg_get(m, "dsnu_e_s"), "a dark signal non-uniformity scales the mean dark current: "
+                                                      "give dark_current_e_s > 0 (or dsnu_e_s: 0)");
+    if ((rc = nc_cfg_double(m, "prnu", 0, 1, &s->prnu)) < 0 ||
         (rc = nc_cfg_double(m, "hot_pixel_fraction", 0, 1, &s->hot_pixel_fraction)) < 0 ||
         (rc = nc_cfg_double(m, "hot_pixel_dark_e_s", 0, 1e9, &s->hot_pixel_dark_e_s)) < 0 ||
         (rc = nc_cfg_double(m, "read_noise_e", 0, 1e6, &s->read_noise_e)) < 0 ||
@@ -298,13 +346,22 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
     if (rc < 0)
         goto fail;
 
+    /* A real lens spreads light from outside the field into the edge
+     * pixels: the renderer draws margin_px more pixels on every side (the
+     * PSF's half width), the PSF acts on that larger image, and the sensor
+     * sees the middle. */
+    cs->margin_px = cs->optics.psf.size > 1 ? cs->optics.psf.size / 2 : 0;
+    cs->render_width_px = cs->width_px + 2 * cs->margin_px;
+    cs->render_height_px = cs->height_px + 2 * cs->margin_px;
     size_t n = (size_t)cs->width_px * (size_t)cs->height_px;
-    cs->response = malloc(n * sizeof(float));
+    size_t nr = (size_t)cs->render_width_px * (size_t)cs->render_height_px;
+    cs->response = malloc(nr * sizeof(float));
     cs->prnu_map = malloc(n * sizeof(float));
     cs->dark_map = malloc(n * sizeof(float));
-    cs->scratch[0] = malloc(n * sizeof(float));
-    cs->scratch[1] = malloc(n * sizeof(float));
-    if (!cs->response || !cs->prnu_map || !cs->dark_map || !cs->scratch[0] || !cs->scratch[1]) {
+    for (int i = 0; i < 3 && cs->margin_px > 0; i++) /* the PSF's work buffers */
+        if (!(cs->scratch[i] = malloc(nr * sizeof(float))))
+            rc = -ENOMEM;
+    if (!cs->response || !cs->prnu_map || !cs->dark_map || rc < 0) {
         rc = nc_error(-ENOMEM, "out of memory");
         goto fail;
     }
@@ -314,21 +371,33 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
      * E = L tau pi / (4 N^2) V(theta); electrons/s = QE E A_pix lambda/(h c). */
     double k = s->qe * o->band_fraction * o->transmission * M_PI / (4.0 * o->f_number * o->f_number) *
                s->pixel_pitch_m * s->pixel_pitch_m * o->wavelength_m / (NC_PLANCK_J_S * NC_LIGHT_M_S);
-    double dark = s->dark_current_e_s * exp2((s->temperature_k - s->dark_ref_temp_k) / s->dark_doubling_k);
+    /* Dark current doubles every dark_doubling_k: the mean, the per-pixel
+     * non-uniformity and the hot pixels alike (the pattern is the sensor's,
+     * its scale the temperature's). DSNU is a log-normal factor of mean 1 and
+     * relative rms dsnu_e_s / dark_current_e_s: never negative, so nothing is
+     * clipped and the mean dark current follows the law at every temperature. */
+    double tscale = exp2((s->temperature_k - s->dark_ref_temp_k) / s->dark_doubling_k);
+    double dark = s->dark_current_e_s * tscale;
+    double cv = s->dark_current_e_s > 0 ? s->dsnu_e_s / s->dark_current_e_s : 0;
+    double ln_sigma = sqrt(log1p(cv * cv)), ln_mu = -0.5 * ln_sigma * ln_sigma;
+    const int m = cs->margin_px;
+    for (int y = 0; y < cs->render_height_px; y++)
+        for (int x = 0; x < cs->render_width_px; x++) {
+            struct nc_vec3 d = nc_camera_ray(geom, x - m, y - m);
+            double theta = acos(d.z / nc_v3_norm(d));
+            cs->response[(size_t)y * (size_t)cs->render_width_px + (size_t)x] = (float)(k * vignette(o, theta));
+        }
     for (int y = 0; y < cs->height_px; y++)
         for (int x = 0; x < cs->width_px; x++) {
             size_t p = (size_t)y * (size_t)cs->width_px + (size_t)x;
-            struct nc_vec3 d = nc_camera_ray(geom, x, y);
-            double theta = acos(d.z / nc_v3_norm(d));
-            cs->response[p] = (float)(k * vignette(o, theta));
             /* Fixed patterns: keyed by the sensor seed only. */
             double u[4], z1, z2;
             nc_rng4(s->seed, NC_RNG_FIXED_PATTERN, 0, (uint32_t)p, 0, u);
             nc_normal2(u[0], u[1], &z1, &z2);
             cs->prnu_map[p] = (float)fmax(0.0, 1.0 + s->prnu * z1);
-            double dp = fmax(0.0, dark + s->dsnu_e_s * z2);
+            double dp = dark * exp(ln_mu + ln_sigma * z2);
             if (u[2] < s->hot_pixel_fraction)
-                dp += s->hot_pixel_dark_e_s;
+                dp += s->hot_pixel_dark_e_s * tscale;
             cs->dark_map[p] = (float)dp;
         }
     return 0;
@@ -342,10 +411,20 @@ void nc_camsys_free(struct nc_camsys *cs)
     free(cs->response);
     free(cs->prnu_map);
     free(cs->dark_map);
-    free(cs->scratch[0]);
-    free(cs->scratch[1]);
+    for (int i = 0; i < 3; i++)
+        free(cs->scratch[i]);
     free(cs->optics.vig_angle_rad);
     free(cs->optics.vig_factor);
     nc_psf_free(&cs->optics.psf);
     memset(cs, 0, sizeof *cs);
+}
+
+void nc_camsys_render_camera(const struct nc_camsys *cs, const struct nc_camera *geom, struct nc_camera *out)
+{
+    struct nc_camera c = *geom;
+    c.width_px = cs->render_width_px;
+    c.height_px = cs->render_height_px;
+    c.cx_px += cs->margin_px;
+    c.cy_px += cs->margin_px;
+    *out = c;
 }

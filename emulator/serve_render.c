@@ -63,11 +63,11 @@ static int pose_for(struct nc__emu *e, const struct nc__job *j, struct nc_pose *
 void *nc__serve_render_thread(void *arg)
 {
     struct nc__emu *e = arg;
-    const int W = e->scene.camera.width_px, H = e->scene.camera.height_px;
+    const int W = e->cs.width_px, H = e->cs.height_px;
     const size_t n = (size_t)W * (size_t)H;
-    struct nc_frame f;
+    struct nc_frame f; /* the camera model's render size: the sensor and the PSF's margin */
     float *el = malloc(n * sizeof *el);
-    if (nc_frame_alloc(&f, W, H) < 0 || !el) {
+    if (nc_frame_alloc(&f, e->cs.render_width_px, e->cs.render_height_px) < 0 || !el) {
         nc_log_error("emulator/render", "out of memory for frames");
         atomic_store(&e->stop, 2);
         free(el);
@@ -92,6 +92,7 @@ void *nc__serve_render_thread(void *arg)
         }
         struct nc_scene at = e->scene; /* shallow: shares meshes and materials */
         nc_scene_apply_pose(&at, &pose);
+        nc_camsys_render_camera(&e->cs, &at.camera, &at.camera);
         struct nc_exposure ex = {.exposure_s = j.exposure_s, .rolling = e->cs.sensor.shutter == NC_SHUTTER_ROLLING,
                                  .line_time_s = e->cs.sensor.line_time_s};
         int ts = 1;

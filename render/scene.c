@@ -44,7 +44,7 @@ const char nc_default_scene_yaml[] =
     "optics:\n"
     "  f_number: 4.0\n"
     "  transmission: 0.9\n"
-    "  passband: {band_fraction: 0.45, wavelength_m: 6.0e-7}\n"
+    "  passband: {from_m: 5.0e-7, to_m: 7.0e-7}    # a 500-700 nm filter through the 5772 K Sun\n"
     "  vignetting: cos4\n"
     "  psf: {type: gaussian, sigma_px: 0.7}\n"
     "sensor:\n"

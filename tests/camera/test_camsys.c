@@ -232,14 +232,16 @@ static void robustness(void)
                           "sensor.hot_pixel_fraction=0.001", "sensor.hot_pixel_dark_e_s=5000",
                           "optics.psf={type: gaussian, sigma_px: 1.2}"};
     load(sets, 5, &g, &cs);
-    static float rad[W * H], e[W * H];
+    /* Radiance images are the render size: the sensor and the PSF's margin. */
+    static float rad[(W + 64) * (H + 64)], e[W * H];
+    const int nr = cs.render_width_px * cs.render_height_px;
     static uint16_t a[W * H], b[W * H];
     const double exposures[] = {0, 1e-12, 1e-6, 0.01, 10, 1e4};
     const float radiances[] = {0, 1e-30f, 1, 1e6f, 3e38f, NAN, INFINITY};
     int bad = 0;
     for (int k = 0; k < 7; k++)
         for (int j = 0; j < 6; j++) {
-            for (int i = 0; i < W * H; i++)
+            for (int i = 0; i < nr; i++)
                 rad[i] = radiances[k];
             nc_camsys_electrons(&cs, rad, exposures[j], e);
             for (int i = 0; i < W * H; i++)
@@ -250,7 +252,7 @@ static void robustness(void)
         }
     CHECK(bad == 0, "%d non-finite, negative or out-of-range values", bad);
     /* Saturation: everything at the top of the ADC or the full well. */
-    for (int i = 0; i < W * H; i++)
+    for (int i = 0; i < nr; i++)
         rad[i] = 1e6f;
     nc_camsys_electrons(&cs, rad, 1.0, e);
     nc_camsys_digitise(&cs, e, 1.0, 3, a);
@@ -260,7 +262,7 @@ static void robustness(void)
         off += fabs(a[i] - fw_dn) > 6 * cs.sensor.read_noise_e / cs.sensor.gain_e_per_dn + 1;
     CHECK(off == 0, "%d saturated pixels away from full well", off);
     /* Determinism: the same frame number gives the same frame; another does not. */
-    for (int i = 0; i < W * H; i++)
+    for (int i = 0; i < nr; i++)
         rad[i] = 0.2f;
     nc_camsys_electrons(&cs, rad, 0.01, e);
     nc_camsys_digitise(&cs, e, 0.01, 11, a);
