@@ -35,6 +35,9 @@ static const char expose_help[] =
     "  -d, --dark             dark frames: no light (radiance 0)\n"
     "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N), 16-bit unsigned;\n"
     "                         .png/.tif/.exr: numbered files OUT_0000.ext, OUT_0001.ext, ...\n"
+    "      --fits-rows ORDER  .fits only: top_down (default: row 1 is the top image\n"
+    "                         row) or bottom_up (row 1 at the bottom, as FITS viewers\n"
+    "                         and mission archives show it); keyword ROWORDER\n"
     "  -s, --set KEY=VALUE    override a configuration key (repeatable)\n"
     "  -h, --help             this help\n"
     "\n"
@@ -51,9 +54,9 @@ int main(int argc, char **argv)
         {"frames", required_argument, NULL, 'n'},   {"first-frame", required_argument, NULL, 'F'},
         {"dark", no_argument, NULL, 'd'},           {"output", required_argument, NULL, 'o'},
         {"set", required_argument, NULL, 's'},      {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+        {"fits-rows", required_argument, NULL, 'R'}, {NULL, 0, NULL, 0},
     };
-    const char *out = NULL, *cam_path = NULL;
+    const char *out = NULL, *cam_path = NULL, *rows = NULL;
     const char **sets = calloc((size_t)argc + 1, sizeof *sets);
     double L = -1, T = -1, nframes = 1, first = 0;
     int nsets = 0, dark = 0, c, rc = 2;
@@ -78,6 +81,7 @@ int main(int argc, char **argv)
         case 'F': first = v; break;
         case 'd': dark = 1; break;
         case 'o': out = optarg; break;
+        case 'R': rows = optarg; break;
         case 's': sets[nsets++] = optarg; break;
         case 'h': fputs(expose_help, stdout); rc = 0; goto out;
         default: fputs("Try 'navcam expose --help'.\n", stderr); goto out;
@@ -93,6 +97,11 @@ int main(int argc, char **argv)
     }
     if (!nc_image_format_ok(out, NULL)) {
         fprintf(stderr, "navcam expose: %s: unsupported output format (use .fits, .png, .tif or .exr)\n", out);
+        goto out;
+    }
+    if (rows && (!nc_image_is_fits(out) || nc_image_fits_row_order_ok(rows) < 0)) {
+        fprintf(stderr, "navcam expose: --fits-rows: %s\n",
+                !nc_image_is_fits(out) ? "applies to .fits output only" : nc_errmsg());
         goto out;
     }
     struct nc_camera geom;
@@ -115,8 +124,8 @@ int main(int argc, char **argv)
     for (size_t i = 0; ok && i < nr; i++)
         rad[i] = (float)L;
     ok = ok && nc_camsys_electrons(&cs, rad, T, e) >= 0;
-    int is_fits = strstr(out, ".fits") || strstr(out, ".fit") || strstr(out, ".fts");
-    struct nc_image_attr attrs[16];
+    int is_fits = nc_image_is_fits(out);
+    struct nc_image_attr attrs[20];
     char text[16][200], ltxt[64], ntxt[32];
     snprintf(ltxt, sizeof ltxt, "%.17g", L);
     snprintf(ntxt, sizeof ntxt, "%zu", nf);
@@ -138,6 +147,8 @@ int main(int argc, char **argv)
         int na = nc_camsys_meta(&cs, T, (uint64_t)first, attrs, text, 16);
         attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
         attrs[na++] = (struct nc_image_attr){"navcam:frames", ntxt};
+        if (rows)
+            attrs[na++] = (struct nc_image_attr){"navcam:fits_row_order", rows};
         ok = nc_image_write_dn_cube(out, dn, geom.width_px, geom.height_px, (int)nf, cs.sensor.adc_bits, attrs, na) >= 0;
         if (ok)
             printf("wrote %s: %zu frames of %dx%d, %d-bit, radiance %g W m^-2 sr^-1, exposure %g s\n", out, nf,

@@ -47,6 +47,10 @@ static const char render_help[] =
     "                           --set render.samples_per_pixel=16\n"
     "  -j, --threads N        render threads (default: render.threads, else all\n"
     "                         cores); the image does not depend on N\n"
+    "      --fits-rows ORDER  .fits only: top_down (default: row 1 is the top image\n"
+    "                         row, y = 0) or bottom_up (row 1 at the bottom, as FITS\n"
+    "                         viewers and mission archives show it); the keyword\n"
+    "                         ROWORDER records which\n"
     "  -h, --help             this help\n"
     "\n"
     "Conventions: positions in metres (double precision); quaternions scalar-first\n"
@@ -64,7 +68,8 @@ static double now_ms(void)
 /* Electrons (float) or a digitised frame of a rendered radiance image (the
  * camera model's render size: the sensor plus the PSF's margin). */
 static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
-                              const struct nc_camsys *cs, double exposure, unsigned long long frame_no, double *scale)
+                              const struct nc_camsys *cs, double exposure, unsigned long long frame_no,
+                              const struct nc_image_attr *extra, double *scale)
 {
     const int W = cs->width_px, H = cs->height_px;
     size_t n = (size_t)W * (size_t)H;
@@ -74,7 +79,9 @@ static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc
     char text[32][200];
     int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
     int na = nc_frame_meta(s, q, attrs, text, 32);
-    na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 32 - na);
+    na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 31 - na);
+    if (extra)
+        attrs[na++] = *extra;
     if (rc >= 0 && q == NC_Q_ELECTRONS)
         rc = nc_image_write(out, e, W, H, attrs, na, scale);
     else if (rc >= 0 && (rc = nc_camsys_digitise(cs, e, exposure, frame_no, dn)) >= 0)
@@ -91,9 +98,10 @@ int main(int argc, char **argv)
         {"output", required_argument, NULL, 'o'}, {"quantity", required_argument, NULL, 'q'},
         {"set", required_argument, NULL, 's'},    {"threads", required_argument, NULL, 'j'},
         {"exposure", required_argument, NULL, 'e'}, {"frame", required_argument, NULL, 'f'},
+        {"fits-rows", required_argument, NULL, 'R'},
         {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
     };
-    const char *out = NULL, *scene_path = NULL;
+    const char *out = NULL, *scene_path = NULL, *rows = NULL;
     double exposure = -1;
     unsigned long long frame_no = 0;
     const char **sets = calloc((size_t)argc, sizeof *sets);
@@ -105,6 +113,7 @@ int main(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "o:q:s:j:e:f:h", opts, NULL)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
+        case 'R': rows = optarg; break;
         case 'e':
         case 'f': {
             char *end;
@@ -157,6 +166,13 @@ int main(int argc, char **argv)
         free(sets);
         return 2;
     }
+    if (rows && (!nc_image_is_fits(out) || nc_image_fits_row_order_ok(rows) < 0)) {
+        fprintf(stderr, "navcam render: --fits-rows: %s\n",
+                !nc_image_is_fits(out) ? "applies to .fits output only" : nc_errmsg());
+        free(sets);
+        return 2;
+    }
+    const struct nc_image_attr row_attr = {"navcam:fits_row_order", rows ? rows : "top_down"};
     /* Fail before rendering, not after, when OUT cannot be written. */
     char dir[4096];
     snprintf(dir, sizeof dir, "%s", out);
@@ -196,9 +212,9 @@ int main(int argc, char **argv)
         rc = nc_render_exposure(&r, &drawn, &ex, &f, &tsamples);
     double t2 = now_ms(), scale = 0;
     if (rc >= 0 && q <= NC_Q_RANGE)
-        rc = nc_frame_write(out, &f, q, &scene, &scale);
+        rc = nc_frame_write(out, &f, q, &scene, &row_attr, rows ? 1 : 0, &scale);
     else if (rc >= 0)
-        rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, &scale);
+        rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, rows ? &row_attr : NULL, &scale);
     if (rc >= 0) {
         printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene setup %.1f ms, "
                "render %.1f ms\n",

@@ -16,12 +16,18 @@ struct file_out {
     char pattern[256];
     FILE *sidecar;
     char sidecar_path[2300];
+    int bottom_up; /* FITS rows in the archive order */
 };
+
+static const char *const fits_orders[] = {"top_down", "bottom_up", NULL};
 
 static const struct nc_param file_params[] = {
     NC_P_STRING("directory", "out", "where the files go (made if missing)"),
     NC_P_STRING("pattern", "frame_%06llu.png", "file name with one %llu-style conversion for the frame number; the extension picks the format "
      "(.png, .tif, .fits, .exr)"),
+    NC_P_ENUM("fits_row_order", "top_down", fits_orders,
+              "for .fits patterns: top_down (row 1 is the top image row) or bottom_up (row 1 at the bottom, as FITS "
+              "viewers and mission archives show it); the keyword ROWORDER records which"),
     NC_P_STRING_OR_EMPTY("sidecar", "frames.jsonl", "JSON-lines file with every frame's metadata, in the directory (empty: none)"),
     NC_P_END,
 };
@@ -33,7 +39,8 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     int rc;
     if ((rc = nc_param_string(opts, file_params, "directory", &dir)) < 0 ||
         (rc = nc_param_string(opts, file_params, "pattern", &pattern)) < 0 ||
-        (rc = nc_param_string(opts, file_params, "sidecar", &sidecar)) < 0)
+        (rc = nc_param_string(opts, file_params, "sidecar", &sidecar)) < 0 ||
+        (rc = nc_param_enum(opts, file_params, "fits_row_order", &f->bottom_up)) < 0)
         return rc;
     /* The pattern must format exactly one unsigned long long. */
     const char *pc = strchr(pattern, '%');
@@ -44,6 +51,9 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     snprintf(probe, sizeof probe, pattern, 0ULL);
     if (!nc_image_format_ok(probe, NULL))
         return nc_cfg_error(nc_cfg_get(opts, "pattern"), "unsupported image format (use .png, .tif, .fits or .exr)");
+    if (f->bottom_up && !nc_image_is_fits(probe))
+        return nc_cfg_error(nc_cfg_get(opts, "fits_row_order"), "applies to .fits patterns only (the pattern writes %s)",
+                            probe);
     snprintf(f->dir, sizeof f->dir, "%s", dir);
     snprintf(f->pattern, sizeof f->pattern, "%s", pattern);
     if (mkdir(f->dir, 0777) < 0 && errno != EEXIST)
@@ -71,9 +81,9 @@ static int file_submit(void *priv, const struct nc_frame_record *r)
     int jl = nc_frame_record_json(r, 1, json, sizeof json), ml = nc_frame_record_json(r, 0, meta, sizeof meta);
     const struct nc_image_attr attrs[] = {
         {"navcam:quantity", "dn"}, {"navcam:units", "DN"}, {"navcam:adc_bits", adc}, {"navcam:frame", fr},
-        {"navcam:frame_record", ml > 0 ? meta : ""},
+        {"navcam:frame_record", ml > 0 ? meta : ""}, {"navcam:fits_row_order", f->bottom_up ? "bottom_up" : "top_down"},
     };
-    int rc = nc_image_write_dn(path, r->dn, r->width_px, r->height_px, r->adc_bits, attrs, 5);
+    int rc = nc_image_write_dn(path, r->dn, r->width_px, r->height_px, r->adc_bits, attrs, f->bottom_up ? 6 : 5);
     if (rc < 0)
         return rc;
     if (f->sidecar && jl > 0) {

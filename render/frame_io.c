@@ -72,13 +72,15 @@ int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_
 }
 
 int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
-                   double *preview_scale)
+                   const struct nc_image_attr *extra, int nextra, double *preview_scale)
 {
     if (q > NC_Q_RANGE)
         return nc_error(NC_EUSAGE, "quantity %s needs the camera model", nc_quantity_names[q]);
-    struct nc_image_attr attrs[24];
+    struct nc_image_attr attrs[32];
     char text[24][200];
     int n = nc_frame_meta(s, q, attrs, text, 24);
+    for (int i = 0; i < nextra && n < 32; i++)
+        attrs[n++] = extra[i];
     const float *px = q == NC_Q_RADIANCE ? f->radiance : q == NC_Q_IOF ? f->iof : f->range_m;
     return nc_image_write(path, px, f->width_px, f->height_px, attrs, n, preview_scale);
 }

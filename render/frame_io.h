@@ -20,8 +20,10 @@ int nc_quantity_parse(const char *name, enum nc_quantity *q);
  * fills attrs (up to max, each value stored in text[i]) and returns the count. */
 int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_attr *attrs, char (*text)[200],
                   int max);
-/* Write radiance, iof or range of f to path (format from the extension). */
+/* Write radiance, iof or range of f to path (format from the extension),
+ * with the scene's metadata and nextra more attributes (e.g.
+ * navcam:fits_row_order, image_io.h). */
 int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
-                   double *preview_scale);
+                   const struct nc_image_attr *extra, int nextra, double *preview_scale);
 
 #endif

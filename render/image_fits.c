@@ -7,7 +7,12 @@
  * name as the card's comment; any other attribute becomes HIERARCH NAVCAM
  * NAME (cfitsio 4.2 drops the continuation of long HIERARCH values, so those
  * must stay short).
- * Rows are written top row first: FITS row 1 is image row y = 0.
+ * Row order: by default the top image row first (FITS row 1 is image row
+ * y = 0, as NavCam's pixel coordinates run); with the attribute
+ * navcam:fits_row_order = bottom_up, the archive convention of FITS
+ * viewers and mission archives (row 1 at the bottom, +Y up). Either way the
+ * keyword ROWORDER says which ('TOP-DOWN' or 'BOTTOM-UP'), and reading turns
+ * a BOTTOM-UP file back into top-down rows.
  */
 #include <ctype.h>
 #include <math.h>
@@ -47,7 +52,29 @@ static const char *const fits_keys[][2] = {
     {"navcam:radiance_w_m2_sr", "RADIANCE"},
     {"navcam:frame_record", "FRAMEREC"},
     {"navcam:preview_rule", "PRVRULE"},
+    {"navcam:fits_row_order", "ROWORDER"},
 };
+
+/* 1 when attrs ask for the archive row order (row 1 at the bottom). */
+static int bottom_up(const struct nc_image_attr *attrs, int nattrs)
+{
+    for (int i = 0; i < nattrs; i++)
+        if (!strcmp(attrs[i].name, "navcam:fits_row_order"))
+            return !strcmp(attrs[i].value, "bottom_up");
+    return 0;
+}
+
+/* Rows of every plane in reverse order (a copy; caller frees). */
+static void *flip_rows(const void *px, size_t elem, int w, int h, int depth)
+{
+    size_t row = elem * (size_t)w;
+    unsigned char *out = malloc(row * (size_t)h * (size_t)depth);
+    const unsigned char *in = px;
+    for (int d = 0; out && d < depth; d++)
+        for (int y = 0; y < h; y++)
+            memcpy(out + ((size_t)d * h + (size_t)(h - 1 - y)) * row, in + ((size_t)d * h + (size_t)y) * row, row);
+    return out;
+}
 
 static void fits_key(const char *attr, char *key, size_t len)
 {
@@ -80,12 +107,19 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
     /* Unsigned 16-bit is BITPIX 16 with BZERO 32768 (cfitsio's USHORT_IMG). */
     int bitpix = type == NC__PX_FLOAT ? FLOAT_IMG : type == NC__PX_U16 ? USHORT_IMG : BYTE_IMG;
     int dtype = type == NC__PX_FLOAT ? TFLOAT : type == NC__PX_U16 ? TUSHORT : TBYTE;
+    const int up = bottom_up(attrs, nattrs);
+    size_t elem = type == NC__PX_FLOAT ? 4 : type == NC__PX_U16 ? 2 : 1;
+    void *flipped = up ? flip_rows(px, elem, w, h, depth) : NULL;
+    if (up && !flipped)
+        return nc_error(-ENOMEM, "%s: out of memory", path);
     if (fits_create_file(&f, fname, &status) || fits_create_img(f, bitpix, depth > 1 ? 3 : 2, naxes, &status))
         goto fail;
     fits_write_key_longwarn(f, &status);
     for (int i = 0; i < nattrs && !status; i++) {
         char key[80], *end;
         fits_key(attrs[i].name, key, sizeof key);
+        if (!strcmp(attrs[i].name, "navcam:fits_row_order"))
+            continue; /* written below, in the keyword's own spelling */
         /* Numbers as FITS numbers (EXPTIME, ADCBITS, ...), the rest as strings. */
         double v = strtod(attrs[i].value, &end);
         if (end != attrs[i].value && !*end && isfinite(v)) {
@@ -97,15 +131,21 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
             fits_write_key_longstr(f, key, attrs[i].value, attrs[i].name, &status);
         }
     }
-    fits_write_comment(f, "Row 1 is the top image row (y = 0, +Y down).", &status);
+    fits_write_key_str(f, "ROWORDER", up ? "BOTTOM-UP" : "TOP-DOWN", "order of the image rows in the data", &status);
+    fits_write_comment(f, up ? "Row 1 is the bottom image row (y = height - 1): +Y up, as FITS viewers show it."
+                             : "Row 1 is the top image row (y = 0, +Y down).",
+                       &status);
+    fits_write_comment(f, "Pixel coordinates in the NavCam keywords (INTRINS) run from the top row down.", &status);
     fits_write_comment(f, "Each NavCam metadata card carries its attribute name as its comment.", &status);
-    if (status || fits_write_img(f, dtype, 1, (LONGLONG)w * h * depth, (void *)px, &status))
+    if (status || fits_write_img(f, dtype, 1, (LONGLONG)w * h * depth, flipped ? flipped : (void *)px, &status))
         goto fail;
+    free(flipped);
     if (fits_close_file(f, &status))
         return fits_fail(path, "close", status);
     return 0;
 fail:;
     int rc = fits_fail(path, "write", status);
+    free(flipped);
     status = 0;
     if (f)
         fits_close_file(f, &status);
@@ -139,9 +179,19 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
         fits_close_file(f, &status);
         return rc;
     }
+    char order[FLEN_VALUE] = "";
+    if (fits_read_key_str(f, "ROWORDER", order, NULL, &status))
+        status = 0; /* files from elsewhere: top-down, as NavCam wrote them before */
     fits_close_file(f, &status);
     *w = (int)naxes[0];
     *h = (int)naxes[1];
+    if (!strcmp(order, "BOTTOM-UP")) {
+        float *top = flip_rows(buf, sizeof *buf, *w, *h, 1);
+        free(buf);
+        if (!top)
+            return nc_error(-ENOMEM, "%s: out of memory", path);
+        buf = top;
+    }
     *px = buf;
     return 0;
 }

@@ -34,6 +34,17 @@ static enum fmt format_of(const char *path)
     return FMT_NONE;
 }
 
+int nc_image_is_fits(const char *path) { return format_of(path) == FMT_FITS; }
+
+int nc_image_fits_row_order_ok(const char *word)
+{
+    if (!strcmp(word, "top_down") || !strcmp(word, "bottom_up"))
+        return 0;
+    return nc_error(NC_EUSAGE, "FITS row order '%s': expected top_down (row 1 is the top image row, NavCam's "
+                               "default) or bottom_up (row 1 at the bottom, as FITS viewers and archives show it)",
+                    word);
+}
+
 int nc_image_format_ok(const char *path, int *is_float)
 {
     enum fmt f = format_of(path);

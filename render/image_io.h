@@ -5,6 +5,11 @@
  * the largest finite value maps to 65535, with that scale written into the
  * file's metadata. NaN and Inf are written as 0. This is the only file that
  * touches OpenImageIO (C++).
+ * FITS is written and read with cfitsio (OpenImageIO 2.4 writes headers
+ * standard readers reject and cannot read float FITS). Its rows go top row
+ * first unless the attribute navcam:fits_row_order is "bottom_up" (the
+ * archive convention); the keyword ROWORDER records which, and reading
+ * returns top-down rows either way. Other formats are always top-down.
  */
 #ifndef NC_IMAGE_IO_H
 #define NC_IMAGE_IO_H
@@ -21,6 +26,11 @@ struct nc_image_attr {
     const char *value;
 };
 
+/* 1 if path names a FITS file (.fits, .fit, .fts). */
+int nc_image_is_fits(const char *path);
+/* The value of navcam:fits_row_order from a command-line word ("top_down",
+ * "bottom_up"): 0, or an error naming the choices. */
+int nc_image_fits_row_order_ok(const char *word);
 /* 1 if the extension is a supported output format (and *is_float), else 0. */
 int nc_image_format_ok(const char *path, int *is_float);
 /* Write a single-channel image; *preview_scale (may be NULL) receives the

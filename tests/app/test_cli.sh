@@ -41,7 +41,7 @@ diff -u "$src/docs/drivers.md" "$tmp/drivers.md" > "$tmp/drivers.diff" && ok ||
   bad "docs/drivers.md differs from \`navcam serve --driver-docs\` (run make docs): $(head -20 "$tmp/drivers.diff")"
 # Unknown driver keys: file, line, key and what the driver takes, before any device is touched.
 printf 'base: builtin:default\noutputs:\n  - driver: file\n    patern: f_%%06llu.png\n' > "$tmp/outs.yaml"
-expect 1 "outs.yaml:4: outputs[0].patern: unknown key for output driver 'file' (it takes: driver, directory, pattern, sidecar)" -- \
+expect 1 "outs.yaml:4: outputs[0].patern: unknown key for output driver 'file' (it takes: driver, directory, pattern, fits_row_order, sidecar)" -- \
   "$navcam" serve "$tmp/outs.yaml"
 expect 1 "serve.trigger.strobe.levle: unknown key for trigger driver 'gpio'" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: gpio, line: X, strobe: {line: Y, levle: low}}"
@@ -107,6 +107,18 @@ printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' > "$tmp/quad.obj"
 expect 1 "quad.obj:5: face with 4 vertices" -- "$navcam" render -o "$tmp/b.exr" \
   --set "bodies.0.shape={type: mesh, file: $tmp/quad.obj, unit: m}"
 expect 1 "cannot write into directory '/nonexistent-dir'" -- "$navcam" render -o /nonexistent-dir/x.exr "${small[@]}"
+
+# FITS row order: an option of FITS output only, recorded in ROWORDER.
+expect 0 "wrote $tmp/up.fits" -- "$navcam" render -o "$tmp/up.fits" --fits-rows bottom_up "${small[@]}"
+grep -a -q "ROWORDER= 'BOTTOM-UP'" "$tmp/up.fits" && ok || bad "up.fits lacks ROWORDER = 'BOTTOM-UP'"
+grep -a -q "ROWORDER= 'TOP-DOWN'" "$tmp/radiance.fits" && ok || bad "radiance.fits lacks ROWORDER = 'TOP-DOWN'"
+expect 2 "--fits-rows: applies to .fits output only" -- "$navcam" render -o "$tmp/x.png" --fits-rows bottom_up
+expect 2 "expected top_down" -- "$navcam" expose "$src/configs/examples/navcam_camera.yaml" -L 1 -o "$tmp/x.fits" --fits-rows up
+expect 1 "fits_row_order: applies to .fits patterns only" -- "$navcam" serve \
+  --set "outputs=[{driver: file, fits_row_order: bottom_up}]"
+# One pixel pitch for geometry and radiometry.
+expect 1 "sensor.pixel_pitch_m: 6e-06 m disagrees with the camera's pixel pitch 5.5e-06 m" -- \
+  "$navcam" render -o "$tmp/x.fits" -q dn --set sensor.pixel_pitch_m=6e-6
 
 # navcam brdf: one geometry, standard input, errors.
 expect 0 "i_deg,e_deg,g_deg,r,brdf,radf,reff" -- "$navcam" brdf --model lambert --param A=0.5 --geometry 60,0,60

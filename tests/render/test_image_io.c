@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <fitsio.h>
+
 #include "core/error.h"
 #include "render/frame_io.h"
 #include "render/image_io.h"
@@ -18,6 +20,63 @@ static const char yaml[] =
     "sun: {direction: [0.3, 0, -1]}\n"
     "camera: {width_px: 48, height_px: 36, fx_px: 60, fy_px: 60, position_m: [0, 0, -3000.123456789012],\n"
     "         attitude_q: [1, 0, 0, 0]}\n";
+
+/* FITS row order, read back with cfitsio's own API (the reader FITS users
+ * have; OpenImageIO 2.4 cannot read float FITS at all): by default row 1 is
+ * image row 0 (ROWORDER 'TOP-DOWN'); with navcam:fits_row_order bottom_up,
+ * row 1 is the bottom image row (ROWORDER 'BOTTOM-UP', the archive
+ * convention); nc_image_read returns top-down rows either way, bit exact. */
+static void fits_rows(void)
+{
+    enum { FW = 3, FH = 4 };
+    float img[FW * FH];
+    uint16_t dn[2 * FW * FH];
+    for (int i = 0; i < FW * FH; i++)
+        img[i] = 10.0f * (i / FW) + (i % FW) + 0.25f, dn[i] = (uint16_t)i, dn[FW * FH + i] = (uint16_t)(100 + i);
+    const char *order[] = {"top_down", "bottom_up"};
+    for (int up = 0; up < 2; up++) {
+        char name[64];
+        snprintf(name, sizeof name, "rows_%s.fits", order[up]);
+        const char *path = nc_test_path(name);
+        const struct nc_image_attr a = {"navcam:fits_row_order", order[up]};
+        CHECK(nc_image_write(path, img, FW, FH, &a, 1, NULL) == 0, "%s: %s", name, nc_errmsg());
+        fitsfile *ff = NULL;
+        int status = 0, anynul = 0;
+        float raw[FW * FH];
+        char rowkey[FLEN_VALUE] = "";
+        fits_open_image(&ff, path, READONLY, &status);
+        fits_read_key_str(ff, "ROWORDER", rowkey, NULL, &status);
+        fits_read_img(ff, TFLOAT, 1, FW * FH, NULL, raw, &anynul, &status);
+        fits_close_file(ff, &status);
+        CHECK(status == 0 && !strcmp(rowkey, up ? "BOTTOM-UP" : "TOP-DOWN"), "%s: cfitsio status %d, ROWORDER '%s'",
+              name, status, rowkey);
+        int same = 1;
+        for (int y = 0; y < FH; y++)
+            for (int x = 0; x < FW; x++)
+                same &= raw[y * FW + x] == img[(up ? FH - 1 - y : y) * FW + x];
+        CHECK(same, "%s: FITS row 1 is not image row %d", name, up ? FH - 1 : 0);
+        float *back = NULL;
+        int w = 0, h = 0;
+        CHECK(nc_image_read(path, &back, &w, &h) == 0 && w == FW && h == FH && !memcmp(back, img, sizeof img),
+              "%s: read back is not the image, top-down", name);
+        free(back);
+        /* A DN cube: every plane in the same order. */
+        snprintf(name, sizeof name, "cube_%s.fits", order[up]);
+        path = nc_test_path(name);
+        CHECK(nc_image_write_dn_cube(path, dn, FW, FH, 2, 12, &a, 1) == 0, "%s: %s", name, nc_errmsg());
+        unsigned short rawdn[2 * FW * FH];
+        status = 0;
+        fits_open_image(&ff, path, READONLY, &status);
+        fits_read_img(ff, TUSHORT, 1, 2 * FW * FH, NULL, rawdn, &anynul, &status);
+        fits_close_file(ff, &status);
+        same = status == 0;
+        for (int k = 0; k < 2; k++)
+            for (int y = 0; y < FH; y++)
+                for (int x = 0; x < FW; x++)
+                    same &= rawdn[(k * FH + y) * FW + x] == dn[(k * FH + (up ? FH - 1 - y : y)) * FW + x];
+        CHECK(same, "%s: a plane's rows are not in %s order", name, order[up]);
+    }
+}
 
 int main(void)
 {
@@ -33,7 +92,7 @@ int main(void)
             snprintf(name, sizeof name, "frame_%s.%s", nc_quantity_names[q], exts[e]);
             const char *path = nc_test_path(name);
             double scale = -1;
-            int rc = nc_frame_write(path, &f, (enum nc_quantity)q, &s, &scale);
+            int rc = nc_frame_write(path, &f, (enum nc_quantity)q, &s, NULL, 0, &scale);
             CHECK(rc == 0, "%s: %s", name, nc_errmsg());
             float *px = NULL;
             int w = 0, h = 0;
@@ -92,6 +151,7 @@ int main(void)
     CHECK(nc_image_write("/nonexistent-dir/x.exr", bad, 2, 2, NULL, 0, NULL) < 0 &&
               nc_test_contains(nc_errmsg(), "/nonexistent-dir/x.exr"),
           "unwritable path names the file: %s", nc_errmsg());
+    fits_rows();
     nc_frame_free(&f);
     nc_scene_free(&s);
     return nc_test_end();
