@@ -48,6 +48,10 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
                       "serve needs the camera model: give camera.focal_length_m and pixel_pitch_m, or sensor.pixel_pitch_m");
     if (rc >= 0)
         rc = nc_renderer_init(&e->renderer, &e->scene, opt->threads);
+    if (rc >= 0 && !(e->clients = calloc((size_t)e->max_clients, sizeof *e->clients)))
+        rc = nc_error(-ENOMEM, "out of memory");
+    for (int i = 0; rc >= 0 && i < e->max_clients; i++)
+        e->clients[i].fd = -1;
     if (rc >= 0)
         rc = nc__serve_open_sockets(e);
     if (rc < 0)
@@ -72,6 +76,7 @@ static void init_sync(struct nc__emu *e)
     pthread_mutex_init(&e->stat_lock, NULL);
     pthread_cond_init(&e->jcond, NULL);
     pthread_cond_init(&e->scond, NULL);
+    pthread_cond_init(&e->sfree, NULL);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
@@ -99,7 +104,41 @@ static void supervise(struct nc__emu *e, const struct nc_serve_options *opt)
     }
 }
 
-/* Stop input, finish the frame in flight, drop what is queued, flush. */
+/* Every request still queued is answered "dropped", in request order,
+ * after the frames before it; then the answers are sent (up to 1 s). */
+static void answer_the_rest(struct nc__emu *e)
+{
+    if (e->have_held)
+        nc__serve_drop(e, &e->held, NC__DROP_SHUTDOWN);
+    e->have_held = 0;
+    pthread_mutex_lock(&e->jlock);
+    while (e->jcount > 0) {
+        struct nc__job j = e->jobs[e->jhead];
+        e->jhead = (e->jhead + 1) % e->queue_frames;
+        e->jcount--;
+        pthread_mutex_unlock(&e->jlock);
+        nc__serve_drop(e, &j, NC__DROP_SHUTDOWN);
+        pthread_mutex_lock(&e->jlock);
+    }
+    pthread_mutex_unlock(&e->jlock);
+    nc__serve_answer_unread(e);
+    for (int tries = 0; tries < 100; tries++) {
+        int pending = 0;
+        pthread_mutex_lock(&e->client_lock);
+        for (int i = 0; i < e->max_clients; i++)
+            if (e->clients[i].fd >= 0 && e->clients[i].out_len) {
+                nc__serve_flush_client(e, &e->clients[i]);
+                pending |= e->clients[i].out_len > 0;
+            }
+        pthread_mutex_unlock(&e->client_lock);
+        if (!pending)
+            break;
+        nanosleep(&(struct timespec){0, 10000000}, NULL);
+    }
+}
+
+/* Stop input, finish the frame in flight and the frames made, answer what
+ * is queued as dropped, flush. */
 static void shutdown_threads(struct nc__emu *e, pthread_t *threads, int nthreads)
 {
     atomic_store(&e->stop, 1);
@@ -113,6 +152,9 @@ static void shutdown_threads(struct nc__emu *e, pthread_t *threads, int nthreads
     pthread_mutex_lock(&e->jlock);
     pthread_cond_broadcast(&e->jcond);
     pthread_mutex_unlock(&e->jlock);
+    pthread_mutex_lock(&e->slock);
+    pthread_cond_broadcast(&e->sfree); /* a lock-step render waiting for a slot */
+    pthread_mutex_unlock(&e->slock);
     if (nthreads > 1)
         pthread_join(threads[1], NULL); /* render */
     atomic_store(&e->stop, 3);
@@ -121,6 +163,7 @@ static void shutdown_threads(struct nc__emu *e, pthread_t *threads, int nthreads
     pthread_mutex_unlock(&e->slock);
     if (nthreads > 0)
         pthread_join(threads[0], NULL); /* output */
+    answer_the_rest(e);
     for (int i = 0; i < e->nout; i++)
         nc_output_control(&e->out[i], "flush", NULL);
 }
@@ -134,6 +177,7 @@ static void teardown(struct nc__emu *e, int have_scene, int have_cs)
     if (e->have_line)
         nc_trigger_close(&e->line);
     nc__serve_close_sockets(e);
+    free(e->clients);
     for (int i = 0; e->slots && i < e->nslots; i++)
         free(e->slots[i].dn);
     free(e->slots);
@@ -157,8 +201,6 @@ int nc_serve(const struct nc_serve_options *opt)
         return nc_error(-ENOMEM, "out of memory");
     e->drivers = opt->drivers;
     e->udp_fd = e->tcp_fd = -1;
-    for (int i = 0; i < NC_SERVE_MAX_CLIENTS; i++)
-        e->clients[i].fd = -1;
     pthread_mutex_init(&e->acq_lock, NULL);
     nc__serve_init_control(e);
     int have_scene = 0, have_cs = 0;

@@ -87,6 +87,7 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
     snprintf(e->bind, sizeof e->bind, "127.0.0.1");
     e->udp_port = 5750;
     e->tcp_port = 5751;
+    e->max_clients = 64;
     if ((rc = nc_cfg_map(cfg->root, "serve", &sv)) < 0)
         return rc;
     if (sv) {
@@ -122,6 +123,10 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
             return rc;
         if (rc)
             e->tcp_port = (int)v;
+        if ((rc = nc_cfg_int(sv, "max_clients", 1, 1000, &v)) < 0)
+            return rc;
+        if (rc)
+            e->max_clients = (int)v;
     }
     e->mode = (enum nc__serve_mode)m;
     e->pose_wait_ns = llround(pose_wait_s * 1e9);

@@ -27,8 +27,8 @@
 #include "render/scene.h"
 
 #define NC_SERVE_MAX_OUTPUTS 8
-#define NC_SERVE_MAX_CLIENTS 16
 #define NC_SERVE_LAT_SAMPLES 4096
+#define NC_SERVE_CLIENT_OUT_BYTES 65536 /* answers waiting for a client that does not read them */
 
 enum nc__serve_mode { NC__MODE_LOCKSTEP, NC__MODE_FREERUN, NC__MODE_TRIGGER };
 extern const char *const nc__serve_mode_names[];
@@ -42,6 +42,7 @@ enum nc__drop_reason {
     NC__DROP_OUTPUT_BUSY,
     NC__DROP_SHUTDOWN,
     NC__DROP_IGNORED,
+    NC__DROP_REJECTED, /* a capture whose message the timeline refused (time went backwards) */
     NC__DROP_COUNT
 };
 extern const char *const nc__serve_drop_names[];
@@ -56,19 +57,28 @@ struct nc__job {
     const char *source;
     double exposure_s, gain_db;
     int before_poses; /* triggered before any pose: not on the simulator's clock */
+    int rejected;     /* lock-step: the request was refused; answer "dropped" in its turn */
+    int has_pose;     /* lock-step: the pose the request carries, rendered as sent */
+    struct nc_pose pose;
 };
 
+/* A finished job on its way to the outputs: a frame, or (lock-step) a drop
+ * that must be answered in request order. */
 struct nc__slot {
     struct nc_frame_record rec;
     struct nc__job job;
     uint16_t *dn;
+    int dropped;                 /* 1: no frame; answer DROPPED for reason why */
+    enum nc__drop_reason why;
 };
 
 struct nc__client {
     int fd;
     unsigned gen;
-    uint8_t buf[4 + NC_PROTO_MAX_BYTES];
+    uint8_t buf[4 + NC_PROTO_MAX_BYTES]; /* requests not yet taken (lock-step back-pressure keeps them here) */
     size_t have;
+    uint8_t out[NC_SERVE_CLIENT_OUT_BYTES]; /* answers not yet sent (the client reads slowly) */
+    size_t out_len;
 };
 
 struct nc__emu {
@@ -78,7 +88,7 @@ struct nc__emu {
     int64_t pose_wait_ns; /* triggered frames: wait this long past the exposure for a later pose */
     int queue_frames, drop_oldest, stale_render, no_pose_scene;
     char bind[64];
-    int udp_port, tcp_port;
+    int udp_port, tcp_port, max_clients;
     const struct nc_driver_registry *drivers;
     /* the camera */
     struct nc_scene scene;
@@ -108,17 +118,21 @@ struct nc__emu {
     /* jobs */
     struct nc__job *jobs;
     int jhead, jcount;
+    struct nc__job held; /* the render thread's job when shutdown came (written by it, read after it ends) */
+    int have_held;
     pthread_mutex_t jlock;
     pthread_cond_t jcond;
     /* finished frames */
     struct nc__slot *slots;
     int nslots, shead, scount;
     pthread_mutex_t slock;
-    pthread_cond_t scond;
+    pthread_cond_t scond;      /* a slot was filled */
+    pthread_cond_t sfree;      /* a slot was freed (lock-step waits for one) */
     /* network */
     int udp_fd, tcp_fd;
-    struct nc__client clients[NC_SERVE_MAX_CLIENTS];
+    struct nc__client *clients; /* max_clients of them */
     pthread_mutex_t client_lock;
+    unsigned long refused_clients, slow_clients;
     /* state */
     atomic_int stop; /* 1: stop taking input; 2: render exits; 3: output exits */
     uint64_t next_frame;
@@ -138,13 +152,25 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
 int nc__serve_open_sockets(struct nc__emu *e);
 void nc__serve_close_sockets(struct nc__emu *e);
 void *nc__serve_net_thread(void *arg);
+/* At shutdown: every capture request the clients sent that was not taken
+ * yet (back-pressure left it in a buffer or a socket) is answered "dropped". */
+void nc__serve_answer_unread(struct nc__emu *e);
 
 /* serve_jobs.c */
 void nc__serve_lockstep(struct nc__emu *e, const struct nc_pose_msg *m, int client, unsigned gen, int64_t mono);
+/* A capture request the pose timeline refused: answered "dropped" in
+ * request order (lock-step: through the job queue), counted as rejected. */
+void nc__serve_refused_capture(struct nc__emu *e, const struct nc_pose_msg *m, int client, unsigned gen);
 void nc__serve_software(struct nc__emu *e, const struct nc_pose_msg *m, int client, unsigned gen, int64_t mono);
 void nc__serve_on_freerun(void *arg, const struct nc_trigger_event *ev);
 void nc__serve_on_line(void *arg, const struct nc_trigger_event *ev);
+/* Answer a request (no-op for UDP and software triggers without a client):
+ * queued on the client's connection, sent without waiting. */
 void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame, uint32_t status);
+/* Send what a client's answers queue holds, without waiting (client_lock held). */
+void nc__serve_flush_client(struct nc__emu *e, struct nc__client *c);
+/* 1 when the job queue is full (lock-step then stops taking requests). */
+int nc__serve_queue_full(struct nc__emu *e);
 void nc__serve_drop(struct nc__emu *e, const struct nc__job *j, enum nc__drop_reason why);
 void nc__serve_acq_get(struct nc__emu *e, struct nc_acquisition *a);
 /* Enable the source the acquisition settings name, disable the others

@@ -10,9 +10,26 @@
 
 #include "core/clock.h"
 #include "core/error.h"
+#include "core/log.h"
 #include "emulator/serve_internal.h"
 
-const char *const nc__serve_drop_names[] = {"queue_full", "stale_pose", "no_pose", "output_busy", "shutdown", "ignored_request"};
+const char *const nc__serve_drop_names[] = {"queue_full", "stale_pose",      "no_pose",         "output_busy",
+                                            "shutdown",   "ignored_request", "rejected_request"};
+
+void nc__serve_flush_client(struct nc__emu *e, struct nc__client *c)
+{
+    size_t sent = 0;
+    while (c->fd >= 0 && sent < c->out_len) {
+        ssize_t w = send(c->fd, c->out + sent, c->out_len - sent, MSG_NOSIGNAL | MSG_DONTWAIT);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            break; /* EAGAIN: the net thread sends the rest when the socket takes it */
+        sent += (size_t)w;
+    }
+    memmove(c->out, c->out + sent, c->out_len - sent);
+    c->out_len -= sent;
+}
 
 void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame, uint32_t status)
 {
@@ -26,9 +43,29 @@ void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame,
         buf[i] = (uint8_t)(n >> (8 * i));
     pthread_mutex_lock(&e->client_lock);
     struct nc__client *c = &e->clients[j->client];
-    if (c->fd >= 0 && c->gen == j->client_gen)
-        (void)!send(c->fd, buf, 4 + n, MSG_NOSIGNAL);
+    if (c->fd >= 0 && c->gen == j->client_gen) {
+        if (c->out_len + 4 + n > sizeof c->out) {
+            /* A client that reads none of its answers must not hold up the
+             * others: it is disconnected, and said so. */
+            nc_log_warn("emulator/net", "a TCP client read none of its last %zu answers: disconnected",
+                        c->out_len / (4 + n));
+            e->slow_clients++;
+            shutdown(c->fd, SHUT_RDWR);
+        } else {
+            memcpy(c->out + c->out_len, buf, 4 + n);
+            c->out_len += 4 + n;
+            nc__serve_flush_client(e, c);
+        }
+    }
     pthread_mutex_unlock(&e->client_lock);
+}
+
+int nc__serve_queue_full(struct nc__emu *e)
+{
+    pthread_mutex_lock(&e->jlock);
+    int full = e->jcount == e->queue_frames;
+    pthread_mutex_unlock(&e->jlock);
+    return full;
 }
 
 void nc__serve_drop(struct nc__emu *e, const struct nc__job *j, enum nc__drop_reason why)
@@ -99,12 +136,23 @@ void nc__serve_lockstep(struct nc__emu *e, const struct nc_pose_msg *m, int clie
      * out as soon as the request is here. */
     struct nc__job j = {.trigger_sim_ns = m->sim_time_ns, .mid_sim_ns = m->sim_time_ns, .trigger_mono_ns = mono,
                         .ready_mono_ns = mono, .sequence = m->sequence, .client = client, .client_gen = gen,
-                        .source = "lockstep", .exposure_s = a.exposure_s, .gain_db = a.gain_db};
+                        .source = "lockstep", .exposure_s = a.exposure_s, .gain_db = a.gain_db, .has_pose = 1};
+    nc_pose_from_msg(m, &j.pose);
     if (m->flags & NC_MSG_EXPOSURE)
         j.exposure_s = m->exposure_s;
     if (m->flags & NC_MSG_GAIN)
         j.gain_db = m->gain_db;
     push_job(e, &j);
+}
+
+void nc__serve_refused_capture(struct nc__emu *e, const struct nc_pose_msg *m, int client, unsigned gen)
+{
+    struct nc__job j = {.trigger_sim_ns = m->sim_time_ns, .sequence = m->sequence, .client = client,
+                        .client_gen = gen, .rejected = 1};
+    if (e->mode == NC__MODE_LOCKSTEP)
+        push_job(e, &j);
+    else
+        nc__serve_drop(e, &j, NC__DROP_REJECTED);
 }
 
 /* A software command (m: the TRIGGER or POSE message that asked, or NULL

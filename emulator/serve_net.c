@@ -5,7 +5,9 @@
 #include <arpa/inet.h>
 #include <errno.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -50,8 +52,14 @@ static void handle_message(struct nc__emu *e, const uint8_t *buf, size_t len, in
             pthread_cond_broadcast(&e->tl_cond);
         }
         pthread_mutex_unlock(&e->tl_lock);
-        if (r != NC_REJECT_NONE) {
+        /* A lock-step capture is rendered with the pose it carries, so its
+         * time need not follow other clients' poses (several simulators may
+         * share one camera); only the timeline does not take it. */
+        int lockstep_capture = e->mode == NC__MODE_LOCKSTEP && (m.flags & NC_MSG_CAPTURE);
+        if (r != NC_REJECT_NONE && !(lockstep_capture && r == NC_REJECT_TIME_BACKWARDS)) {
             log_reject(e, r, from);
+            if (m.flags & NC_MSG_CAPTURE) /* still answered, exactly once */
+                nc__serve_refused_capture(e, &m, client, gen);
             return;
         }
     }
@@ -66,8 +74,6 @@ static void handle_message(struct nc__emu *e, const uint8_t *buf, size_t len, in
 int nc__serve_open_sockets(struct nc__emu *e)
 {
     e->udp_fd = e->tcp_fd = -1;
-    for (int i = 0; i < NC_SERVE_MAX_CLIENTS; i++)
-        e->clients[i].fd = -1;
     struct sockaddr_in a = {.sin_family = AF_INET};
     if (inet_pton(AF_INET, e->bind, &a.sin_addr) != 1)
         return nc_error(NC_ECONFIG, "serve.bind: '%s' is not an IPv4 address", e->bind);
@@ -82,7 +88,7 @@ int nc__serve_open_sockets(struct nc__emu *e)
         e->tcp_fd = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
         a.sin_port = htons((uint16_t)e->tcp_port);
         if (e->tcp_fd < 0 || setsockopt(e->tcp_fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) < 0 ||
-            bind(e->tcp_fd, (struct sockaddr *)&a, sizeof a) < 0 || listen(e->tcp_fd, 8) < 0)
+            bind(e->tcp_fd, (struct sockaddr *)&a, sizeof a) < 0 || listen(e->tcp_fd, 64) < 0)
             return nc_error(-errno, "serve: TCP %s:%d: %s", e->bind, e->tcp_port, strerror(errno));
     }
     return 0;
@@ -90,7 +96,7 @@ int nc__serve_open_sockets(struct nc__emu *e)
 
 void nc__serve_close_sockets(struct nc__emu *e)
 {
-    for (int i = 0; i < NC_SERVE_MAX_CLIENTS; i++)
+    for (int i = 0; e->clients && i < e->max_clients; i++)
         if (e->clients[i].fd >= 0) {
             close(e->clients[i].fd);
             e->clients[i].fd = -1;
@@ -109,13 +115,52 @@ static void close_client(struct nc__emu *e, int i)
     e->clients[i].fd = -1;
     e->clients[i].gen++;
     e->clients[i].have = 0;
+    e->clients[i].out_len = 0;
     pthread_mutex_unlock(&e->client_lock);
 }
 
-/* Consume whole length-prefixed messages from a client's buffer. */
+/* Take one whole length-prefixed message from a client's buffer: 1 when one
+ * was taken, 0 when none is complete or lock-step has no room for it (the
+ * request waits in the buffer: back-pressure), -1 when the client was
+ * disconnected. */
+static int client_take(struct nc__emu *e, int i)
+{
+    struct nc__client *c = &e->clients[i];
+    if (c->have < 4)
+        return 0;
+    uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 | (uint32_t)c->buf[3] << 24;
+    if (len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) {
+        /* The stream cannot be resynchronised: count and disconnect. */
+        log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
+        atomic_fetch_add(&e->received, 1);
+        close_client(e, i);
+        return -1;
+    }
+    if (c->have < 4 + len || (e->mode == NC__MODE_LOCKSTEP && nc__serve_queue_full(e)))
+        return 0;
+    handle_message(e, c->buf + 4, len, i, c->gen, "a TCP client");
+    memmove(c->buf, c->buf + 4 + len, c->have - 4 - len);
+    c->have -= 4 + len;
+    return 1;
+}
+
+/* Requests waiting in the clients' buffers, one per client in turn, so that
+ * no client's backlog goes before another's. */
+static void take_requests(struct nc__emu *e)
+{
+    for (int progress = 1; progress;) {
+        progress = 0;
+        for (int i = 0; i < e->max_clients; i++)
+            if (e->clients[i].fd >= 0 && client_take(e, i) > 0)
+                progress = 1;
+    }
+}
+
 static void client_read(struct nc__emu *e, int i)
 {
     struct nc__client *c = &e->clients[i];
+    if (c->have == sizeof c->buf)
+        return; /* a whole request waits for room in the job queue */
     ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
     if (n <= 0) {
         if (n == 0 || (errno != EAGAIN && errno != EINTR))
@@ -123,24 +168,6 @@ static void client_read(struct nc__emu *e, int i)
         return;
     }
     c->have += (size_t)n;
-    for (;;) {
-        if (c->have < 4)
-            return;
-        uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
-                       (uint32_t)c->buf[3] << 24;
-        if (len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) {
-            /* The stream cannot be resynchronised: count and disconnect. */
-            log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
-            atomic_fetch_add(&e->received, 1);
-            close_client(e, i);
-            return;
-        }
-        if (c->have < 4 + len)
-            return;
-        handle_message(e, c->buf + 4, len, i, c->gen, "a TCP client");
-        memmove(c->buf, c->buf + 4 + len, c->have - 4 - len);
-        c->have -= 4 + len;
-    }
 }
 
 static void read_datagrams(struct nc__emu *e)
@@ -159,51 +186,125 @@ static void read_datagrams(struct nc__emu *e)
     }
 }
 
+/* A connection beyond serve.max_clients is told why (a FRAME with status
+ * REFUSED, its frame field the limit) and closed. */
+static void refuse(struct nc__emu *e, int fd)
+{
+    struct nc_pose_msg m = {.type = NC_MSG_FRAME, .frame = (uint64_t)e->max_clients, .status = NC_FRAME_REFUSED};
+    uint8_t buf[4 + NC_PROTO_MAX_BYTES];
+    size_t n = nc_msg_encode(&m, buf + 4, NC_PROTO_MAX_BYTES);
+    for (int i = 0; i < 4; i++)
+        buf[i] = (uint8_t)(n >> (8 * i));
+    (void)!send(fd, buf, 4 + n, MSG_NOSIGNAL | MSG_DONTWAIT);
+    close(fd);
+    if (e->refused_clients++ == 0)
+        nc_log_warn("emulator/net", "refused a TCP client: all %d client slots are in use (serve.max_clients; "
+                                    "counting further refusals)",
+                    e->max_clients);
+}
+
 static void accept_client(struct nc__emu *e)
 {
     int fd = accept4(e->tcp_fd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0)
         return;
     int slot = -1;
-    for (int i = 0; i < NC_SERVE_MAX_CLIENTS && slot < 0; i++)
+    for (int i = 0; i < e->max_clients && slot < 0; i++)
         if (e->clients[i].fd < 0)
             slot = i;
     if (slot < 0) {
-        nc_log_warn("emulator/net", "refused a TCP client: all %d client slots are in use", NC_SERVE_MAX_CLIENTS);
-        close(fd);
+        refuse(e, fd);
         return;
     }
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one); /* answers go out as they are made */
     pthread_mutex_lock(&e->client_lock);
     e->clients[slot].fd = fd;
     e->clients[slot].have = 0;
+    e->clients[slot].out_len = 0;
     pthread_mutex_unlock(&e->client_lock);
 }
 
 void *nc__serve_net_thread(void *arg)
 {
     struct nc__emu *e = arg;
+    struct pollfd *pf = malloc((size_t)(2 + e->max_clients) * sizeof *pf);
+    int *map = malloc((size_t)(2 + e->max_clients) * sizeof *map);
+    if (!pf || !map) {
+        nc_log_error("emulator/net", "out of memory");
+        free(pf);
+        free(map);
+        atomic_store(&e->stop, 1);
+        return NULL;
+    }
     while (atomic_load(&e->stop) == 0) {
-        struct pollfd pf[2 + NC_SERVE_MAX_CLIENTS];
-        int map[2 + NC_SERVE_MAX_CLIENTS], n = 0;
+        /* Lock-step with a full job queue: requests stay in the sockets
+         * (the simulator's sends block) until the render takes a job. */
+        int held = e->mode == NC__MODE_LOCKSTEP && nc__serve_queue_full(e);
+        int n = 0;
         if (e->udp_fd >= 0)
             pf[n] = (struct pollfd){e->udp_fd, POLLIN, 0}, map[n++] = -1;
         if (e->tcp_fd >= 0)
             pf[n] = (struct pollfd){e->tcp_fd, POLLIN, 0}, map[n++] = -2;
-        for (int i = 0; i < NC_SERVE_MAX_CLIENTS; i++)
+        pthread_mutex_lock(&e->client_lock);
+        for (int i = 0; i < e->max_clients; i++)
             if (e->clients[i].fd >= 0)
-                pf[n] = (struct pollfd){e->clients[i].fd, POLLIN, 0}, map[n++] = i;
-        if (poll(pf, (nfds_t)n, 50) <= 0)
-            continue;
-        for (int k = 0; k < n; k++) {
-            if (!(pf[k].revents & (POLLIN | POLLHUP | POLLERR)))
-                continue;
-            if (map[k] == -1)
-                read_datagrams(e);
-            else if (map[k] == -2)
-                accept_client(e);
-            else
-                client_read(e, map[k]);
+                pf[n] = (struct pollfd){e->clients[i].fd, (short)((held ? 0 : POLLIN) | (e->clients[i].out_len ? POLLOUT : 0)), 0},
+                map[n++] = i;
+        pthread_mutex_unlock(&e->client_lock);
+        if (poll(pf, (nfds_t)n, held ? 2 : 50) > 0) {
+            for (int k = 0; k < n; k++) {
+                if (!pf[k].revents)
+                    continue;
+                if (map[k] == -1) {
+                    read_datagrams(e);
+                } else if (map[k] == -2) {
+                    accept_client(e);
+                } else {
+                    if (pf[k].revents & POLLOUT) {
+                        pthread_mutex_lock(&e->client_lock);
+                        nc__serve_flush_client(e, &e->clients[map[k]]);
+                        pthread_mutex_unlock(&e->client_lock);
+                    }
+                    if (pf[k].revents & (POLLIN | POLLHUP | POLLERR))
+                        client_read(e, map[k]);
+                }
+            }
+        }
+        take_requests(e);
+    }
+    free(pf);
+    free(map);
+    return NULL;
+}
+
+void nc__serve_answer_unread(struct nc__emu *e)
+{
+    for (int i = 0; i < e->max_clients; i++) {
+        struct nc__client *c = &e->clients[i];
+        while (c->fd >= 0) {
+            while (c->have >= 4) {
+                uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
+                               (uint32_t)c->buf[3] << 24;
+                if (len > NC_PROTO_MAX_BYTES || c->have < 4 + len)
+                    break;
+                struct nc_pose_msg m;
+                if (nc_msg_decode(c->buf + 4, len, &m) == NC_REJECT_NONE && (m.flags & NC_MSG_CAPTURE) &&
+                    m.type != NC_MSG_FRAME) {
+                    struct nc__job j = {.trigger_sim_ns = m.sim_time_ns, .sequence = m.sequence, .client = i,
+                                        .client_gen = c->gen};
+                    atomic_fetch_add(&e->received, 1);
+                    nc__serve_drop(e, &j, NC__DROP_SHUTDOWN);
+                }
+                memmove(c->buf, c->buf + 4 + len, c->have - 4 - len);
+                c->have -= 4 + len;
+            }
+            if (c->have == sizeof c->buf)
+                break; /* an oversized request: nothing more to make of this stream */
+            ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
+            if (n <= 0)
+                break; /* EAGAIN: all that was sent is answered */
+            c->have += (size_t)n;
         }
     }
-    return NULL;
 }

@@ -26,6 +26,16 @@ static void report_failure(struct nc__emu *e, int i, uint64_t frame)
     e->out_quiet[i] = 0;
 }
 
+/* The head slot is done: free it for the render thread. */
+static void release(struct nc__emu *e)
+{
+    pthread_mutex_lock(&e->slock);
+    e->shead = (e->shead + 1) % e->nslots;
+    e->scount--;
+    pthread_cond_signal(&e->sfree);
+    pthread_mutex_unlock(&e->slock);
+}
+
 void *nc__serve_output_thread(void *arg)
 {
     struct nc__emu *e = arg;
@@ -39,6 +49,11 @@ void *nc__serve_output_thread(void *arg)
         }
         struct nc__slot *sl = &e->slots[e->shead];
         pthread_mutex_unlock(&e->slock);
+        if (sl->dropped) { /* lock-step: a drop answered in request order */
+            nc__serve_drop(e, &sl->job, sl->why);
+            release(e);
+            continue;
+        }
         /* Latency: pose received (lock-step) or exposure end (triggered) ->
          * frame handed to the outputs. */
         int64_t handed = nc_mono_ns();
@@ -54,10 +69,7 @@ void *nc__serve_output_thread(void *arg)
         pthread_mutex_unlock(&e->stat_lock);
         atomic_fetch_add(&e->delivered, 1);
         nc__serve_reply(e, &sl->job, sl->rec.frame, NC_FRAME_DELIVERED);
-        pthread_mutex_lock(&e->slock);
-        e->shead = (e->shead + 1) % e->nslots;
-        e->scount--;
-        pthread_mutex_unlock(&e->slock);
+        release(e);
     }
     return NULL;
 }

@@ -11,13 +11,14 @@
 #include "core/log.h"
 #include "emulator/serve_internal.h"
 
-/* The next job, or 0 when the thread is to end. */
+/* The next job, or 0 when the thread is to end (what is still queued then
+ * is answered at shutdown, in order, after the frames made). */
 static int next_job(struct nc__emu *e, struct nc__job *j)
 {
     pthread_mutex_lock(&e->jlock);
     while (e->jcount == 0 && atomic_load(&e->stop) < 2)
         pthread_cond_wait(&e->jcond, &e->jlock);
-    if (e->jcount == 0) {
+    if (e->jcount == 0 || atomic_load(&e->stop) >= 2) {
         pthread_mutex_unlock(&e->jlock);
         return 0;
     }
@@ -35,6 +36,12 @@ static int next_job(struct nc__emu *e, struct nc__job *j)
 static int pose_for(struct nc__emu *e, const struct nc__job *j, struct nc_pose *pose, enum nc_pose_quality *q,
                     int64_t *gap)
 {
+    if (j->has_pose) { /* lock-step: exactly the pose sent */
+        *pose = j->pose;
+        *q = NC_POSE_INTERPOLATED;
+        *gap = 0;
+        return atomic_load(&e->stop) < 2;
+    }
     pthread_mutex_lock(&e->tl_lock);
     for (;;) {
         int64_t now = nc_mono_ns(), until = j->ready_mono_ns;
@@ -60,6 +67,56 @@ static int pose_for(struct nc__emu *e, const struct nc__job *j, struct nc_pose *
     return 1;
 }
 
+/* The job in hand when shutdown came: answered first at shutdown, before
+ * what is still queued (it came before all of it). */
+static void hold_job(struct nc__emu *e, const struct nc__job *j)
+{
+    e->held = *j;
+    e->have_held = 1;
+}
+
+/* A free slot for the job's result. Lock-step waits for one (it never
+ * drops); the other modes take what is free or drop by policy. NULL: none
+ * (dropped, or shutting down: the job is held for the shutdown's answers). */
+static struct nc__slot *free_slot(struct nc__emu *e, const struct nc__job *j)
+{
+    pthread_mutex_lock(&e->slock);
+    while (e->mode == NC__MODE_LOCKSTEP && e->scount == e->nslots && atomic_load(&e->stop) < 2)
+        pthread_cond_wait(&e->sfree, &e->slock);
+    struct nc__slot *sl = e->scount < e->nslots ? &e->slots[(e->shead + e->scount) % e->nslots] : NULL;
+    pthread_mutex_unlock(&e->slock);
+    if (!sl && e->mode == NC__MODE_LOCKSTEP)
+        hold_job(e, j);
+    else if (!sl)
+        nc__serve_drop(e, j, NC__DROP_OUTPUT_BUSY);
+    return sl;
+}
+
+static void fill_slot(struct nc__emu *e)
+{
+    pthread_mutex_lock(&e->slock);
+    e->scount++;
+    pthread_cond_signal(&e->scond);
+    pthread_mutex_unlock(&e->slock);
+}
+
+/* A job that makes no frame. Lock-step answers it through the output
+ * thread, after the frames before it; the other modes at once. */
+static void drop_job(struct nc__emu *e, const struct nc__job *j, enum nc__drop_reason why)
+{
+    if (e->mode != NC__MODE_LOCKSTEP) {
+        nc__serve_drop(e, j, why);
+        return;
+    }
+    struct nc__slot *sl = free_slot(e, j);
+    if (!sl)
+        return;
+    sl->job = *j;
+    sl->dropped = 1;
+    sl->why = why;
+    fill_slot(e);
+}
+
 void *nc__serve_render_thread(void *arg)
 {
     struct nc__emu *e = arg;
@@ -74,20 +131,24 @@ void *nc__serve_render_thread(void *arg)
         return NULL;
     }
     struct nc__job j;
-    while (next_job(e, &j)) {
+    while (!e->have_held && next_job(e, &j)) {
         struct nc_pose pose;
         enum nc_pose_quality q;
         int64_t gap;
-        if (atomic_load(&e->stop) >= 2 || !pose_for(e, &j, &pose, &q, &gap)) {
-            nc__serve_drop(e, &j, NC__DROP_SHUTDOWN);
+        if (j.rejected) {
+            drop_job(e, &j, NC__DROP_REJECTED);
             continue;
         }
+        if (!pose_for(e, &j, &pose, &q, &gap)) {
+            hold_job(e, &j); /* shutting down: answered with the rest of the queue */
+            break;
+        }
         if (q == NC_POSE_NONE) {
-            nc__serve_drop(e, &j, NC__DROP_NO_POSE);
+            drop_job(e, &j, NC__DROP_NO_POSE);
             continue;
         }
         if (q == NC_POSE_STALE && !e->stale_render) {
-            nc__serve_drop(e, &j, NC__DROP_STALE_POSE);
+            drop_job(e, &j, NC__DROP_STALE_POSE);
             continue;
         }
         struct nc_scene at = e->scene; /* shallow: shares meshes and materials */
@@ -99,15 +160,9 @@ void *nc__serve_render_thread(void *arg)
         int64_t t0 = nc_mono_ns();
         int rc = nc_render_exposure(&e->renderer, &at, &ex, &f, &ts);
         int64_t t1 = nc_mono_ns();
-        /* A free slot for the digitised frame, or drop by policy. */
-        pthread_mutex_lock(&e->slock);
-        if (e->scount == e->nslots) {
-            pthread_mutex_unlock(&e->slock);
-            nc__serve_drop(e, &j, NC__DROP_OUTPUT_BUSY);
+        struct nc__slot *sl = free_slot(e, &j);
+        if (!sl)
             continue;
-        }
-        struct nc__slot *sl = &e->slots[(e->shead + e->scount) % e->nslots];
-        pthread_mutex_unlock(&e->slock);
         struct nc_camsys cs = e->cs; /* per-frame gain */
         cs.sensor.analog_gain_db = j.gain_db;
         uint64_t frame = e->next_frame++;
@@ -118,13 +173,21 @@ void *nc__serve_render_thread(void *arg)
         int64_t t2 = nc_mono_ns();
         if (rc < 0) {
             nc_log_error("emulator/render", "frame %llu: %s", (unsigned long long)frame, nc_errmsg());
-            nc__serve_drop(e, &j, NC__DROP_OUTPUT_BUSY);
+            if (e->mode != NC__MODE_LOCKSTEP) {
+                nc__serve_drop(e, &j, NC__DROP_OUTPUT_BUSY);
+                continue;
+            }
+            sl->job = j; /* the slot is ours: answer in order */
+            sl->dropped = 1;
+            sl->why = NC__DROP_OUTPUT_BUSY;
+            fill_slot(e);
             continue;
         }
         int64_t exp_ns = (int64_t)llround(j.exposure_s * 1e9);
         int64_t start_sim = j.mid_sim_ns - (int64_t)llround(0.5 * j.exposure_s * 1e9);
         int64_t start_mono = j.trigger_mono_ns + (start_sim - j.trigger_sim_ns);
         sl->job = j;
+        sl->dropped = 0;
         sl->rec = (struct nc_frame_record){
             .frame = frame, .request_sequence = j.sequence, .trigger_source = j.source,
             .trigger_sim_ns = j.trigger_sim_ns, .exposure_start_sim_ns = start_sim,
@@ -133,10 +196,7 @@ void *nc__serve_render_thread(void *arg)
             .pose_quality = q, .pose_gap_ns = gap, .exposure_s = j.exposure_s, .gain_db = j.gain_db,
             .time_samples = ts, .render_ms = (t1 - t0) * 1e-6, .camera_ms = (t2 - t1) * 1e-6, .width_px = W,
             .height_px = H, .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
-        pthread_mutex_lock(&e->slock);
-        e->scount++;
-        pthread_cond_signal(&e->scond);
-        pthread_mutex_unlock(&e->slock);
+        fill_slot(e);
     }
     nc_frame_free(&f);
     free(el);

@@ -69,7 +69,7 @@ long nc_client_send(struct nc_client *c, struct nc_pose_msg *m)
     return (long)m->sequence;
 }
 
-int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms, uint64_t *frame, uint32_t *status)
+int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence, uint64_t *frame, uint32_t *status)
 {
     if (!c->tcp)
         return nc_error(NC_EUNSUPPORTED, "frames are answered over TCP only");
@@ -87,24 +87,45 @@ int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms,
             enum nc_reject r = nc_msg_decode(c->buf + 4, len, &m);
             memmove(c->buf, c->buf + 4 + len, c->have - 4 - len);
             c->have -= 4 + len;
-            if (r == NC_REJECT_NONE && m.type == NC_MSG_FRAME && m.sequence == sequence) {
-                *frame = m.frame;
-                *status = m.status;
-                return 0;
-            }
+            if (r != NC_REJECT_NONE || m.type != NC_MSG_FRAME)
+                continue;
+            if (m.status == NC_FRAME_REFUSED)
+                return nc_error(-ECONNREFUSED, "navcam serve refused this connection: all %llu of its client slots "
+                                               "are in use (serve.max_clients)",
+                                (unsigned long long)m.frame);
+            *sequence = m.sequence;
+            *frame = m.frame;
+            *status = m.status;
+            return 0;
         }
         struct timespec t1;
         clock_gettime(CLOCK_MONOTONIC, &t1);
         long left = timeout_ms - ((t1.tv_sec - t0.tv_sec) * 1000 + (t1.tv_nsec - t0.tv_nsec) / 1000000);
         if (left <= 0)
-            return nc_error(-ETIMEDOUT, "no frame for request %u within %d ms", sequence, timeout_ms);
+            return nc_error(-ETIMEDOUT, "no frame answer within %d ms", timeout_ms);
         struct pollfd pf = {c->fd, POLLIN, 0};
         if (poll(&pf, 1, (int)left) <= 0)
             continue;
         ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
         if (n <= 0)
-            return nc_error(n == 0 ? -ECONNRESET : -errno, "connection closed while waiting for frame %u", sequence);
+            return nc_error(n == 0 ? -ECONNRESET : -errno, "connection closed while waiting for a frame answer");
         c->have += (size_t)n;
+    }
+}
+
+int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms, uint64_t *frame, uint32_t *status)
+{
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (;;) {
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        long left = timeout_ms - ((t1.tv_sec - t0.tv_sec) * 1000 + (t1.tv_nsec - t0.tv_nsec) / 1000000);
+        uint32_t seq;
+        int rc = nc_client_next_frame(c, left > 0 ? (int)left : 0, &seq, frame, status);
+        if (rc == -ETIMEDOUT)
+            return nc_error(rc, "no frame for request %u within %d ms", sequence, timeout_ms);
+        if (rc < 0 || seq == sequence)
+            return rc;
     }
 }
 

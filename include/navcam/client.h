@@ -19,8 +19,16 @@ int nc_client_connect(const char *host, int port, int tcp, struct nc_client **ou
 /* Send a POSE or TRIGGER message (its sequence is set by the client). Returns
  * the sequence used, or a negative error. */
 long nc_client_send(struct nc_client *c, struct nc_pose_msg *m);
-/* Wait (TCP) for the FRAME answer to `sequence`; frame and status out.
- * Returns 0, or -ETIMEDOUT / a negative error. */
+/* The next FRAME answer (TCP), in the order NavCam sent them: the request's
+ * sequence, the frame number and the status (NC_FRAME_DELIVERED or
+ * NC_FRAME_DROPPED) out. For simulators that send several captures before
+ * reading: in lock-step every capture is answered exactly once, in request
+ * order. Returns 0, -ETIMEDOUT, -ECONNREFUSED (NavCam had no client slot
+ * for this connection: serve.max_clients), or another negative error. */
+int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence, uint64_t *frame, uint32_t *status);
+/* Wait (TCP) for the FRAME answer to `sequence`, passing over answers to
+ * other requests; frame and status out. Returns 0, or -ETIMEDOUT / a
+ * negative error as nc_client_next_frame. */
 int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms, uint64_t *frame, uint32_t *status);
 void nc_client_close(struct nc_client *c);
 /* What the last failing call on this thread said, e.g. "connect 127.0.0.1:5751:

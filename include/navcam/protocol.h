@@ -24,7 +24,10 @@
 /* POSE and TRIGGER: simulator -> NavCam. FRAME: NavCam -> simulator over
  * TCP, one per captured request, once the frame is with every output. */
 enum nc_msg_type { NC_MSG_POSE = 1, NC_MSG_TRIGGER = 2, NC_MSG_FRAME = 3 };
-enum nc_frame_status { NC_FRAME_DELIVERED = 0, NC_FRAME_DROPPED = 1 };
+/* FRAME status. REFUSED answers no request (sequence 0): NavCam sends it on
+ * a TCP connection it will not serve (all serve.max_clients slots in use;
+ * the frame field holds that limit) and closes the connection. */
+enum nc_frame_status { NC_FRAME_DELIVERED = 0, NC_FRAME_DROPPED = 1, NC_FRAME_REFUSED = 2 };
 
 enum nc_msg_flags {
     NC_MSG_SUN_POSITION = 1u << 0, /* sun vector is a position (m), else a direction */

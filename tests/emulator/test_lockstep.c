@@ -1,0 +1,238 @@
+/* test_lockstep.c - lock-step under load, through the real program and the
+ * client library over 127.0.0.1: `navcam serve` with a render slower than
+ * the requests (a 4-deep job queue) never drops a capture, answers every one
+ * exactly once and in request order (back-pressure, not drops); 50
+ * concurrent clients within serve.max_clients are all served; a client
+ * beyond the limit is told why; a client that reads none of its answers
+ * does not hold up another; at shutdown every capture still queued is
+ * answered "dropped", after the frames before it.
+ * Usage: test_lockstep NAVCAM TMPDIR */
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "navcam/client.h"
+#include "testutil.h"
+
+static const char *navcam, *tmp;
+static int port;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* navcam serve in lock-step on a free port: a small frame with 16 samples
+ * per pixel (slower than back-to-back requests), null output. */
+static pid_t serve(const char *name, const char *extra)
+{
+    static char dir[4096], log[4200], tcp[64];
+    snprintf(dir, sizeof dir, "%s/%s", tmp, name);
+    snprintf(log, sizeof log, "%s/serve.log", dir);
+    mkdir(dir, 0777);
+    port = 20000 + (int)(getpid() % 20000);
+    snprintf(tcp, sizeof tcp, "serve.tcp_port=%d", port);
+    const char *argv[] = {navcam, "serve", "--set", "serve.mode=lockstep", "--set", "serve.udp_port=0", "--set", tcp,
+                          "--set", "outputs=[{driver: null}]", "--set", "camera.width_px=256", "--set",
+                          "camera.height_px=256", "--set", "render.samples_per_pixel=16", "--set",
+                          "bodies.0.shape.subdivisions=4", "--set", "serve.stats_interval_s=0", "--set",
+                          "serve.queue_frames=4", "--set", extra ? extra : "serve.max_clients=64", "--max-seconds",
+                          "120", NULL};
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644), nul = open("/dev/null", O_WRONLY);
+        if (fd < 0 || nul < 0)
+            _exit(127);
+        dup2(fd, 2);
+        dup2(nul, 1);
+        execv(navcam, (char *const *)argv);
+        _exit(127);
+    }
+    return pid;
+}
+
+static struct nc_client *connect_to(void)
+{
+    struct nc_client *c = NULL;
+    for (int i = 0; i < 600 && nc_client_connect("127.0.0.1", port, 1, &c) < 0; i++)
+        usleep(50000); /* the scene loads first */
+    return c;
+}
+
+static int finish(pid_t pid)
+{
+    int st = 0;
+    kill(pid, SIGTERM);
+    waitpid(pid, &st, 0);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+static long capture(struct nc_client *c, double t_s)
+{
+    struct nc_pose_msg m = {.type = NC_MSG_POSE, .flags = NC_MSG_CAPTURE, .sim_time_ns = (int64_t)(t_s * 1e9),
+                            .cam_position_m = {0, -3000, 0}, .cam_attitude_q = {0.70710678118654752, -0.70710678118654752, 0, 0},
+                            .sun = {1, 0, 0}};
+    return nc_client_send(c, &m);
+}
+
+/* Read n answers; checks they answer sequences first..first+n-1 in order.
+ * Returns how many were delivered (-1 on a broken stream). */
+static int answers(struct nc_client *c, uint32_t first, int n, const char *what)
+{
+    int delivered = 0, in_order = 1;
+    uint64_t last = 0;
+    for (int k = 0; k < n; k++) {
+        uint32_t seq = 0, status = 0;
+        uint64_t frame = 0;
+        if (nc_client_next_frame(c, 60000, &seq, &frame, &status) < 0) {
+            CHECK(0, "%s: answer %d of %d: %s", what, k + 1, n, nc_client_errmsg());
+            return -1;
+        }
+        in_order &= seq == first + (uint32_t)k;
+        if (status == NC_FRAME_DELIVERED) {
+            in_order &= delivered == 0 || frame > last;
+            last = frame;
+            delivered++;
+        }
+    }
+    CHECK(in_order, "%s: answers out of request order", what);
+    return delivered;
+}
+
+static void twenty_back_to_back(void)
+{
+    pid_t pid = serve("twenty", NULL);
+    struct nc_client *c = connect_to();
+    CHECK(c != NULL, "no connection: %s", nc_client_errmsg());
+    if (!c) {
+        finish(pid);
+        return;
+    }
+    double t0 = now_s();
+    for (int i = 0; i < 20; i++)
+        capture(c, i * 0.1);
+    int got = answers(c, 1, 20, "20 back to back");
+    printf("lock-step, 20 captures sent without waiting, 4-deep queue: %d of 20 delivered in %.2f s\n", got,
+           now_s() - t0);
+    CHECK(got == 20, "20 captures sent back to back: %d frames delivered", got);
+    nc_client_close(c);
+    CHECK(finish(pid) == 0, "serve did not exit cleanly");
+}
+
+static void fifty_clients_and_a_slow_one(void)
+{
+    pid_t pid = serve("fifty", NULL);
+    enum { N = 50 };
+    struct nc_client *c[N + 1] = {0};
+    int ok = 1;
+    for (int i = 0; i <= N; i++)
+        ok &= (c[i] = connect_to()) != NULL;
+    CHECK(ok, "51 connections within serve.max_clients 64: %s", nc_client_errmsg());
+    /* c[N] sends 20 captures and reads none of its answers. */
+    double t = 0;
+    for (int i = 0; ok && i < 20; i++)
+        capture(c[N], t += 0.01);
+    for (int i = 0; ok && i < N; i++)
+        capture(c[i], t += 0.01), capture(c[i], t += 0.01);
+    int all = 0;
+    double t0 = now_s();
+    for (int i = 0; ok && i < N; i++)
+        all += answers(c[i], 1, 2, "one of 50 clients") == 2;
+    printf("50 concurrent clients, 2 captures each, beside one that never reads: %d of 50 fully served in %.2f s\n",
+           all, now_s() - t0);
+    CHECK(all == N, "%d of 50 clients got both frames", all);
+    for (int i = 0; i <= N; i++)
+        nc_client_close(c[i]);
+    CHECK(finish(pid) == 0, "serve did not exit cleanly");
+}
+
+static void refused_beyond_the_limit(void)
+{
+    pid_t pid = serve("limit", "serve.max_clients=2");
+    struct nc_client *a = connect_to(), *b = connect_to(), *x = connect_to();
+    CHECK(a && b && x, "connections");
+    uint32_t seq, status;
+    uint64_t frame;
+    int rc = x ? nc_client_next_frame(x, 10000, &seq, &frame, &status) : 0;
+    CHECK(rc == -ECONNREFUSED && nc_test_contains(nc_client_errmsg(), "all 2 of its client slots are in use"),
+          "the third client of two: rc %d, '%s'", rc, nc_client_errmsg());
+    /* The two admitted clients are served. */
+    if (a && b) {
+        capture(a, 1);
+        capture(b, 1);
+        CHECK(answers(a, 1, 1, "client a") == 1 && answers(b, 1, 1, "client b") == 1, "admitted clients served");
+    }
+    nc_client_close(a);
+    nc_client_close(b);
+    nc_client_close(x);
+    CHECK(finish(pid) == 0, "serve did not exit cleanly");
+    char log[4200], text[4096] = "";
+    snprintf(log, sizeof log, "%s/limit/serve.log", tmp);
+    FILE *f = fopen(log, "r");
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    text[n] = '\0';
+    if (f)
+        fclose(f);
+    CHECK(nc_test_contains(text, "refused a TCP client: all 2 client slots are in use (serve.max_clients"),
+          "the refusal is not in the log:\n%s", text);
+}
+
+static void shutdown_answers_everything(void)
+{
+    pid_t pid = serve("shutdown", NULL);
+    struct nc_client *c = connect_to();
+    if (!c) {
+        CHECK(0, "no connection");
+        finish(pid);
+        return;
+    }
+    for (int i = 0; i < 20; i++)
+        capture(c, i * 0.1);
+    uint32_t seq, status;
+    uint64_t frame;
+    CHECK(nc_client_next_frame(c, 60000, &seq, &frame, &status) == 0 && seq == 1, "first answer");
+    kill(pid, SIGTERM); /* with most captures still queued or not yet read */
+    int delivered = 1, dropped = 0, in_order = 1, phase_ok = 1;
+    for (uint32_t want = 2; want <= 20; want++) {
+        if (nc_client_next_frame(c, 30000, &seq, &frame, &status) < 0) {
+            CHECK(0, "answer to %u missing: %s", want, nc_client_errmsg());
+            break;
+        }
+        in_order &= seq == want;
+        if (status == NC_FRAME_DELIVERED)
+            phase_ok &= dropped == 0, delivered++; /* no frame after a drop */
+        else
+            dropped++;
+    }
+    printf("SIGTERM with captures queued: %d delivered, then %d answered \"dropped\", of 20\n", delivered, dropped);
+    CHECK(in_order && phase_ok && delivered + dropped == 20, "shutdown answers: in order %d, %d delivered, %d dropped",
+          in_order, delivered, dropped);
+    int st = 0;
+    waitpid(pid, &st, 0);
+    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0, "serve exit status %d", st);
+    nc_client_close(c);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 3)
+        return 2;
+    navcam = argv[1];
+    tmp = argv[2];
+    mkdir(tmp, 0777);
+    signal(SIGPIPE, SIG_IGN);
+    twenty_back_to_back();
+    fifty_clients_and_a_slow_one();
+    refused_beyond_the_limit();
+    shutdown_answers_everything();
+    return nc_test_end();
+}
