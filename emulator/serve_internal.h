@@ -167,6 +167,8 @@ void nc__serve_on_line(void *arg, const struct nc_trigger_event *ev);
 /* Answer a request (no-op for UDP and software triggers without a client):
  * queued on the client's connection, sent without waiting. */
 void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame, uint32_t status);
+/* A message as TCP carries it (u32 length first) into buf (4 + NC_PROTO_MAX_BYTES); returns the message's length. */
+size_t nc__serve_encode_tcp(const struct nc_pose_msg *m, uint8_t *buf);
 /* Send what a client's answers queue holds, without waiting (client_lock held). */
 void nc__serve_flush_client(struct nc__emu *e, struct nc__client *c);
 /* 1 when the job queue is full (lock-step then stops taking requests). */

@@ -31,6 +31,14 @@ void nc__serve_flush_client(struct nc__emu *e, struct nc__client *c)
     c->out_len -= sent;
 }
 
+size_t nc__serve_encode_tcp(const struct nc_pose_msg *m, uint8_t *buf)
+{
+    size_t n = nc_msg_encode(m, buf + 4, NC_PROTO_MAX_BYTES);
+    for (int i = 0; i < 4; i++)
+        buf[i] = (uint8_t)(n >> (8 * i));
+    return n;
+}
+
 void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame, uint32_t status)
 {
     if (j->client < 0)
@@ -38,9 +46,7 @@ void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame,
     struct nc_pose_msg m = {.type = NC_MSG_FRAME, .sequence = j->sequence, .sim_time_ns = j->trigger_sim_ns,
                             .frame = frame, .status = status};
     uint8_t buf[4 + NC_PROTO_MAX_BYTES];
-    size_t n = nc_msg_encode(&m, buf + 4, NC_PROTO_MAX_BYTES);
-    for (int i = 0; i < 4; i++)
-        buf[i] = (uint8_t)(n >> (8 * i));
+    size_t n = nc__serve_encode_tcp(&m, buf);
     pthread_mutex_lock(&e->client_lock);
     struct nc__client *c = &e->clients[j->client];
     if (c->fd >= 0 && c->gen == j->client_gen) {

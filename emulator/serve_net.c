@@ -192,9 +192,7 @@ static void refuse(struct nc__emu *e, int fd)
 {
     struct nc_pose_msg m = {.type = NC_MSG_FRAME, .frame = (uint64_t)e->max_clients, .status = NC_FRAME_REFUSED};
     uint8_t buf[4 + NC_PROTO_MAX_BYTES];
-    size_t n = nc_msg_encode(&m, buf + 4, NC_PROTO_MAX_BYTES);
-    for (int i = 0; i < 4; i++)
-        buf[i] = (uint8_t)(n >> (8 * i));
+    size_t n = nc__serve_encode_tcp(&m, buf);
     (void)!send(fd, buf, 4 + n, MSG_NOSIGNAL | MSG_DONTWAIT);
     close(fd);
     if (e->refused_clients++ == 0)
