@@ -75,6 +75,15 @@ static int open_outputs(struct nc_cfg *cfg, struct nc__emu *e, const char *confi
     return 0;
 }
 
+/* An int setting: *out keeps its default unless the key is there. */
+static int int_key(struct nc_cfg_node *map, const char *key, long min, long max, int *out)
+{
+    long v = *out;
+    int rc = nc_cfg_int(map, key, min, max, &v);
+    *out = (int)v;
+    return rc;
+}
+
 int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir)
 {
     struct nc_cfg_node *sv = NULL;
@@ -96,7 +105,6 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
         static const char *const nopose[] = {"scene", "drop", NULL};
         int np = 0;
         const char *bind = NULL;
-        long v;
         int d = 0, st = 0;
         if ((rc = nc_cfg_enum(sv, "mode", nc__serve_mode_names, &m)) < 0 ||
             (rc = nc_cfg_double(sv, "frame_rate_hz", 1e-3, 1000, &e->frame_rate_hz)) < 0 ||
@@ -111,22 +119,11 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
         e->stale_render = st;
         if (bind)
             snprintf(e->bind, sizeof e->bind, "%s", bind);
-        if ((rc = nc_cfg_int(sv, "queue_frames", 1, 1024, &v)) < 0)
+        if ((rc = int_key(sv, "queue_frames", 1, 1024, &e->queue_frames)) < 0 ||
+            (rc = int_key(sv, "udp_port", 0, 65535, &e->udp_port)) < 0 ||
+            (rc = int_key(sv, "tcp_port", 0, 65535, &e->tcp_port)) < 0 ||
+            (rc = int_key(sv, "max_clients", 1, 1000, &e->max_clients)) < 0)
             return rc;
-        if (rc)
-            e->queue_frames = (int)v;
-        if ((rc = nc_cfg_int(sv, "udp_port", 0, 65535, &v)) < 0)
-            return rc;
-        if (rc)
-            e->udp_port = (int)v;
-        if ((rc = nc_cfg_int(sv, "tcp_port", 0, 65535, &v)) < 0)
-            return rc;
-        if (rc)
-            e->tcp_port = (int)v;
-        if ((rc = nc_cfg_int(sv, "max_clients", 1, 1000, &v)) < 0)
-            return rc;
-        if (rc)
-            e->max_clients = (int)v;
     }
     e->mode = (enum nc__serve_mode)m;
     e->pose_wait_ns = llround(pose_wait_s * 1e9);

@@ -1,9 +1,11 @@
 /* testutil.c - see testutil.h. */
 #include "testutil.h"
 
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/error.h"
 
@@ -90,4 +92,22 @@ int nc_test_end(void)
 {
     printf("%d passed, %d failed\n", nc_test_passed, nc_test_failed);
     return nc_test_failed ? 1 : 0;
+}
+
+int nc_test_spawn(const char *dir, const char *const *argv)
+{
+    char log[4200];
+    snprintf(log, sizeof log, "%s/serve.log", dir);
+    mkdir(dir, 0777);
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644), nul = open("/dev/null", O_WRONLY);
+        if (chdir(dir) < 0 || fd < 0 || nul < 0)
+            _exit(127);
+        dup2(fd, 2);
+        dup2(nul, 1);
+        execv(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    return (int)pid;
 }

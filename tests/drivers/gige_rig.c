@@ -49,22 +49,7 @@ pid_t serve(const char *dir, const char *const *extra, int nextra)
     argv[n++] = "--max-seconds";
     argv[n++] = "60";
     argv[n] = NULL;
-    char log[4200];
-    if (!dir)
-        return -1;
-    snprintf(log, sizeof log, "%s/serve.log", dir);
-    mkdir(dir, 0777);
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644), nul = open("/dev/null", O_WRONLY);
-        if (chdir(dir) < 0 || fd < 0 || nul < 0)
-            _exit(127);
-        dup2(fd, 2);
-        dup2(nul, 1);
-        execv(navcam, (char *const *)argv);
-        _exit(127);
-    }
-    return pid;
+    return dir ? nc_test_spawn(dir, argv) : -1;
 }
 
 int stop(pid_t pid)

@@ -8,7 +8,6 @@
  * answered "dropped", after the frames before it.
  * Usage: test_lockstep NAVCAM TMPDIR */
 #include <errno.h>
-#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,10 +34,8 @@ static double now_s(void)
  * per pixel (slower than back-to-back requests), null output. */
 static pid_t serve(const char *name, const char *extra)
 {
-    static char dir[4096], log[4200], tcp[64];
+    static char dir[4096], tcp[64];
     snprintf(dir, sizeof dir, "%s/%s", tmp, name);
-    snprintf(log, sizeof log, "%s/serve.log", dir);
-    mkdir(dir, 0777);
     port = 20000 + (int)(getpid() % 20000);
     snprintf(tcp, sizeof tcp, "serve.tcp_port=%d", port);
     const char *argv[] = {navcam, "serve", "--set", "serve.mode=lockstep", "--set", "serve.udp_port=0", "--set", tcp,
@@ -47,17 +44,7 @@ static pid_t serve(const char *name, const char *extra)
                           "bodies.0.shape.subdivisions=4", "--set", "serve.stats_interval_s=0", "--set",
                           "serve.queue_frames=4", "--set", extra ? extra : "serve.max_clients=64", "--max-seconds",
                           "120", NULL};
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644), nul = open("/dev/null", O_WRONLY);
-        if (fd < 0 || nul < 0)
-            _exit(127);
-        dup2(fd, 2);
-        dup2(nul, 1);
-        execv(navcam, (char *const *)argv);
-        _exit(127);
-    }
-    return pid;
+    return nc_test_spawn(dir, argv);
 }
 
 static struct nc_client *connect_to(void)
