@@ -96,7 +96,54 @@ struct job {
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
     struct nc_vec3 sun_dir;
     double sun_irr;
+    int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
 };
+
+/* Whether any ray of the 4x4 pixel block at (px0, py0) can reach a body's
+ * bounding sphere. Conservative: every sample of pixel (x, y) lies in
+ * [x - 0.5, x + 0.5] x [y - 0.5, y + 0.5] and uses its row's camera, so the
+ * cone from the block's centre direction through all rows' corner directions
+ * holds every ray (the rays through a rectangle of the image plane form a
+ * convex set whose extreme directions are its corners). Row origins differ by
+ * the camera's motion over a rolling shutter: the spheres grow by the spread.
+ * A block that fails the test would only trace misses (nothing adds to the
+ * pixel), so skipping it leaves the frame bit-identical. */
+static int block_can_hit(const struct job *j, int px0, int py0)
+{
+    const struct nc_scene *s = j->s;
+    const int H = s->camera.height_px, py1 = py0 + 3 < H ? py0 + 3 : H - 1;
+    const struct row_cam *top = &j->row[py0];
+    struct nc_vec3 corner[16];
+    int nc = 0;
+    double spread = 0;
+    for (int py = py0; py <= py1; py++) {
+        const struct row_cam *rc = &j->row[py];
+        spread = fmax(spread, nc_v3_norm(nc_v3_sub(rc->o, top->o)));
+        for (int k = 0; k < 4; k++) {
+            double fx = px0 - 0.5 + 4.0 * (k & 1), fy = py - 0.5 + (k >> 1);
+            corner[nc++] = nc_v3_unit(nc_v3_add(rc->d00, nc_v3_add(nc_v3_scale(rc->ex, fx), nc_v3_scale(rc->ey, fy))));
+        }
+    }
+    struct nc_vec3 axis = nc_v3(0, 0, 0);
+    for (int k = 0; k < nc; k++)
+        axis = nc_v3_add(axis, corner[k]);
+    axis = nc_v3_unit(axis);
+    double cos_half = 1.0;
+    for (int k = 0; k < nc; k++)
+        cos_half = fmin(cos_half, nc_v3_dot(axis, corner[k]));
+    /* 1e-6 rad and 1e-6 relative: the float rays Embree traces, to spare */
+    double half = acos(fmax(-1.0, fmin(1.0, cos_half))) + 1e-6;
+    for (int b = 0; b < s->nbodies; b++) {
+        struct nc_vec3 to = nc_v3_sub(j->body_rel[b], top->o);
+        double d = nc_v3_norm(to), r = s->body[b].bounding_radius_m * (1 + 1e-6) + spread;
+        if (d <= r)
+            return 1; /* the camera is inside the sphere */
+        double ang = acos(fmax(-1.0, fmin(1.0, nc_v3_dot(axis, to) / d)));
+        if (ang <= half + asin(r / d))
+            return 1;
+    }
+    return 0;
+}
 
 static void shade_tile(struct job *j, int tile)
 {
@@ -110,6 +157,10 @@ static void shade_tile(struct job *j, int tile)
     memset(acc_iof, 0, sizeof acc_iof);
     memset(acc_range, 0, sizeof acc_range);
     memset(hits, 0, sizeof hits);
+    int live[TILE / 4][TILE / 4];
+    for (int by = 0; by < TILE; by += 4)
+        for (int bx = 0; bx < TILE; bx += 4)
+            live[by / 4][bx / 4] = y0 + by < H && x0 + bx < W && (!j->cull || block_can_hit(j, x0 + bx, y0 + by));
 
     struct nc_ray16 ray, shadow;
     struct nc_vec3 dir[NC_PACKET], orig[NC_PACKET]; /* the camera rays in double precision */
@@ -122,6 +173,8 @@ static void shade_tile(struct job *j, int tile)
         const int sx = sidx % n, sy = sidx / n;
         for (int by = 0; by < TILE; by += 4)
             for (int bx = 0; bx < TILE; bx += 4) {
+                if (!live[by / 4][bx / 4])
+                    continue;
                 /* Camera rays for a 4x4 pixel block. */
                 for (int i = 0; i < NC_PACKET; i++) {
                     int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
@@ -323,6 +376,7 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     if (j.n_strata < 1)
         j.n_strata = 1;
     atomic_init(&j.next, 0);
+    j.cull = !c->distorted && !r->no_cull; /* the lens model's rays are not linear in the pixel */
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
 
     int nthreads = r->threads, started = 0;

@@ -30,6 +30,9 @@ struct nc_renderer {
      * rays with it); called from render threads, so use with threads = 1. */
     void (*ray_hook)(void *user, int shadow, const struct nc_ray16 *ray);
     void *ray_hook_user;
+    /* 1: trace every block, even those whose rays cannot reach a body's
+     * bounding sphere (tests compare the two; the frames are identical). */
+    int no_cull;
 };
 
 int nc_frame_alloc(struct nc_frame *f, int width_px, int height_px);

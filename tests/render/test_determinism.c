@@ -12,6 +12,44 @@ static int same(const struct nc_frame *a, const struct nc_frame *b)
            !memcmp(a->coverage, b->coverage, n);
 }
 
+static void count_packet(void *user, int shadow, const struct nc_ray16 *ray)
+{
+    (void)ray;
+    ((long *)user)[shadow]++;
+}
+
+/* Skipping the blocks whose rays cannot reach a body changes no pixel and
+ * does skip some: the same exposure traced with and without the test. */
+static void check_cull(struct nc_scene *s, const struct nc_exposure *ex, const char *what, int expect_skip)
+{
+    struct nc_frame a, b;
+    struct nc_renderer ra, rb;
+    long packets[2][2] = {{0, 0}, {0, 0}};
+    int ka = 0, kb = 0;
+    nc_renderer_init(&ra, s, 1);
+    nc_renderer_init(&rb, s, 1);
+    rb.no_cull = 1;
+    ra.ray_hook = rb.ray_hook = count_packet;
+    ra.ray_hook_user = packets[0];
+    rb.ray_hook_user = packets[1];
+    nc_frame_alloc(&a, s->camera.width_px, s->camera.height_px);
+    nc_frame_alloc(&b, s->camera.width_px, s->camera.height_px);
+    nc_render_exposure(&ra, s, ex, &a, &ka);
+    nc_render_exposure(&rb, s, ex, &b, &kb);
+    double sum = 0;
+    for (int i = 0; i < a.width_px * a.height_px; i++)
+        sum += a.coverage[i];
+    CHECK(sum > 0 && ka == kb && same(&a, &b), "%s: skipping empty blocks changed the frame", what);
+    CHECK(packets[0][1] == packets[1][1], "%s: shadow packets %ld with the test, %ld without", what, packets[0][1],
+          packets[1][1]);
+    CHECK(expect_skip ? packets[0][0] < packets[1][0] : packets[0][0] == packets[1][0],
+          "%s: %ld camera packets traced with the test, %ld without", what, packets[0][0], packets[1][0]);
+    nc_frame_free(&a);
+    nc_frame_free(&b);
+    nc_renderer_free(&ra);
+    nc_renderer_free(&rb);
+}
+
 int main(void)
 {
     /* The built-in default scene (procedural mesh, 4 jittered samples) at a
@@ -78,6 +116,30 @@ int main(void)
           k1, k3);
     nc_frame_free(&e1);
     nc_frame_free(&e3);
+    /* Empty blocks: the body in view, still and smeared (rolling shutter,
+     * the camera moving and turning); the limb cut by the frame's edge; a
+     * second body; the camera inside the bounding sphere (nothing skipped). */
+    struct nc_exposure still = {.exposure_s = 0.001};
+    struct nc_vec3 w = s.camera.angular_velocity_rad_s;
+    s.camera.angular_velocity_rad_s = nc_v3(0, 0, 0);
+    s.body[0].angular_velocity_rad_s = nc_v3(0, 0, 0);
+    check_cull(&s, &still, "body in view", 1);
+    s.camera.angular_velocity_rad_s = w;
+    s.camera.velocity_m_s = nc_v3(300, 0, 200);
+    check_cull(&s, &ex, "rolling shutter, moving camera", 1);
+    s.camera.angular_velocity_rad_s = nc_v3(0, 0, 0);
+    s.camera.velocity_m_s = nc_v3(0, 0, 0);
+    s.body[0].position_m = nc_v3(250, 0, 120); /* the limb leaves the frame */
+    check_cull(&s, &still, "limb at the edge", 1);
+    s.body[1] = s.body[0];
+    s.body[1].position_m = nc_v3(-200, 900, -100);
+    s.nbodies = 2;
+    check_cull(&s, &still, "two bodies", 1);
+    s.nbodies = 1;
+    s.body[0].position_m = nc_v3(0, 0, 0);
+    s.camera.position_m = nc_v3(0, -s.body[0].bounding_radius_m * 0.9, 0);
+    check_cull(&s, &still, "camera inside the bounding sphere", 0);
+    s.camera.position_m = keep;
     nc_renderer_free(&r1);
     nc_renderer_free(&r3);
     nc_frame_free(&ref);
