@@ -56,7 +56,11 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
         rc = nc__serve_open_sockets(e);
     if (rc < 0)
         return rc;
-    e->nslots = e->queue_frames + 1;
+    /* Lock-step queues what the simulator asks for; a triggered camera holds
+     * one exposure waiting for readout, and one finished frame may wait
+     * while the outputs send the one before (docs/emulator.md, overload). */
+    e->job_cap = e->mode == NC__MODE_LOCKSTEP ? e->queue_frames : 1;
+    e->nslots = e->mode == NC__MODE_LOCKSTEP ? e->queue_frames + 1 : 2;
     e->jobs = calloc((size_t)e->queue_frames, sizeof *e->jobs);
     e->slots = calloc((size_t)e->nslots, sizeof *e->slots);
     if (!e->jobs || !e->slots)

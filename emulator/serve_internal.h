@@ -34,9 +34,13 @@ enum nc__serve_mode { NC__MODE_LOCKSTEP, NC__MODE_FREERUN, NC__MODE_TRIGGER };
 extern const char *const nc__serve_mode_names[];
 
 /* DROP_IGNORED: a capture request the acquisition mode does not take
- * (free-run, or a software trigger while the trigger source is a line). */
+ * (free-run, or a software trigger while the trigger source is a line).
+ * DROP_OVERRUN (free-run and trigger modes): a trigger or timer tick while
+ * the camera still holds an exposure waiting for readout (docs/emulator.md).
+ * DROP_QUEUE_FULL: a lock-step capture over UDP while the job queue is full. */
 enum nc__drop_reason {
     NC__DROP_QUEUE_FULL,
+    NC__DROP_OVERRUN,
     NC__DROP_STALE_POSE,
     NC__DROP_NO_POSE,
     NC__DROP_OUTPUT_BUSY,
@@ -68,6 +72,7 @@ struct nc__slot {
     struct nc_frame_record rec;
     struct nc__job job;
     uint16_t *dn;
+    int64_t render_start_mono_ns; /* the job left the queue and its pose was there: the render began */
     int dropped;                 /* 1: no frame; answer DROPPED for reason why */
     enum nc__drop_reason why;
 };
@@ -87,6 +92,9 @@ struct nc__emu {
     double frame_rate_hz, stats_interval_s;
     int64_t pose_wait_ns; /* triggered frames: wait this long past the exposure for a later pose */
     int queue_frames, drop_oldest, stale_render, no_pose_scene;
+    atomic_llong readout_end_ns; /* CLOCK_MONOTONIC the frame being rendered should be done (0: none) */
+    int64_t last_trigger_mono_ns; /* of the trigger or tick before (under jlock) */
+    int job_cap; /* jobs that may wait for the render: queue_frames (lock-step) or 1 (the sensor holds one frame) */
     char bind[64];
     int udp_port, tcp_port, max_clients;
     const struct nc_driver_registry *drivers;
@@ -139,7 +147,7 @@ struct nc__emu {
     int64_t start_mono_ns;
     /* statistics */
     atomic_ulong received, rejected[NC_REJECT_COUNT], dropped[NC__DROP_COUNT], delivered;
-    double lat_ms[NC_SERVE_LAT_SAMPLES], render_ms[NC_SERVE_LAT_SAMPLES];
+    double lat_ms[NC_SERVE_LAT_SAMPLES], render_ms[NC_SERVE_LAT_SAMPLES], wait_ms[NC_SERVE_LAT_SAMPLES];
     unsigned long nlat;
     pthread_mutex_t stat_lock;
     int64_t last_reject_log_ns;
@@ -185,6 +193,12 @@ void *nc__serve_render_thread(void *arg);
 void *nc__serve_output_thread(void *arg);
 
 /* serve_stats.c */
+/* The median render and camera-model time of the last 16 frames, ms (0: none yet). */
+double nc__serve_render_estimate_ms(struct nc__emu *e);
+/* The frame rate the camera can deliver now: the requested rate (free-run),
+ * capped by 1 / nc__serve_render_estimate_ms (0: not known yet, in trigger
+ * and lock-step modes before a frame). */
+double nc__serve_resulting_rate_hz(struct nc__emu *e);
 void nc__serve_stats_line(struct nc__emu *e, double elapsed_s);
 void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f);
 

@@ -13,8 +13,8 @@
 #include "core/log.h"
 #include "emulator/serve_internal.h"
 
-const char *const nc__serve_drop_names[] = {"queue_full", "stale_pose",      "no_pose",         "output_busy",
-                                            "shutdown",   "ignored_request", "rejected_request"};
+const char *const nc__serve_drop_names[] = {"queue_full", "overrun",         "stale_pose",      "no_pose",
+                                            "output_busy", "shutdown",       "ignored_request", "rejected_request"};
 
 void nc__serve_flush_client(struct nc__emu *e, struct nc__client *c)
 {
@@ -69,7 +69,7 @@ void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame,
 int nc__serve_queue_full(struct nc__emu *e)
 {
     pthread_mutex_lock(&e->jlock);
-    int full = e->jcount == e->queue_frames;
+    int full = e->jcount == e->job_cap;
     pthread_mutex_unlock(&e->jlock);
     return full;
 }
@@ -80,14 +80,35 @@ void nc__serve_drop(struct nc__emu *e, const struct nc__job *j, enum nc__drop_re
     nc__serve_reply(e, j, UINT64_MAX, NC_FRAME_DROPPED);
 }
 
-/* Queue a frame job without ever waiting: when full, drop by policy.
+/* Free-run and trigger modes: a tick or trigger whose exposure would wait
+ * after its end for the frame being rendered longer than the time since the
+ * trigger before it (one frame period) is an overrun, so every frame leaves
+ * at most one period plus one render after its exposure, and the camera runs
+ * at the rate its render allows (jlock held). */
+static int too_late(struct nc__emu *e, const struct nc__job *j)
+{
+    int64_t busy = atomic_load(&e->readout_end_ns), period = j->trigger_mono_ns - e->last_trigger_mono_ns;
+    e->last_trigger_mono_ns = j->trigger_mono_ns;
+    return busy && busy - j->ready_mono_ns > period;
+}
+
+/* Queue a frame job without ever waiting. Free-run and trigger: a trigger
+ * too late for the render (too_late) is an overrun; the camera holds one
+ * exposure waiting for readout (job_cap 1), and a trigger while it does is
+ * an overrun too: the new one is ignored (drop_newest, as a camera does)
+ * or replaces the waiting one (drop_oldest). Lock-step over UDP: queue_full.
  * Returns 1 when this job was queued. */
 static int push_job(struct nc__emu *e, const struct nc__job *j)
 {
     pthread_mutex_lock(&e->jlock);
-    if (e->jcount == e->queue_frames) {
-        atomic_fetch_add(&e->dropped[NC__DROP_QUEUE_FULL], 1);
-        if (!e->drop_oldest) {
+    if (e->mode != NC__MODE_LOCKSTEP && !j->rejected && too_late(e, j)) {
+        atomic_fetch_add(&e->dropped[NC__DROP_OVERRUN], 1);
+        pthread_mutex_unlock(&e->jlock);
+        return 0;
+    }
+    if (e->jcount == e->job_cap) {
+        atomic_fetch_add(&e->dropped[e->mode == NC__MODE_LOCKSTEP ? NC__DROP_QUEUE_FULL : NC__DROP_OVERRUN], 1);
+        if (!e->drop_oldest || e->mode == NC__MODE_LOCKSTEP) {
             pthread_mutex_unlock(&e->jlock);
             return 0; /* the newest job goes */
         }

@@ -65,6 +65,7 @@ void *nc__serve_output_thread(void *arg)
         pthread_mutex_lock(&e->stat_lock);
         e->lat_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = (handed - sl->job.ready_mono_ns) * 1e-6;
         e->render_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = sl->rec.render_ms + sl->rec.camera_ms;
+        e->wait_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = (sl->render_start_mono_ns - sl->job.ready_mono_ns) * 1e-6;
         e->nlat++;
         pthread_mutex_unlock(&e->stat_lock);
         atomic_fetch_add(&e->delivered, 1);

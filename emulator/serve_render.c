@@ -157,7 +157,9 @@ void *nc__serve_render_thread(void *arg)
         struct nc_exposure ex = {.exposure_s = j.exposure_s, .rolling = e->cs.sensor.shutter == NC_SHUTTER_ROLLING,
                                  .line_time_s = e->cs.sensor.line_time_s};
         int ts = 1;
-        int64_t t0 = nc_mono_ns();
+        int64_t t0 = nc_mono_ns(); /* from here on the frame is being read out */
+        double est_ms = nc__serve_render_estimate_ms(e); /* 0 before the first frame: no tick waits for it */
+        atomic_store(&e->readout_end_ns, est_ms > 0 ? t0 + llround(est_ms * 1e6) : INT64_MAX);
         int rc = nc_render_exposure(&e->renderer, &at, &ex, &f, &ts);
         int64_t t1 = nc_mono_ns();
         struct nc__slot *sl = free_slot(e, &j);
@@ -171,6 +173,7 @@ void *nc__serve_render_thread(void *arg)
         if (rc >= 0)
             rc = nc_camsys_digitise(&cs, el, j.exposure_s, frame, sl->dn);
         int64_t t2 = nc_mono_ns();
+        atomic_store(&e->readout_end_ns, 0);
         if (rc < 0) {
             nc_log_error("emulator/render", "frame %llu: %s", (unsigned long long)frame, nc_errmsg());
             if (e->mode != NC__MODE_LOCKSTEP) {
@@ -188,6 +191,7 @@ void *nc__serve_render_thread(void *arg)
         int64_t start_mono = j.trigger_mono_ns + (start_sim - j.trigger_sim_ns);
         sl->job = j;
         sl->dropped = 0;
+        sl->render_start_mono_ns = t0;
         sl->rec = (struct nc_frame_record){
             .frame = frame, .request_sequence = j.sequence, .trigger_source = j.source,
             .trigger_sim_ns = j.trigger_sim_ns, .exposure_start_sim_ns = start_sim,

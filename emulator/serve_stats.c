@@ -1,6 +1,7 @@
 /* serve_stats.c - the emulator's statistics (serve_internal.h): latency and
  * render-time percentiles, the periodic line, the JSON summary. Reads the
  * counters; changes nothing. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -13,30 +14,60 @@ static int cmpd(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Per frame: latency = waiting (queue, pose) + render and camera model +
+ * hand-off; overhead = latency - render and camera model. */
+enum { Q_LAT, Q_REN, Q_WAIT, Q_OVER, Q_COUNT };
 struct percentiles {
-    double lat50, lat99, ren50, over99;
+    double p50[Q_COUNT], p99[Q_COUNT];
 };
 
 static struct percentiles percentiles(struct nc__emu *e)
 {
-    struct percentiles p = {0};
+    struct percentiles p = {{0}, {0}};
     pthread_mutex_lock(&e->stat_lock);
     unsigned long n = e->nlat < NC_SERVE_LAT_SAMPLES ? e->nlat : NC_SERVE_LAT_SAMPLES;
-    double *a = malloc((n ? n : 1) * 3 * sizeof *a);
+    double *a = malloc((n ? n : 1) * Q_COUNT * sizeof *a);
     for (unsigned long i = 0; a && i < n; i++) {
-        a[i] = e->lat_ms[i];
-        a[n + i] = e->render_ms[i];
-        a[2 * n + i] = e->lat_ms[i] - e->render_ms[i];
+        a[Q_LAT * n + i] = e->lat_ms[i];
+        a[Q_REN * n + i] = e->render_ms[i];
+        a[Q_WAIT * n + i] = e->wait_ms[i];
+        a[Q_OVER * n + i] = e->lat_ms[i] - e->render_ms[i];
     }
     pthread_mutex_unlock(&e->stat_lock);
     if (n && a) {
-        for (int k = 0; k < 3; k++)
-            qsort(a + k * n, n, sizeof *a, cmpd);
         size_t i99 = (size_t)(0.99 * (n - 1));
-        p = (struct percentiles){a[n / 2], a[i99], a[n + n / 2], a[2 * n + i99]};
+        for (int k = 0; k < Q_COUNT; k++) {
+            qsort(a + k * n, n, sizeof *a, cmpd);
+            p.p50[k] = a[k * n + n / 2];
+            p.p99[k] = a[k * n + i99];
+        }
     }
     free(a);
     return p;
+}
+
+double nc__serve_render_estimate_ms(struct nc__emu *e)
+{
+    double r[16];
+    pthread_mutex_lock(&e->stat_lock);
+    unsigned long n = e->nlat < 16 ? e->nlat : 16;
+    for (unsigned long i = 0; i < n; i++)
+        r[i] = e->render_ms[(e->nlat - 1 - i) % NC_SERVE_LAT_SAMPLES];
+    pthread_mutex_unlock(&e->stat_lock);
+    if (n == 0)
+        return 0.0;
+    qsort(r, n, sizeof *r, cmpd);
+    return r[n / 2];
+}
+
+double nc__serve_resulting_rate_hz(struct nc__emu *e)
+{
+    struct nc_acquisition a;
+    nc__serve_acq_get(e, &a);
+    double want = a.triggered || e->mode == NC__MODE_LOCKSTEP ? INFINITY : a.frame_rate_hz;
+    double r = nc__serve_render_estimate_ms(e), can = r > 0 ? 1000.0 / r : INFINITY;
+    double got = fmin(want, can);
+    return isfinite(got) ? got : 0.0;
 }
 
 void nc__serve_stats_line(struct nc__emu *e, double elapsed_s)
@@ -49,12 +80,14 @@ void nc__serve_stats_line(struct nc__emu *e, double elapsed_s)
         drp += atomic_load(&e->dropped[i]);
     unsigned long delivered = atomic_load(&e->delivered);
     nc_log_info("emulator",
-                "%.1f s: frames %lu (%.2f fps), dropped %lu (queue %lu, stale %lu, no pose %lu, output %lu), "
-                "messages %lu, rejected %lu, latency p50 %.2f ms p99 %.2f ms",
+                "%.1f s: frames %lu (%.2f fps), dropped %lu (overrun %lu, queue %lu, stale %lu, no pose %lu, "
+                "output %lu), messages %lu, rejected %lu, latency p50 %.2f ms p99 %.2f ms (render+camera p50 %.2f "
+                "ms, waiting p99 %.2f ms)",
                 elapsed_s, delivered, elapsed_s > 0 ? delivered / elapsed_s : 0.0, drp,
-                atomic_load(&e->dropped[NC__DROP_QUEUE_FULL]), atomic_load(&e->dropped[NC__DROP_STALE_POSE]),
-                atomic_load(&e->dropped[NC__DROP_NO_POSE]), atomic_load(&e->dropped[NC__DROP_OUTPUT_BUSY]),
-                atomic_load(&e->received), rej, p.lat50, p.lat99);
+                atomic_load(&e->dropped[NC__DROP_OVERRUN]), atomic_load(&e->dropped[NC__DROP_QUEUE_FULL]),
+                atomic_load(&e->dropped[NC__DROP_STALE_POSE]), atomic_load(&e->dropped[NC__DROP_NO_POSE]),
+                atomic_load(&e->dropped[NC__DROP_OUTPUT_BUSY]), atomic_load(&e->received), rej, p.p50[Q_LAT],
+                p.p99[Q_LAT], p.p50[Q_REN], p.p99[Q_WAIT]);
 }
 
 void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f)
@@ -84,9 +117,19 @@ void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f)
                    "\"accepted\": %lu}, ",
                 e->have_line ? e->line.drv->name : "software", c.edges, c.wrong_edge, c.debounced, c.accepted);
     }
+    if (e->have_freerun) {
+        struct nc_trigger_counts c;
+        nc_trigger_counts(&e->freerun, &c);
+        fprintf(f, "\"freerun\": {\"ticks\": %lu}, ", c.accepted);
+    }
+    struct nc_acquisition a;
+    nc__serve_acq_get(e, &a);
+    fprintf(f, "\"frame_rate_hz\": %.4f, \"resulting_frame_rate_hz\": %.4f, ", a.frame_rate_hz,
+            nc__serve_resulting_rate_hz(e));
     fprintf(f, "\"latency_p50_ms\": %.3f, \"latency_p99_ms\": %.3f, \"render_camera_p50_ms\": %.3f, "
+               "\"render_camera_p99_ms\": %.3f, \"wait_p50_ms\": %.3f, \"wait_p99_ms\": %.3f, "
                "\"overhead_p99_ms\": %.3f, \"outputs\": [",
-            p.lat50, p.lat99, p.ren50, p.over99);
+            p.p50[Q_LAT], p.p99[Q_LAT], p.p50[Q_REN], p.p99[Q_REN], p.p50[Q_WAIT], p.p99[Q_WAIT], p.p99[Q_OVER]);
     for (int i = 0; i < e->nout; i++)
         fprintf(f, "%s{\"driver\": \"%s\", \"submitted\": %lu, \"failed\": %lu}", i ? ", " : "", e->out[i].drv->name,
                 e->out[i].submitted, e->out[i].failed);

@@ -97,7 +97,7 @@ cat a/capture.log
 step "B: a storm of 20000 edges while poses stream in"
 # 400 poses at 200 Hz of simulation time, streamed in real time.
 awk 'BEGIN { for (i = 0; i < 400; i++) printf "%.3f,0,-6000,0,1,0,0,0,1e11,0,0\n", i * 0.005 }' >b/traj.csv
-start_serve b --set "serve.trigger=$trig" --set serve.queue_frames=2 --set serve.udp_port=5760 \
+start_serve b --set "serve.trigger=$trig" --set serve.udp_port=5760 \
     --set serve.tcp_port=5761 --set "outputs=[{driver: v4l2, card: NavCam}, {driver: null}]"
 "$navcam" replay b/traj.csv --port 5760 >b/replay.log 2>&1 &
 replay_pid=$!
