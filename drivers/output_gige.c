@@ -1,19 +1,25 @@
 /* output_gige.c - the GigE Vision output: NavCam as a GenICam camera that
  * any GigE Vision client (Aravis, vendor viewers) opens by address. It
- * embeds Aravis's GigE Vision device (ArvGvFakeCamera) with NavCam's own
- * GenICam description (drivers/gige/navcam-genicam.xml, compiled in).
+ * embeds Aravis's GigE Vision device (ArvGvFakeCamera) for the control
+ * protocol, with NavCam's own GenICam description
+ * (drivers/gige/navcam-genicam.xml, compiled in), and streams frames itself.
  *
  * Who does what:
- * - The device thread (Aravis) answers GVCP and sends GVSP. NavCam keeps it
- *   in its internal software-trigger mode and raises its trigger latch once
- *   per finished frame; the device polls that latch trigger_poll_hz times a
- *   second and then calls fill(), which copies the newest frame (ROI, pixel
- *   format, optional metadata row). fill() never waits on rendering.
+ * - The device thread (Aravis) answers GVCP: registers, acquisition start
+ *   and stop, heartbeats. It never streams: its own trigger stays in
+ *   software mode and its latch is never raised.
+ * - The sender thread sends each finished frame the moment submit() hands
+ *   it over (gige/gvsp.c): ROI and pixel format as the registers say, the
+ *   optional metadata row, the exposure start as GVSP timestamp. A frame
+ *   whose exposure started before the client's AcquisitionStart is never
+ *   sent; a newer frame replaces one not yet sent.
  * - NavCam's poll thread reads what clients wrote (ExposureTime, Gain,
  *   AcquisitionFrameRate, TriggerMode/Source/Activation/Delay) poll_hz times
  *   a second and hands changes to the emulator (struct nc_camera_control),
- *   so they act on the next exposure; TriggerSoftware fires the emulator's
- *   software trigger.
+ *   so they act on the next exposure; at AcquisitionStart it applies the
+ *   settings first, then opens the stream to exposures from then on.
+ *   TriggerSoftware fires the emulator's software trigger;
+ *   AcquisitionResultingFrameRate is kept up to date.
  * Registers are plain memory shared with the device thread (no locking in
  * Aravis 0.8): 32-bit accesses are single loads and stores.
  */
@@ -31,9 +37,11 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include "core/clock.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "drivers/gige/gige_check.h"
+#include "drivers/gige/gvsp.h"
 #include "drivers/navcam_genicam_xml.h"
 #include "emulator/output.h"
 #include "core/version.h"
@@ -46,6 +54,7 @@ enum {
     REG_TRIGGER_ACT = 0x1018,    /* 0 rising, 1 falling, 2 any */
     REG_TRIGGER_SW = 0x101c,     /* latch: a client writes 1 */
     REG_TRIGGER_DELAY = 0x1020,  /* double, us */
+    REG_RESULTING_RATE = 0x1028, /* double, Hz, read-only */
     REG_META_ROWS = 0x1030,      /* 0 or 1 */
     REG_PACKET_SIZE = 0xd04,     /* stream channel 0: packet size in the low 16 bits */
     REG_VENDOR = 0x48,
@@ -64,16 +73,20 @@ struct gige {
     const struct nc_camera_control *ctl;
     int W, H, adc_bits, meta_rows;
     char iface[IF_NAMESIZE], addr[INET_ADDRSTRLEN];
-    /* the newest finished frame */
+    /* the newest finished frame, for the sender thread */
     pthread_mutex_t lock;
+    pthread_cond_t cond; /* a frame was handed over, or stop */
     uint16_t *dn;
+    uint8_t *payload; /* the frame as the stream carries it */
     struct nc_frame_record rec;
     uint64_t seq, sent_seq, submitted;
-    unsigned long sent, resent, skipped, empty;
-    /* the poll thread */
-    pthread_t thread;
+    unsigned long sent, skipped, not_acquiring, before_start, send_failed;
+    struct nc__gvsp gvsp;
+    atomic_llong acq_start_ns; /* CLOCK_MONOTONIC of AcquisitionStart (settings applied); 0: stopped */
+    /* the poll and sender threads */
+    pthread_t thread, sender;
     atomic_int stop;
-    int running;
+    int running, sending;
     double poll_hz;
     struct nc_acquisition applied; /* what the registers said last time */
     unsigned long rejected_settings;
@@ -147,10 +160,29 @@ static int same(const struct nc_acquisition *a, const struct nc_acquisition *b)
            a->trigger_delay_s == b->trigger_delay_s;
 }
 
+/* Client-written settings to the emulator, when they changed. */
+static void apply_settings(struct gige *g)
+{
+    struct nc_acquisition want;
+    read_settings(g, &want);
+    if (same(&want, &g->applied) || !g->ctl)
+        return;
+    if (g->ctl->set(g->ctl->emu, &want) >= 0) {
+        g->applied = want; /* the registers already say so */
+        return;
+    }
+    /* Refused (lock-step, out of range): show the client what holds. */
+    if (g->rejected_settings++ == 0)
+        nc_log_warn("output/gige", "a client's setting was refused: %s", nc_errmsg());
+    g->ctl->get(g->ctl->emu, &want);
+    publish(g, &want);
+}
+
 static void *poll_thread(void *arg)
 {
     struct gige *g = arg;
     const long period_ns = (long)(1e9 / g->poll_hz);
+    int64_t next_rate_ns = 0;
     while (!atomic_load(&g->stop)) {
         nanosleep(&(struct timespec){0, period_ns}, NULL);
         if (reg_get(g, REG_TRIGGER_SW) == 1) {
@@ -158,19 +190,21 @@ static void *poll_thread(void *arg)
             if (g->ctl)
                 g->ctl->software_trigger(g->ctl->emu);
         }
-        struct nc_acquisition want;
-        read_settings(g, &want);
-        if (same(&want, &g->applied) || !g->ctl)
-            continue;
-        if (g->ctl->set(g->ctl->emu, &want) >= 0) {
-            g->applied = want; /* the registers already say so */
-            continue;
+        /* Acquisition: read after the settings a client wrote before its
+         * AcquisitionStart, so those are applied before the stream opens to
+         * exposures starting from now. */
+        int acquiring = arv_fake_camera_get_acquisition_status(g->fc) != 0 &&
+                        arv_fake_camera_get_control_channel_privilege(g->fc) != 0;
+        apply_settings(g);
+        if (acquiring && !atomic_load(&g->acq_start_ns))
+            atomic_store(&g->acq_start_ns, nc_mono_ns());
+        else if (!acquiring)
+            atomic_store(&g->acq_start_ns, 0);
+        int64_t now = nc_mono_ns();
+        if (g->ctl && g->ctl->resulting_rate_hz && now >= next_rate_ns) {
+            reg_set_double(g, REG_RESULTING_RATE, g->ctl->resulting_rate_hz(g->ctl->emu));
+            next_rate_ns = now + 100000000;
         }
-        /* Refused (lock-step, out of range): show the client what holds. */
-        if (g->rejected_settings++ == 0)
-            nc_log_warn("output/gige", "a client's setting was refused: %s", nc_errmsg());
-        g->ctl->get(g->ctl->emu, &want);
-        publish(g, &want);
     }
     return NULL;
 }
@@ -227,39 +261,25 @@ static inline uint16_t convert(uint16_t dn, uint32_t pf, int bits)
     return (uint16_t)(dn << (16 - bits)); /* Mono16: most significant bits */
 }
 
-/* Device thread, camera mutex held: copy the newest frame, never wait. */
-static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gain_raw, ArvPixelFormat pf)
+/* The newest frame (lock held) as the registers ask for it now: ROI, pixel
+ * format, the metadata row on top. Returns 0, or -1 for settings NavCam does
+ * not serve (a format it lacks, a size beyond 65536): nothing is sent then. */
+static int pack(struct gige *g, struct nc__gvsp_image *im)
 {
-    struct gige *g = data;
-    size_t size = 0;
-    uint8_t *out = (uint8_t *)arv_buffer_get_data(buffer, &size); /* size reads 0 here */
-    /* The device sized the buffer from these registers. Clients may write
-     * anything into them (GenICam range checks are the client's): offsets
-     * are clamped to the sensor, and a format NavCam does not serve leaves
-     * the buffer alone rather than overrun it. */
+    /* Clients may write anything into these registers (GenICam range checks
+     * are the client's): offsets are clamped to the sensor. */
     const uint32_t w = reg_get(g, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = reg_get(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
     const uint32_t rox = reg_get(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET);
     const uint32_t roy = reg_get(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
+    const uint32_t pf = reg_get(g, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT);
     const int ox = rox < (uint32_t)g->W ? (int)rox : g->W, oy = roy < (uint32_t)g->H ? (int)roy : g->H;
-    if ((pf != PF_MONO8 && pf != PF_MONO12 && pf != PF_MONO16) || w > 65536 || h > 65536)
-        return;
+    if ((pf != PF_MONO8 && pf != PF_MONO12 && pf != PF_MONO16) || w == 0 || h == 0 ||
+        (size_t)w * h > (size_t)g->W * (g->H + 1))
+        return -1;
     const int bpp = pf == PF_MONO8 ? 1 : 2;
-    pthread_mutex_lock(&g->lock);
-    if (!g->seq) {
-        memset(out, 0, (size_t)w * h * bpp);
-        g->empty++;
-        pthread_mutex_unlock(&g->lock);
-        return;
-    }
-    /* Newer frames replace one the device has not sent yet (it polls its
-     * latch at trigger_poll_hz and can be late on a loaded machine). */
-    if (g->sent_seq && g->seq > g->sent_seq + 1)
-        g->skipped += g->seq - g->sent_seq - 1;
-    g->resent += g->sent_seq == g->seq;
-    g->sent_seq = g->seq;
-    g->sent++;
+    uint8_t *out = g->payload;
     int row0 = 0;
-    if (g->meta_rows && h > 0) { /* the metadata row on top */
+    if (g->meta_rows) { /* the metadata row on top */
         uint8_t m[META_BYTES];
         metadata(&g->rec, m);
         size_t rowb = (size_t)w * bpp;
@@ -286,9 +306,62 @@ static void fill(ArvBuffer *buffer, void *data, guint32 exposure_us, guint32 gai
         if (n < (int)w)
             memset(o + (size_t)n * bpp, 0, (size_t)((int)w - n) * bpp);
     }
-    /* The GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns. */
-    arv_buffer_set_timestamp(buffer, (guint64)g->rec.exposure_start_mono_ns);
+    *im = (struct nc__gvsp_image){.pixel_format = pf, .width = w, .height = h, .offset_x = (uint32_t)ox,
+                                  .offset_y = (uint32_t)oy, .data = out, .size = (size_t)w * h * bpp,
+                                  /* the GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns */
+                                  .timestamp_ns = (uint64_t)g->rec.exposure_start_mono_ns};
+    return 0;
+}
+
+/* Where the client wants the stream (GevSCDA, GevSCPHostPort); 0 if nowhere. */
+static int stream_dest(struct gige *g, struct sockaddr_in *dest)
+{
+    GSocketAddress *sa = arv_fake_camera_get_stream_address(g->fc);
+    int ok = sa && g_socket_address_to_native(sa, dest, sizeof *dest, NULL) && dest->sin_family == AF_INET &&
+             dest->sin_port != 0;
+    g_clear_object(&sa);
+    return ok;
+}
+
+/* Each frame handed over is sent at once, unless no client acquires or it
+ * was exposed before AcquisitionStart. */
+static void *sender_thread(void *arg)
+{
+    struct gige *g = arg;
+    pthread_mutex_lock(&g->lock);
+    while (!atomic_load(&g->stop)) {
+        if (g->seq == g->sent_seq) {
+            pthread_cond_wait(&g->cond, &g->lock);
+            continue;
+        }
+        if (g->sent_seq && g->seq > g->sent_seq + 1)
+            g->skipped += g->seq - g->sent_seq - 1; /* replaced by newer ones while sending */
+        g->sent_seq = g->seq;
+        int64_t start = atomic_load(&g->acq_start_ns);
+        struct sockaddr_in dest;
+        struct nc__gvsp_image im;
+        if (!start || !stream_dest(g, &dest)) {
+            g->not_acquiring++;
+            continue;
+        }
+        if (g->rec.exposure_start_mono_ns < start) {
+            g->before_start++; /* the client asked for frames exposed from AcquisitionStart on */
+            continue;
+        }
+        uint32_t packet = reg_get(g, REG_PACKET_SIZE) & 0xffff;
+        if (pack(g, &im) < 0) {
+            g->send_failed++;
+            continue;
+        }
+        pthread_mutex_unlock(&g->lock); /* submit() may hand over the next frame meanwhile */
+        int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &im);
+        pthread_mutex_lock(&g->lock);
+        if (rc < 0 && g->send_failed++ == 0)
+            nc_log_warn("output/gige", "frame %llu: %s", (unsigned long long)g->rec.frame, nc_errmsg());
+        g->sent += rc == 0;
+    }
     pthread_mutex_unlock(&g->lock);
+    return NULL;
 }
 
 /* ---- open, submit, close ------------------------------------------------------ */
@@ -303,7 +376,6 @@ static const struct nc_param gige_params[] = {
     NC_P_STRING("model", "NavCam emulator", "model name the device reports"),
     NC_P_STRING("xml", NULL, "a GenICam description file to serve instead of NavCam's own (relative to the config file)"),
     NC_P_ENUM("pixel_format", "Mono16", formats, "initial pixel format (clients may change it)"),
-    NC_P_DOUBLE("trigger_poll_hz", "200", 1, 1000, "Hz", "how often the device looks for a finished frame"),
     NC_P_DOUBLE("poll_hz", "1000", 1, 10000, "Hz", "how often client-written settings are read"),
     NC_P_INT("packet_size", NULL, 576, 65000, "bytes", "GVSP packet size (default 8192 on lo, 1400 elsewhere)"),
     NC_P_INT("metadata_row", "0", 0, 1, "", "1: append a row with the frame's metadata"),
@@ -314,7 +386,6 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
 {
     struct gige *g = priv;
     const char *iface = NULL, *serial = NULL, *model = NULL, *xml = NULL;
-    double trig_hz = 0;
     long packet = -1, meta = 0;
     int fmt = 0, rc;
     if ((rc = nc_param_string(opts, gige_params, "interface", &iface)) < 0 ||
@@ -322,7 +393,6 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         (rc = nc_param_string(opts, gige_params, "model", &model)) < 0 ||
         (rc = nc_param_string(opts, gige_params, "xml", &xml)) < 0 ||
         (rc = nc_param_enum(opts, gige_params, "pixel_format", &fmt)) < 0 ||
-        (rc = nc_param_double(opts, gige_params, "trigger_poll_hz", &trig_hz)) < 0 ||
         (rc = nc_param_double(opts, gige_params, "poll_hz", &g->poll_hz)) < 0 ||
         (rc = nc_param_int(opts, gige_params, "packet_size", &packet)) < 0 ||
         (rc = nc_param_int(opts, gige_params, "metadata_row", &meta)) < 0)
@@ -379,12 +449,18 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         return rc;
     }
     g->dn = calloc((size_t)g->W * g->H, sizeof *g->dn);
-    if (!g->dn) {
+    g->payload = malloc((size_t)g->W * (g->H + 1) * 2);
+    if (!g->dn || !g->payload || (rc = nc__gvsp_open(&g->gvsp, g->addr)) < 0) {
         if (!xml)
             unlink(path);
-        return nc_error(-ENOMEM, "out of memory");
+        free(g->dn);
+        free(g->payload);
+        g->dn = NULL;
+        g->payload = NULL;
+        return rc < 0 ? rc : nc_error(-ENOMEM, "out of memory");
     }
     pthread_mutex_init(&g->lock, NULL);
+    pthread_cond_init(&g->cond, NULL);
     g->gv = arv_gv_fake_camera_new_full(g->iface, serial, path);
     if (!xml)
         unlink(path); /* read at construction */
@@ -409,21 +485,24 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     reg_set(g, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE, 1);
     /* Loopback carries big packets; real links start at the safe 1400. */
     reg_set(g, REG_PACKET_SIZE, (uint32_t)(packet > 0 ? packet : !strcmp(g->iface, "lo") ? 8192 : 1400));
-    /* Internal: the device sends a frame when NavCam raises its latch. */
+    /* Internal: the device itself never streams (its software trigger is
+     * never raised; it looks for it 10 times a second); the sender does. */
     reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_MODE, 1);
     reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOURCE, 1);
-    arv_fake_camera_set_trigger_frequency(g->fc, trig_hz);
+    arv_fake_camera_set_trigger_frequency(g->fc, 10);
     struct nc_acquisition a = {.frame_rate_hz = 10, .exposure_s = 1e-3};
     if (g->ctl)
         g->ctl->get(g->ctl->emu, &a);
     publish(g, &a);
-    arv_fake_camera_set_fill_pattern(g->fc, fill, g);
-    int err = pthread_create(&g->thread, NULL, poll_thread, g);
+    int err = pthread_create(&g->sender, NULL, sender_thread, g);
+    g->sending = !err;
+    if (!err)
+        err = pthread_create(&g->thread, NULL, poll_thread, g);
+    g->running = !err;
     if (err) {
         gige_close(g);
-        return nc_error(-err, "gige: cannot start the poll thread: %s", strerror(err));
+        return nc_error(-err, "gige: cannot start its threads: %s", strerror(err));
     }
-    g->running = 1;
     nc_log_info("output/gige", "GigE Vision camera '%s' (serial %s) on %s (%s), %dx%d %s; open it by address, "
                 "e.g. arv-tool-0.8 -a %s features",
             model, serial, g->addr, g->iface, g->W, g->H, formats[fmt], g->addr);
@@ -441,26 +520,38 @@ static int gige_submit(void *priv, const struct nc_frame_record *r)
     g->rec.dn = g->dn;
     g->seq++;
     g->submitted++;
+    pthread_cond_signal(&g->cond); /* the sender sends it now */
     pthread_mutex_unlock(&g->lock);
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOFTWARE, 1); /* the device sends it at its next poll */
     return 0;
 }
 
 static void gige_close(void *priv)
 {
     struct gige *g = priv;
-    if (g->running) {
-        atomic_store(&g->stop, 1);
+    atomic_store(&g->stop, 1);
+    if (g->running)
         pthread_join(g->thread, NULL);
-        nc_log_info("output/gige", "%llu frames handed over, %lu sent (%lu again, %lu replaced by newer "
-                    "before the device sent them, %lu blank before the first frame), %lu client settings refused",
-                (unsigned long long)g->submitted, g->sent, g->resent, g->skipped, g->empty, g->rejected_settings);
+    if (g->sending) {
+        pthread_mutex_lock(&g->lock);
+        pthread_cond_broadcast(&g->cond);
+        pthread_mutex_unlock(&g->lock);
+        pthread_join(g->sender, NULL);
     }
+    if (g->running)
+        nc_log_info("output/gige", "%llu frames handed over, %lu sent (%lu replaced by newer ones while sending, "
+                    "%lu while no client acquired, %lu exposed before AcquisitionStart, %lu failed), "
+                    "%lu client settings refused",
+                    (unsigned long long)g->submitted, g->sent, g->skipped, g->not_acquiring, g->before_start,
+                    g->send_failed, g->rejected_settings);
     if (g->gv)
-        g_object_unref(g->gv); /* stops and joins the device thread before g goes */
-    if (g->dn)
+        g_object_unref(g->gv); /* stops and joins the device thread */
+    if (g->dn) {
         pthread_mutex_destroy(&g->lock);
+        pthread_cond_destroy(&g->cond);
+        nc__gvsp_close(&g->gvsp);
+    }
     free(g->dn);
+    free(g->payload);
 }
 
 const struct nc_output_driver nc_output_gige = {

@@ -62,6 +62,9 @@ struct nc_camera_control {
     int (*set)(void *emu, const struct nc_acquisition *a);
     /* A software trigger now (counted as ignored unless triggered by software). */
     void (*software_trigger)(void *emu);
+    /* The frame rate the camera delivers now, Hz: the requested free-run
+     * rate capped by what the render allows (0: not known yet). */
+    double (*resulting_rate_hz)(void *emu);
 };
 
 struct nc_output_ctx {

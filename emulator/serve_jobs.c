@@ -269,8 +269,10 @@ void nc__serve_enable_sources(struct nc__emu *e)
 }
 
 static void control_software_trigger(void *emu) { nc__serve_software(emu, NULL, -1, 0, nc_mono_ns()); }
+static double control_resulting_rate(void *emu) { return nc__serve_resulting_rate_hz(emu); }
 
 void nc__serve_init_control(struct nc__emu *e)
 {
-    e->control = (struct nc_camera_control){e, control_get, control_set, control_software_trigger};
+    e->control = (struct nc_camera_control){e, control_get, control_set, control_software_trigger,
+                                            control_resulting_rate};
 }

@@ -3,7 +3,9 @@
  * pixels equal the file output's frame of the same number (Mono12 as is,
  * Mono16 and Mono8 shifted, ROI crops); ExposureTime and Gain act on the
  * physics of the next exposure (noise off: 2x exposure -> 2x signal above
- * bias, gain scales as 10^(dB/20)); TriggerMode On + Software: one frame per
+ * bias, gain scales as 10^(dB/20)); after AcquisitionStop, ExposureTime,
+ * AcquisitionStart every frame has the new setting (none exposed before the
+ * start arrives); TriggerMode On + Software: one frame per
  * TriggerSoftware and none without; TriggerSource Line0 follows the line of
  * serve.trigger; AcquisitionFrameRate within 2%; a client
  * killed mid-stream, then a new client streams; clear errors for a missing
@@ -146,6 +148,63 @@ static void test_exposure_gain(void)
     CHECK(fabs(r_ex / 2 - 1) < 0.02, "doubling ExposureTime: ratio %.4f", r_ex);
     CHECK(fabs(r_gain / want_gain - 1) < 0.02, "Gain 6 dB: ratio %.4f, want %.4f", r_gain, want_gain);
     CHECK(mx[1] < (1 << BITS) - 1 && mx[2] < (1 << BITS) - 1, "saturated: the test needs signal below full scale");
+    free(img);
+    g_object_unref(c);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+}
+
+/* The issue-13 sequence: AcquisitionStop; ExposureTime=X; AcquisitionStart;
+ * grab 4 frames, for X = 500, 500, 500, 2000, 2000, 2000, 1000, 1000 us.
+ * Every frame grabbed after a start was exposed after it (GVSP timestamp),
+ * carries X in its metadata row and has the signal of X (noise off). */
+static void test_next_exposure(void)
+{
+    char dir[4096];
+    pid_t pid;
+    ArvCamera *c = begin("next_exposure", "outputs=[{driver: gige, pixel_format: Mono12, metadata_row: 1}]",
+                         "serve.frame_rate_hz=20", &pid, dir, sizeof dir);
+    if (!c)
+        return;
+    uint8_t *img = malloc((size_t)W * (H + 1) * 2);
+    struct stream st = {0};
+    CHECK(start(c, &st) == 0, "stream");
+    static const double xs[] = {500, 500, 500, 2000, 2000, 2000, 1000, 1000};
+    int good = 0, total = 0;
+    double per_us = 0, worst = 0;
+    for (int k = 0; k < 8; k++) {
+        arv_camera_stop_acquisition(c, NULL);
+        while (next_frame(&st, 0.15, img, NULL) == 0) /* what was on its way before the stop */
+            ;
+        arv_camera_set_exposure_time(c, xs[k], NULL);
+        uint64_t t_start = (uint64_t)(now_s() * 1e9);
+        arv_camera_start_acquisition(c, NULL);
+        printf("ExposureTime %5.0f us:", xs[k]);
+        for (int i = 0; i < 4; i++) {
+            uint64_t ts, frame;
+            double ex, gain, sum = 0;
+            total++;
+            if (next_frame(&st, 3, img, &ts) < 0 || meta(img, &frame, &ex, &gain) < 0) {
+                CHECK(0, "X = %g us: frame %d did not arrive", xs[k], i);
+                continue;
+            }
+            for (size_t p = 0; p < (size_t)W * H; p++)
+                sum += (img[(W + p) * 2] | img[(W + p) * 2 + 1] << 8) - BIAS;
+            double m = sum / ((double)W * H) / xs[k]; /* DN per us of exposure */
+            if (per_us == 0)
+                per_us = m;
+            worst = fmax(worst, fabs(m / per_us - 1));
+            printf(" %.1f", sum / ((double)W * H));
+            int ok = ts >= t_start && fabs(ex - xs[k] * 1e-6) < 1e-9 && fabs(m / per_us - 1) < 0.02;
+            CHECK(ok, "X = %g us, frame %d (%llu): exposed %+.3f ms after AcquisitionStart, metadata %g us, "
+                      "signal %.4f DN/us (first %.4f)", xs[k], i, (unsigned long long)frame,
+                  ((double)ts - (double)t_start) * 1e-6, ex * 1e6, m, per_us);
+            good += ok;
+        }
+        printf(" DN above bias\n");
+    }
+    printf("settings from the next exposure: %d of %d frames exposed after AcquisitionStart with the new "
+           "ExposureTime (metadata and signal; worst signal deviation %.2f%%)\n", good, total, 100 * worst);
+    finish(c, &st);
     free(img);
     g_object_unref(c);
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
@@ -359,6 +418,7 @@ int main(int argc, char **argv)
     setvbuf(stdout, NULL, _IOLBF, 0);
     test_pixels();
     test_exposure_gain();
+    test_next_exposure();
     test_trigger_and_rate();
     test_line0();
     test_client_killed();
