@@ -43,14 +43,6 @@ static void *serve_thread(void *arg)
     return NULL;
 }
 
-static double json_number(const char *text, const char *key)
-{
-    char pat[80];
-    snprintf(pat, sizeof pat, "\"%s\": ", key);
-    const char *p = strstr(text, pat);
-    return p ? atof(p + strlen(pat)) : -1;
-}
-
 struct result {
     double render_ms, lat50, lat99, over99, rtt50, rtt99, achieved_hz;
 };
@@ -122,12 +114,8 @@ static int run_once(const char *const *user_sets, int nuser, int frames, double 
         free(rtt);
         return -1;
     }
-    char text[8192] = "";
-    FILE *f = fopen(r.json_path, "r");
-    size_t got = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    text[got] = 0;
-    if (f)
-        fclose(f);
+    char text[8192];
+    read_text(r.json_path, text, sizeof text);
     unlink(r.json_path);
     res->render_ms = json_number(text, "render_camera_p50_ms");
     res->lat50 = json_number(text, "latency_p50_ms");

@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 
-#define BATCH 64
+#define BATCH 8
 #define LEADER_BYTES 44 /* header 8 + image leader 36 */
 #define TRAILER_BYTES 16
 #define OVERHEAD 36     /* IP 20 + UDP 8 + GVSP header 8 */
