@@ -41,6 +41,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "drivers/gige/gige_check.h"
+#include "drivers/gige/gige_image.h"
 #include "drivers/gige/gvsp.h"
 #include "drivers/navcam_genicam_xml.h"
 #include "emulator/output.h"
@@ -62,10 +63,6 @@ enum {
     REG_VERSION = 0x88,
     REG_INFO = 0xa8,
 };
-#define PF_MONO8 0x01080001u
-#define PF_MONO12 0x01100005u
-#define PF_MONO16 0x01100007u
-#define META_BYTES 160
 
 struct gige {
     ArvGvFakeCamera *gv;
@@ -211,56 +208,6 @@ static void *poll_thread(void *arg)
 
 /* ---- frames ----------------------------------------------------------------- */
 
-static void put_u16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8); }
-static void put_u32(uint8_t *p, uint32_t v) { put_u16(p, (uint16_t)v), put_u16(p + 2, (uint16_t)(v >> 16)); }
-static void put_u64(uint8_t *p, uint64_t v) { put_u32(p, (uint32_t)v), put_u32(p + 4, (uint32_t)(v >> 32)); }
-static void put_f64(uint8_t *p, double d)
-{
-    uint64_t u;
-    memcpy(&u, &d, sizeof u);
-    put_u64(p, u);
-}
-
-/* The metadata block (docs/gige.md gives the layout), little-endian: a
- * 48-byte core with its own CRC (fits a Mono8 row of 48 pixels), then the
- * pose, with a CRC over everything. */
-static void metadata(const struct nc_frame_record *r, uint8_t m[META_BYTES])
-{
-    memset(m, 0, META_BYTES);
-    memcpy(m, "NCMD", 4);
-    put_u16(m + 4, 1);
-    put_u16(m + 6, META_BYTES);
-    put_u64(m + 8, r->frame);
-    put_u64(m + 16, (uint64_t)r->exposure_start_sim_ns);
-    put_f64(m + 24, r->exposure_s);
-    put_f64(m + 32, r->gain_db);
-    put_u32(m + 40, r->request_sequence);
-    put_u32(m + 44, (uint32_t)crc32(0L, m, 44));
-    put_u64(m + 48, (uint64_t)r->trigger_sim_ns);
-    put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
-    put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
-    const struct nc_pose *p = &r->pose;
-    const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
-                          p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, p->sun.x,
-                          p->sun.y,            p->sun.z};
-    for (int i = 0; i < 10; i++)
-        put_f64(m + 72 + 8 * i, v[i]);
-    m[152] = (uint8_t)p->sun_is_position;
-    m[153] = (uint8_t)r->pose_quality;
-    put_u16(m + 154, (uint16_t)r->adc_bits);
-    put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
-}
-
-/* One DN as the pixel format stores it. */
-static inline uint16_t convert(uint16_t dn, uint32_t pf, int bits)
-{
-    if (pf == PF_MONO8)
-        return (uint16_t)(bits > 8 ? dn >> (bits - 8) : dn << (8 - bits));
-    if (pf == PF_MONO12)
-        return (uint16_t)(bits > 12 ? dn >> (bits - 12) : dn);
-    return (uint16_t)(dn << (16 - bits)); /* Mono16: most significant bits */
-}
-
 /* The newest frame (lock held) as the registers ask for it now: ROI, pixel
  * format, the metadata row on top. Returns 0, or -1 for settings NavCam does
  * not serve (a format it lacks, a size beyond 65536): nothing is sent then. */
@@ -278,34 +225,7 @@ static int pack(struct gige *g, struct nc__gvsp_image *im)
         return -1;
     const int bpp = pf == PF_MONO8 ? 1 : 2;
     uint8_t *out = g->payload;
-    int row0 = 0;
-    if (g->meta_rows) { /* the metadata row on top */
-        uint8_t m[META_BYTES];
-        metadata(&g->rec, m);
-        size_t rowb = (size_t)w * bpp;
-        memset(out, 0, rowb);
-        memcpy(out, m, rowb < META_BYTES ? rowb : META_BYTES);
-        row0 = 1;
-    }
-    for (int y = row0; y < (int)h; y++) {
-        int sy = oy + y - row0;
-        uint8_t *o = out + (size_t)y * w * bpp;
-        if (sy >= g->H) {
-            memset(o, 0, (size_t)w * bpp);
-            continue;
-        }
-        const uint16_t *src = g->dn + (size_t)sy * g->W + ox;
-        int n = ox + (int)w <= g->W ? (int)w : g->W - ox; /* >= 0: ox <= W */
-        if (bpp == 1) {
-            for (int x = 0; x < n; x++)
-                o[x] = (uint8_t)convert(src[x], pf, g->adc_bits);
-        } else {
-            for (int x = 0; x < n; x++)
-                put_u16(o + 2 * x, convert(src[x], pf, g->adc_bits));
-        }
-        if (n < (int)w)
-            memset(o + (size_t)n * bpp, 0, (size_t)((int)w - n) * bpp);
-    }
+    nc__gige_image(g->dn, g->W, g->H, g->adc_bits, g->meta_rows ? &g->rec : NULL, pf, w, h, ox, oy, out);
     *im = (struct nc__gvsp_image){.pixel_format = pf, .width = w, .height = h, .offset_x = (uint32_t)ox,
                                   .offset_y = (uint32_t)oy, .data = out, .size = (size_t)w * h * bpp,
                                   /* the GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns */

@@ -1,0 +1,89 @@
+/* gige_image.c - the streamed image and its metadata row (gige_image.h). */
+#include "drivers/gige/gige_image.h"
+
+#include <string.h>
+#include <zlib.h>
+
+static void put_u16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8); }
+static void put_u32(uint8_t *p, uint32_t v) { put_u16(p, (uint16_t)v), put_u16(p + 2, (uint16_t)(v >> 16)); }
+static void put_u64(uint8_t *p, uint64_t v) { put_u32(p, (uint32_t)v), put_u32(p + 4, (uint32_t)(v >> 32)); }
+static void put_f64(uint8_t *p, double d)
+{
+    uint64_t u;
+    memcpy(&u, &d, sizeof u);
+    put_u64(p, u);
+}
+
+/* The metadata block (docs/gige.md gives the layout), little-endian: a
+ * 48-byte core with its own CRC (fits a Mono8 row of 48 pixels), then the
+ * pose, with a CRC over everything. */
+void nc__gige_metadata(const struct nc_frame_record *r, uint8_t m[NC_GIGE_META_BYTES])
+{
+    memset(m, 0, NC_GIGE_META_BYTES);
+    memcpy(m, "NCMD", 4);
+    put_u16(m + 4, 1);
+    put_u16(m + 6, NC_GIGE_META_BYTES);
+    put_u64(m + 8, r->frame);
+    put_u64(m + 16, (uint64_t)r->exposure_start_sim_ns);
+    put_f64(m + 24, r->exposure_s);
+    put_f64(m + 32, r->gain_db);
+    put_u32(m + 40, r->request_sequence);
+    put_u32(m + 44, (uint32_t)crc32(0L, m, 44));
+    put_u64(m + 48, (uint64_t)r->trigger_sim_ns);
+    put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
+    put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
+    const struct nc_pose *p = &r->pose;
+    const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
+                          p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, p->sun.x,
+                          p->sun.y,            p->sun.z};
+    for (int i = 0; i < 10; i++)
+        put_f64(m + 72 + 8 * i, v[i]);
+    m[152] = (uint8_t)p->sun_is_position;
+    m[153] = (uint8_t)r->pose_quality;
+    put_u16(m + 154, (uint16_t)r->adc_bits);
+    put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
+}
+
+/* One DN as the pixel format stores it. */
+static inline uint16_t convert(uint16_t dn, uint32_t pf, int bits)
+{
+    if (pf == PF_MONO8)
+        return (uint16_t)(bits > 8 ? dn >> (bits - 8) : dn << (8 - bits));
+    if (pf == PF_MONO12)
+        return (uint16_t)(bits > 12 ? dn >> (bits - 12) : dn);
+    return (uint16_t)(dn << (16 - bits)); /* Mono16: most significant bits */
+}
+
+void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct nc_frame_record *meta, uint32_t pf,
+                    uint32_t w, uint32_t h, int ox, int oy, uint8_t *out)
+{
+    const int bpp = pf == PF_MONO8 ? 1 : 2;
+    int row0 = 0;
+    if (meta) { /* the metadata row on top */
+        uint8_t m[NC_GIGE_META_BYTES];
+        nc__gige_metadata(meta, m);
+        size_t rowb = (size_t)w * bpp;
+        memset(out, 0, rowb);
+        memcpy(out, m, rowb < NC_GIGE_META_BYTES ? rowb : NC_GIGE_META_BYTES);
+        row0 = 1;
+    }
+    for (int y = row0; y < (int)h; y++) {
+        int sy = oy + y - row0;
+        uint8_t *o = out + (size_t)y * w * bpp;
+        if (sy >= H) {
+            memset(o, 0, (size_t)w * bpp);
+            continue;
+        }
+        const uint16_t *src = dn + (size_t)sy * W + ox;
+        int n = ox + (int)w <= W ? (int)w : W - ox; /* >= 0: ox <= W */
+        if (bpp == 1) {
+            for (int x = 0; x < n; x++)
+                o[x] = (uint8_t)convert(src[x], pf, adc_bits);
+        } else {
+            for (int x = 0; x < n; x++)
+                put_u16(o + 2 * x, convert(src[x], pf, adc_bits));
+        }
+        if (n < (int)w)
+            memset(o + (size_t)n * bpp, 0, (size_t)((int)w - n) * bpp);
+    }
+}
