@@ -101,7 +101,7 @@ static int too_late(struct nc__emu *e, const struct nc__job *j)
 static int push_job(struct nc__emu *e, const struct nc__job *j)
 {
     pthread_mutex_lock(&e->jlock);
-    if (e->mode != NC__MODE_LOCKSTEP && !j->rejected && too_late(e, j)) {
+    if (e->mode != NC__MODE_LOCKSTEP && too_late(e, j)) {
         atomic_fetch_add(&e->dropped[NC__DROP_OVERRUN], 1);
         pthread_mutex_unlock(&e->jlock);
         return 0;
