@@ -35,6 +35,7 @@ test:
 bench: build
 	bench/startup.sh $(BUILD)
 	$(BUILD)/bench_render
+	$(BUILD)/bench_lod
 	$(BUILD)/bench_brdf
 	$(BUILD)/bench_sensor
 	$(BUILD)/bench_latency

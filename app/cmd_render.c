@@ -69,7 +69,7 @@ static double now_ms(void)
  * camera model's render size: the sensor plus the PSF's margin). */
 static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
                               const struct nc_camsys *cs, double exposure, unsigned long long frame_no,
-                              const struct nc_image_attr *extra, double *scale)
+                              const struct nc_image_attr *extra, int nextra, double *scale)
 {
     const int W = cs->width_px, H = cs->height_px;
     size_t n = (size_t)W * (size_t)H;
@@ -80,8 +80,8 @@ static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc
     int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
     int na = nc_frame_meta(s, q, attrs, text, 32);
     na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 31 - na);
-    if (extra)
-        attrs[na++] = *extra;
+    for (int i = 0; i < nextra && na < 32; i++)
+        attrs[na++] = extra[i];
     if (rc >= 0 && q == NC_Q_ELECTRONS)
         rc = nc_image_write(out, e, W, H, attrs, na, scale);
     else if (rc >= 0 && (rc = nc_camsys_digitise(cs, e, exposure, frame_no, dn)) >= 0)
@@ -211,15 +211,25 @@ int main(int argc, char **argv)
     if (rc >= 0)
         rc = nc_render_exposure(&r, &drawn, &ex, &f, &tsamples);
     double t2 = now_ms(), scale = 0;
+    /* Levels of detail: the error bound of those used (0: full meshes). */
+    char lod[40];
+    snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r.rt));
+    struct nc_image_attr extra[2] = {{"navcam:lod_error_m", lod}, {0}};
+    int nextra = 1;
+    if (rows)
+        extra[nextra++] = row_attr;
     if (rc >= 0 && q <= NC_Q_RANGE)
-        rc = nc_frame_write(out, &f, q, &scene, &row_attr, rows ? 1 : 0, &scale);
+        rc = nc_frame_write(out, &f, q, &scene, extra, nextra, &scale);
     else if (rc >= 0)
-        rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, rows ? &row_attr : NULL, &scale);
+        rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, extra, nextra, &scale);
     if (rc >= 0) {
         printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene setup %.1f ms, "
                "render %.1f ms\n",
                out, scene.camera.width_px, scene.camera.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
                tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
+        if (scene.render.lod_error_px > 0)
+            printf("  levels of detail: surface error bound %.3g m (render.lod_error_px %g)\n", nc_rt_lod_error_m(r.rt),
+                   scene.render.lod_error_px);
         if (scale > 0)
             printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));
     }

@@ -4,10 +4,12 @@
 #ifndef NC_BENCH_UTIL_H
 #define NC_BENCH_UTIL_H
 
+#include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 static inline double now_ms(void)
 {
@@ -45,6 +47,29 @@ static inline void read_text(const char *path, char *buf, size_t len)
     buf[got] = 0;
     if (f)
         fclose(f);
+}
+
+/* The options --frames N (1..1000, else *frames stays) and --threads N
+ * (default: the online cores) of a benchmark named name. Returns -1 to go
+ * on, else the exit status (--help: 0, a bad option: 2). */
+static inline int bench_frames_threads(int argc, char **argv, const char *name, int *frames, int *threads)
+{
+    static const struct option opts[] = {{"frames", required_argument, NULL, 'n'},
+                                         {"threads", required_argument, NULL, 'j'},
+                                         {"help", no_argument, NULL, 'h'},
+                                         {NULL, 0, NULL, 0}};
+    int c, n = *frames;
+    *threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
+    while ((c = getopt_long(argc, argv, "n:j:h", opts, NULL)) != -1) {
+        switch (c) {
+        case 'n': n = atoi(optarg); break;
+        case 'j': *threads = atoi(optarg); break;
+        default: printf("Usage: %s [--frames N] [--threads N]\n", name); return c == 'h' ? 0 : 2;
+        }
+    }
+    if (n >= 1 && n <= 1000)
+        *frames = n;
+    return -1;
 }
 
 #endif

@@ -57,20 +57,10 @@ static void teardown(struct setup *x)
 
 int main(int argc, char **argv)
 {
-    int frames = 7, threads = (int)sysconf(_SC_NPROCESSORS_ONLN), c;
-    static const struct option opts[] = {{"frames", required_argument, NULL, 'n'},
-                                         {"threads", required_argument, NULL, 'j'},
-                                         {"help", no_argument, NULL, 'h'},
-                                         {NULL, 0, NULL, 0}};
-    while ((c = getopt_long(argc, argv, "n:j:h", opts, NULL)) != -1) {
-        switch (c) {
-        case 'n': frames = atoi(optarg); break;
-        case 'j': threads = atoi(optarg); break;
-        default: puts("Usage: bench_brdf [--frames N] [--threads N]"); return c == 'h' ? 0 : 2;
-        }
-    }
-    if (frames < 1 || frames > 1000)
-        frames = 7;
+    int frames = 7, threads;
+    int status = bench_frames_threads(argc, argv, "bench_brdf", &frames, &threads);
+    if (status >= 0)
+        return status;
 
     /* 1. Model evaluations, one core, batches of 16 over 2^20 random
      * geometries with mu0, mu in (0, 1] and a consistent phase angle. */

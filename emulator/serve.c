@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "camera/camsys.h"
 #include "core/clock.h"
@@ -226,6 +227,8 @@ int nc_serve(const struct nc_serve_options *opt)
             break;
         }
     }
+    while (rc >= 0 && !atomic_load(&e->warm) && atomic_load(&e->stop) < 2)
+        usleep(1000); /* the render thread's warm-up frame (serve_render.c) */
     if (rc >= 0 && e->have_freerun)
         rc = nc_trigger_start(&e->freerun);
     if (rc >= 0 && e->have_line)

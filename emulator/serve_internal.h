@@ -143,6 +143,7 @@ struct nc__emu {
     unsigned long refused_clients, slow_clients;
     /* state */
     atomic_int stop; /* 1: stop taking input; 2: render exits; 3: output exits */
+    atomic_int warm; /* 1: the render thread has made its warm-up frame */
     uint64_t next_frame;
     int64_t start_mono_ns;
     /* statistics */

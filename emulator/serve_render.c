@@ -130,6 +130,17 @@ void *nc__serve_render_thread(void *arg)
         free(el);
         return NULL;
     }
+    /* A warm-up frame of the configured pose, discarded: the first frame
+     * served does not pay for first-touch memory, the render threads' start
+     * and lazy library set-up (nc_serve starts the triggers after it). */
+    struct nc_scene warm = e->scene;
+    struct nc_pose p0;
+    nc_scene_pose(&e->scene, 0, &p0);
+    nc_scene_apply_pose(&warm, &p0);
+    nc_camsys_render_camera(&e->cs, &warm.camera, &warm.camera);
+    if (nc_render_frame(&e->renderer, &warm, &f) >= 0)
+        nc_camsys_electrons(&e->cs, f.radiance, e->cs.exposure_s, el);
+    atomic_store(&e->warm, 1);
     struct nc__job j;
     while (!e->have_held && next_job(e, &j)) {
         struct nc_pose pose;
@@ -198,7 +209,7 @@ void *nc__serve_render_thread(void *arg)
             .exposure_end_sim_ns = start_sim + exp_ns, .trigger_mono_ns = j.trigger_mono_ns,
             .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = pose,
             .pose_quality = q, .pose_gap_ns = gap, .exposure_s = j.exposure_s, .gain_db = j.gain_db,
-            .time_samples = ts, .render_ms = (t1 - t0) * 1e-6, .camera_ms = (t2 - t1) * 1e-6, .width_px = W,
+            .time_samples = ts, .lod_error_m = nc_rt_lod_error_m(e->renderer.rt), .render_ms = (t1 - t0) * 1e-6, .camera_ms = (t2 - t1) * 1e-6, .width_px = W,
             .height_px = H, .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
         fill_slot(e);
     }

@@ -53,6 +53,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:frame_record", "FRAMEREC"},
     {"navcam:preview_rule", "PRVRULE"},
     {"navcam:fits_row_order", "ROWORDER"},
+    {"navcam:lod_error_m", "LODERR"},
 };
 
 /* 1 when attrs ask for the archive row order (row 1 at the bottom). */

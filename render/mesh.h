@@ -37,6 +37,30 @@ struct nc_asteroid_params {
 };
 int nc_mesh_asteroid(const struct nc_asteroid_params *p, struct nc_mesh *out);
 
+/* Levels of detail (mesh_lod.c): level 0 is the mesh itself (its own
+ * triangle list, not copied); each next level has about 4x fewer triangles,
+ * made by collapsing edges onto existing vertices (no vertex moves or is
+ * added). error_m bounds, to the simplifier's estimate, how far a level's
+ * surface lies from the full mesh: the sum of the quadric errors of the
+ * steps from level 0, metres. */
+#define NC_LOD_MAX_LEVELS 8
+struct nc_mesh_lod_level {
+    uint32_t *tri;
+    size_t nt;
+    double error_m;
+};
+struct nc_mesh_lod {
+    struct nc_mesh_lod_level level[NC_LOD_MAX_LEVELS];
+    int nlevels;
+};
+/* Levels down to min_triangles (no level below it; a mesh under 4x that
+ * gets level 0 only). */
+int nc_mesh_lod_build(const struct nc_mesh *m, size_t min_triangles, struct nc_mesh_lod *out);
+void nc_mesh_lod_free(struct nc_mesh_lod *l);
+/* The coarsest of nlevels levels with errors error_m[] (non-decreasing)
+ * whose error is at most max_error_m; 0 when none is. */
+int nc_mesh_lod_pick_error(const double *error_m, int nlevels, double max_error_m);
+
 /* Largest distance of a used vertex from the body origin, metres. */
 double nc_mesh_bounding_radius(const struct nc_mesh *m);
 

@@ -4,7 +4,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -13,6 +12,7 @@
 
 #include "render/albedo_map.h"
 #include "core/error.h"
+#include "core/pool.h"
 
 #define TILE NC_TILE
 
@@ -57,6 +57,8 @@ int nc_renderer_init(struct nc_renderer *r, const struct nc_scene *s, int thread
 
 void nc_renderer_free(struct nc_renderer *r)
 {
+    nc_pool_destroy(r->pool);
+    r->pool = NULL;
     nc_rt_destroy(r->rt);
     r->rt = NULL;
 }
@@ -379,18 +381,14 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     j.cull = !c->distorted && !r->no_cull; /* the lens model's rays are not linear in the pixel */
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
 
-    int nthreads = r->threads, started = 0;
-    pthread_t tid[256];
-    if (nthreads > 256)
-        nthreads = 256;
-    for (int i = 1; i < nthreads; i++) {
-        if (pthread_create(&tid[started], NULL, worker, &j) != 0)
-            break; /* fewer threads only costs time, never changes pixels */
-        started++;
+    /* Threads kept between frames (and between a rolling shutter's bands);
+     * fewer threads only cost time, never change pixels. */
+    if (r->pool_threads != r->threads) { /* a caller changed r->threads */
+        nc_pool_destroy(r->pool);
+        r->pool = nc_pool_create(r->threads);
+        r->pool_threads = r->threads;
     }
-    worker(&j);
-    for (int i = 0; i < started; i++)
-        pthread_join(tid[i], NULL);
+    nc_pool_run(r->pool, worker, &j);
     free(j.row);
     return 0;
 }

@@ -26,6 +26,8 @@ struct nc_frame {
 struct nc_renderer {
     struct nc_rt *rt;
     int threads;
+    struct nc_pool *pool; /* pool_threads - 1 workers, started by the first frame */
+    int pool_threads;
     /* Optional observer of every traced packet (benchmarks record the exact
      * rays with it); called from render threads, so use with threads = 1. */
     void (*ray_hook)(void *user, int shadow, const struct nc_ray16 *ray);

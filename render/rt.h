@@ -31,6 +31,11 @@ struct nc_hit16 {
 
 struct nc_rt_stats {
     unsigned long reanchors; /* geometry rebuilt around a new anchor */
+    /* Per body, at the last update: the level of detail shown (0 = the full
+     * mesh or an analytic shape), its triangles and its error bound, m. */
+    int lod_level[NC_MAX_BODIES];
+    size_t lod_triangles[NC_MAX_BODIES];
+    double lod_error_m[NC_MAX_BODIES];
 };
 
 int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out);
@@ -48,6 +53,9 @@ int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
+/* The largest error bound of the levels of detail shown at the last update,
+ * metres (0: every body at full resolution). */
+double nc_rt_lod_error_m(const struct nc_rt *rt);
 
 /* For benchmarks: Embree alone on pre-built native packets. The packets are
  * converted once (untimed); nc_rt_batch_trace() then only resets each packet

@@ -20,13 +20,22 @@
 
 struct rt_body {
     const struct nc_body *src;
-    RTCScene scene;
-    RTCGeometry geom;
+    /* One Embree scene per level of detail (mesh_lod.c; analytic shapes and
+     * meshes without levels have level 0 only), all sharing one vertex
+     * buffer; the instance shows the level picked for the current pose. */
+    RTCScene scene[NC_LOD_MAX_LEVELS];
+    RTCGeometry geom[NC_LOD_MAX_LEVELS];
+    size_t nt[NC_LOD_MAX_LEVELS];
+    double error_m[NC_LOD_MAX_LEVELS];
+    unsigned fitted[NC_LOD_MAX_LEVELS]; /* the anchor generation each level's tree was fitted to */
+    int nlevels, level;
+    float *verts; /* anchor-relative vertices of every level, padded for Embree's 16-byte loads */
     unsigned inst_id;
     RTCGeometry inst;
     int analytic;
     struct nc_vec3 anchor_m; /* body frame; geometry is stored relative to it */
     int anchored;
+    unsigned anchor_gen;
     /* Analytic ellipsoid in anchor-relative coordinates. */
     double centre[3], radii[3];
     float rot[9]; /* body -> scene, row-major, for normals */
@@ -135,41 +144,81 @@ static void ell_occluded(const struct RTCOccludedFunctionNArguments *a)
 
 /* ---- setup ---------------------------------------------------------------- */
 
-static int body_init(struct nc_rt *rt, struct rt_body *b, const struct nc_body *src)
+/* A mesh level of detail: its triangles over the body's shared vertices. */
+static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct nc_mesh_lod_level *lv)
+{
+    const struct nc_mesh *m = &b->src->mesh;
+    b->scene[k] = rtcNewScene(rt->dev);
+    /* LOW makes Embree honour the per-geometry quality (a two-level index). */
+    rtcSetSceneBuildQuality(b->scene[k], RTC_BUILD_QUALITY_LOW);
+    RTCGeometry g = b->geom[k] = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    /* Anchors move by pure translation: a refit keeps the tree exact. */
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, b->verts, 0, 3 * sizeof(float), m->nv);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), lv->nt);
+    if (!ib)
+        return rt_check(rt->dev, "allocating mesh buffers");
+    memcpy(ib, lv->tri, lv->nt * 3 * sizeof(unsigned));
+    rtcAttachGeometry(b->scene[k], g);
+    b->nt[k] = lv->nt;
+    b->error_m[k] = lv->error_m;
+    return rt_check(rt->dev, "creating geometry");
+}
+
+/* Levels of detail only pay where a mesh is much finer than the coarsest
+ * level worth having. */
+#define LOD_MIN_TRIANGLES 4096
+
+static int body_init(struct nc_rt *rt, struct rt_body *b, const struct nc_body *src, double lod_error_px)
 {
     b->src = src;
-    b->scene = rtcNewScene(rt->dev);
-    /* LOW makes Embree honour the per-geometry quality (a two-level index). */
-    rtcSetSceneBuildQuality(b->scene, RTC_BUILD_QUALITY_LOW);
+    int rc = 0;
     if (src->shape == NC_SHAPE_SPHERE || src->shape == NC_SHAPE_ELLIPSOID) {
         b->analytic = 1;
         b->radii[0] = src->radii_m.x;
         b->radii[1] = src->radii_m.y;
         b->radii[2] = src->radii_m.z;
-        b->geom = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(b->geom, 1);
-        rtcSetGeometryUserData(b->geom, b);
-        rtcSetGeometryBoundsFunction(b->geom, ell_bounds, NULL);
-        rtcSetGeometryIntersectFunction(b->geom, ell_intersect);
-        rtcSetGeometryOccludedFunction(b->geom, ell_occluded);
+        b->scene[0] = rtcNewScene(rt->dev);
+        RTCGeometry g = b->geom[0] = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(g, 1);
+        rtcSetGeometryUserData(g, b);
+        rtcSetGeometryBoundsFunction(g, ell_bounds, NULL);
+        rtcSetGeometryIntersectFunction(g, ell_intersect);
+        rtcSetGeometryOccludedFunction(g, ell_occluded);
+        rtcAttachGeometry(b->scene[0], g);
+        b->nlevels = 1;
     } else {
         const struct nc_mesh *m = &src->mesh;
-        b->geom = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-        /* Anchors move by pure translation: a refit keeps the tree exact. */
-        rtcSetGeometryBuildQuality(b->geom, RTC_BUILD_QUALITY_REFIT);
-        float *vb = rtcSetNewGeometryBuffer(b->geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                            3 * sizeof(float), m->nv);
-        unsigned *ib = rtcSetNewGeometryBuffer(b->geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                               3 * sizeof(unsigned), m->nt);
-        if (!vb || !ib)
-            return rt_check(rt->dev, "allocating mesh buffers");
-        memcpy(ib, m->tri, m->nt * 3 * sizeof(unsigned));
+        if (!(b->verts = calloc(3 * m->nv + 1, sizeof *b->verts)))
+            return nc_error(-ENOMEM, "out of memory for %zu vertices", m->nv);
+        struct nc_mesh_lod lod;
+        if ((rc = nc_mesh_lod_build(m, lod_error_px > 0 ? LOD_MIN_TRIANGLES : SIZE_MAX, &lod)) < 0)
+            return rc;
+        for (int k = 0; k < lod.nlevels && rc >= 0; k++) {
+            rc = level_init(rt, b, k, &lod.level[k]);
+            b->nlevels = k + 1;
+        }
+        nc_mesh_lod_free(&lod);
+        if (rc < 0)
+            return rc;
     }
-    rtcAttachGeometry(b->scene, b->geom);
     b->inst = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_INSTANCE);
-    rtcSetGeometryInstancedScene(b->inst, b->scene);
+    rtcSetGeometryInstancedScene(b->inst, b->scene[0]);
     b->inst_id = rtcAttachGeometry(rt->top, b->inst);
     return rt_check(rt->dev, "creating geometry");
+}
+
+/* Level k's tree fitted to the current anchor (a refit after a re-anchor;
+ * a level not shown is refitted when it is next picked). */
+static void fit_level(struct rt_body *b, int k)
+{
+    if (b->fitted[k] == b->anchor_gen)
+        return;
+    if (!b->analytic)
+        rtcUpdateGeometryBuffer(b->geom[k], RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(b->geom[k]);
+    rtcCommitScene(b->scene[k]);
+    b->fitted[k] = b->anchor_gen;
 }
 
 int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
@@ -188,12 +237,18 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
     rtcSetSceneBuildQuality(rt->top, RTC_BUILD_QUALITY_LOW);
     int rc = 0;
     for (int i = 0; i < s->nbodies && rc == 0; i++) {
-        rc = body_init(rt, &rt->body[i], &s->body[i]);
+        rc = body_init(rt, &rt->body[i], &s->body[i], s->render.lod_error_px);
         rt->nbodies = i + 1;
         rt->geom_to_body[rt->body[i].inst_id] = (unsigned)i;
     }
     if (rc == 0)
         rc = nc_rt_update(rt, s);
+    /* Every level's tree now, not when a frame first needs it. */
+    for (int i = 0; i < rt->nbodies && rc == 0; i++)
+        for (int k = 0; k < rt->body[i].nlevels; k++)
+            fit_level(&rt->body[i], k);
+    if (rc == 0)
+        rc = rt_check(rt->dev, "building the levels of detail");
     if (rc < 0) {
         nc_rt_destroy(rt);
         return rc;
@@ -206,22 +261,20 @@ static void reanchor(struct rt_body *b, struct nc_vec3 a)
 {
     b->anchor_m = a;
     b->anchored = 1;
+    b->anchor_gen++;
     if (b->analytic) {
         b->centre[0] = -a.x;
         b->centre[1] = -a.y;
         b->centre[2] = -a.z;
     } else {
         const struct nc_mesh *m = &b->src->mesh;
-        float *vb = rtcGetGeometryBufferData(b->geom, RTC_BUFFER_TYPE_VERTEX, 0);
+        float *vb = b->verts;
         for (size_t i = 0; i < m->nv; i++) {
             vb[3 * i + 0] = (float)(m->v[3 * i + 0] - a.x);
             vb[3 * i + 1] = (float)(m->v[3 * i + 1] - a.y);
             vb[3 * i + 2] = (float)(m->v[3 * i + 2] - a.z);
         }
-        rtcUpdateGeometryBuffer(b->geom, RTC_BUFFER_TYPE_VERTEX, 0);
     }
-    rtcCommitGeometry(b->geom);
-    rtcCommitScene(b->scene);
 }
 
 int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
@@ -243,8 +296,8 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
          * (hence every pixel) is a function of the pose alone, never of the
          * path taken. Inside the bounding sphere a is the camera itself. */
         struct nc_vec3 a = cam_body;
+        double dmin = nc_v3_norm(cam_body) - src->bounding_radius_m;
         if (!b->analytic) {
-            double dmin = nc_v3_norm(cam_body) - src->bounding_radius_m;
             if (dmin > 0) {
                 double cell = exp2(floor(log2(dmin / 8)));
                 a = nc_v3(cell * floor(cam_body.x / cell + 0.5), cell * floor(cam_body.y / cell + 0.5),
@@ -255,6 +308,22 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             reanchor(b, a);
             rt->stats.reanchors++;
         }
+        /* Level of detail: the coarsest whose surface error stays within
+         * render.lod_error_px pixels at the nearest possible range (the
+         * bounding sphere; the finest pixel axis). A function of the pose. */
+        int k = 0;
+        if (b->nlevels > 1 && dmin > 0) {
+            double px_m = dmin / fmax(s->camera.fx_px, s->camera.fy_px);
+            k = nc_mesh_lod_pick_error(b->error_m, b->nlevels, s->render.lod_error_px * px_m);
+        }
+        fit_level(b, k);
+        if (k != b->level) {
+            rtcSetGeometryInstancedScene(b->inst, b->scene[k]);
+            b->level = k;
+        }
+        rt->stats.lod_level[i] = k;
+        rt->stats.lod_triangles[i] = b->nt[k];
+        rt->stats.lod_error_m[i] = b->error_m[k];
         struct nc_vec3 T = nc_v3_sub(nc_v3_add(nc_mat_mul_v(&R, b->anchor_m), src->position_m), cam);
         float xfm[12];
         for (int c = 0; c < 3; c++)
@@ -263,8 +332,8 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
         xfm[9] = (float)T.x;
         xfm[10] = (float)T.y;
         xfm[11] = (float)T.z;
-        for (int k = 0; k < 9; k++)
-            b->rot[k] = (float)R.m[k / 3][k % 3];
+        for (int e = 0; e < 9; e++)
+            b->rot[e] = (float)R.m[e / 3][e % 3];
         b->R = R;
         b->origin_rel = nc_v3_sub(src->position_m, cam);
         rtcSetGeometryTransform(b->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
@@ -362,6 +431,14 @@ void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occlude
 }
 
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st) { *st = rt->stats; }
+
+double nc_rt_lod_error_m(const struct nc_rt *rt)
+{
+    double e = 0;
+    for (int i = 0; i < rt->nbodies; i++)
+        e = fmax(e, rt->stats.lod_error_m[i]);
+    return e;
+}
 
 /* ---- raw batches (benchmarks) --------------------------------------------- */
 
@@ -495,14 +572,18 @@ void nc_rt_destroy(struct nc_rt *rt)
         struct rt_body *b = &rt->body[i];
         if (b->inst)
             rtcReleaseGeometry(b->inst);
-        if (b->geom)
-            rtcReleaseGeometry(b->geom);
-        if (b->scene)
-            rtcReleaseScene(b->scene);
+        for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
+            if (b->geom[k])
+                rtcReleaseGeometry(b->geom[k]);
+            if (b->scene[k])
+                rtcReleaseScene(b->scene[k]);
+        }
     }
     if (rt->top)
         rtcReleaseScene(rt->top);
     if (rt->dev)
         rtcReleaseDevice(rt->dev);
+    for (int i = 0; i < rt->nbodies; i++)
+        free(rt->body[i].verts);
     free(rt);
 }

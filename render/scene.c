@@ -226,6 +226,7 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     r->samples_per_pixel = 1;
     r->seed = 0;
     r->threads = 0;
+    r->lod_error_px = 0;
     if (!map)
         return 0;
     if ((rc = nc_cfg_int(map, "samples_per_pixel", 1, 1024, &v)) < 0)
@@ -245,6 +246,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
         return rc;
     if (rc)
         r->threads = (int)v;
+    if ((rc = nc_cfg_double(map, "lod_error_px", 0, 100, &r->lod_error_px)) < 0)
+        return rc;
     return 0;
 }
 

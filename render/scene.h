@@ -48,6 +48,9 @@ struct nc_render_settings {
     int samples_per_pixel; /* a square number: n x n strata */
     uint64_t seed;
     int threads; /* 0 = all cores */
+    /* Meshes: the coarsest level of detail whose surface error is at most
+     * this many pixels at the body's nearest range; 0 = always the full mesh. */
+    double lod_error_px;
 };
 
 struct nc_scene {
