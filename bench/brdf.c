@@ -5,13 +5,11 @@
  * Usage: bench_brdf [--frames N] [--threads N]
  * Last line: lambert_ms=... hapke_ms=... ratio=...
  */
-#include <getopt.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "bench_util.h"
 #include "core/error.h"

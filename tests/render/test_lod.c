@@ -146,6 +146,7 @@ int main(void)
     render(&r, &s, 0, &full, &st);
     render(&r, &s, 0.5, &lod, &st);
     CHECK(st.lod_level[0] >= 1, "6 km at 0.5 px: level %d", st.lod_level[0]);
+    CHECK(!same(&full, &lod), "6 km: the level's frame is the full mesh's (the instance did not switch)");
     double fa, ax, ay, fb, bx, by;
     centroid(&full, &fa, &ax, &ay);
     centroid(&lod, &fb, &bx, &by);
