@@ -167,7 +167,7 @@ static void shade_tile(struct job *j, int tile)
     struct nc_ray16 ray, shadow;
     struct nc_vec3 dir[NC_PACKET], orig[NC_PACKET]; /* the camera rays in double precision */
     struct nc_hit16 hit;
-    int occluded[NC_PACKET];
+    int occluded[NC_PACKET], from[NC_PACKET], lit[NC_PACKET];
     double mu0[NC_PACKET], irr[NC_PACKET];
     struct nc_photometry geo[NC_PACKET];
 
@@ -213,9 +213,10 @@ static void shade_tile(struct job *j, int tile)
                 nc_rt_intersect16(j->rt, &ray, &hit, 1);
 
                 /* Shadow rays from the visible points that face both Sun and camera. */
-                int any = 0;
+                int any = 0; /* how many */
                 for (int i = 0; i < NC_PACKET; i++) {
-                    shadow.valid[i] = 0;
+                    shadow.valid[i] = lit[i] = 0;
+                    from[i] = -1;
                     if (hit.body[i] < 0)
                         continue;
                     struct nc_vec3 d = dir[i], nrm;
@@ -228,7 +229,8 @@ static void shade_tile(struct job *j, int tile)
                     if (exact == 0)
                         nrm = nc_v3_unit(nc_v3(hit.nx[i], hit.ny[i], hit.nz[i]));
                     double mu = -nc_v3_dot(nrm, d);
-                    if (mu < 0) { /* back face of a mesh with inconsistent winding */
+                    int outside = mu >= 0; /* the camera ray came from outside the surface */
+                    if (mu < 0) { /* back face: inconsistent winding, or the camera inside */
                         nrm = nc_v3_scale(nrm, -1.0);
                         mu = -mu;
                     }
@@ -264,17 +266,23 @@ static void shade_tile(struct job *j, int tile)
                     shadow.tnear[i] = 0.0f;
                     shadow.tfar[i] = INFINITY;
                     shadow.valid[i] = -1;
-                    any = 1;
+                    from[i] = outside ? hit.body[i] : -1;
+                    lit[i] = 1;
+                    any++;
                 }
                 if (!any)
                     continue;
-                if (j->r->ray_hook)
-                    j->r->ray_hook(j->r->ray_hook_user, 1, &shadow);
-                nc_rt_occluded16(j->rt, &shadow, occluded);
+                if (!j->r->no_shadow_cull && nc_rt_shadow_cull16(j->rt, &shadow, from) == any) {
+                    memset(occluded, 0, sizeof occluded); /* every ray proven: nothing to trace */
+                } else {
+                    if (j->r->ray_hook)
+                        j->r->ray_hook(j->r->ray_hook_user, 1, &shadow);
+                    nc_rt_occluded16(j->rt, &shadow, occluded);
+                }
                 /* Sunlit lanes, evaluated in one batch per body (usually one). */
                 int todo[NC_PACKET], ntodo = 0;
                 for (int i = 0; i < NC_PACKET; i++)
-                    if (shadow.valid[i] && !occluded[i])
+                    if (lit[i] && !occluded[i])
                         todo[ntodo++] = i;
                 while (ntodo > 0) {
                     int body = hit.body[todo[0]], lane[NC_PACKET], nl = 0, rest = 0;

@@ -35,6 +35,10 @@ struct nc_renderer {
     /* 1: trace every block, even those whose rays cannot reach a body's
      * bounding sphere (tests compare the two; the frames are identical). */
     int no_cull;
+    /* 1: trace every shadow ray, even those proven to meet nothing
+     * (nc_rt_occluded16); the frames differ only where float tracing of
+     * such a ray reports a spurious hit. */
+    int no_shadow_cull;
 };
 
 int nc_frame_alloc(struct nc_frame *f, int width_px, int height_px);

@@ -36,6 +36,9 @@ struct nc_rt_stats {
     int lod_level[NC_MAX_BODIES];
     size_t lod_triangles[NC_MAX_BODIES];
     double lod_error_m[NC_MAX_BODIES];
+    /* Since creation: shadow rays proven unoccluded (nc_rt_shadow_cull16), and
+     * rays traced by nc_rt_occluded16. */
+    unsigned long shadow_rays_culled, shadow_rays_traced;
 };
 
 int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out);
@@ -52,6 +55,11 @@ int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct
                  struct nc_vec3 *n);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
+/* Shadow rays that need no tracing: from[i] >= 0 says ray i leaves the outer
+ * side of body from[i] (a surface point whose normal faces both camera and
+ * ray). Rays proven to meet nothing (shadow_grid.h for the body's own shape,
+ * the bounding spheres for the others) are made inactive; returns how many. */
+int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from);
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
 /* The largest error bound of the levels of detail shown at the last update,
  * metres (0: every body at full resolution). */

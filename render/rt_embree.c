@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "render/shadow_grid.h"
 
 struct rt_body {
     const struct nc_body *src;
@@ -33,6 +34,15 @@ struct rt_body {
     unsigned inst_id;
     RTCGeometry inst;
     int analytic;
+    /* Shadow-ray culling (shadow_grid.h): which levels are closed outward
+     * surfaces, and the grid of the level shown (body frame, body origin). */
+    int closed[NC_LOD_MAX_LEVELS];
+    struct nc_shadow_grid grid;
+    int grid_level; /* -1: no valid grid */
+    /* The grid's axes u, v, sun in the camera-relative scene frame, and the
+     * offsets that give a point's grid coordinates from it: x . axis - off. */
+    struct nc_vec3 grid_axis[3];
+    double grid_off[3];
     struct nc_vec3 anchor_m; /* body frame; geometry is stored relative to it */
     int anchored;
     unsigned anchor_gen;
@@ -50,6 +60,7 @@ struct nc_rt {
     int nbodies;
     unsigned geom_to_body[NC_MAX_BODIES];
     struct nc_rt_stats stats;
+    atomic_ulong shadow_culled, shadow_traced;
 };
 
 static int rt_check(RTCDevice dev, const char *what)
@@ -162,6 +173,10 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
     rtcAttachGeometry(b->scene[k], g);
     b->nt[k] = lv->nt;
     b->error_m[k] = lv->error_m;
+    int closed = nc_shadow_grid_closed(m->v, m->nv, lv->tri, lv->nt);
+    if (closed < 0)
+        return closed;
+    b->closed[k] = closed;
     return rt_check(rt->dev, "creating geometry");
 }
 
@@ -172,6 +187,7 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
 static int body_init(struct nc_rt *rt, struct rt_body *b, const struct nc_body *src, double lod_error_px)
 {
     b->src = src;
+    b->grid_level = -1;
     int rc = 0;
     if (src->shape == NC_SHAPE_SPHERE || src->shape == NC_SHAPE_ELLIPSOID) {
         b->analytic = 1;
@@ -277,9 +293,60 @@ static void reanchor(struct rt_body *b, struct nc_vec3 a)
     }
 }
 
+/* Rays within GRID_TOL_RAD of the direction a shadow grid was built for
+ * use it; the Sun direction in the body frame is snapped to steps of half
+ * that, so a turning body rebuilds its grid only when it has turned by a
+ * step (a few tenths of a second for Bennu's 4.3 h rotation), and the grid is a function of
+ * the pose, never of the path to it. */
+#define GRID_TOL_RAD 2.5e-4
+
+static int build_grid(struct rt_body *b, int k, struct nc_vec3 sun, double margin_m)
+{
+    const unsigned *tri = rtcGetGeometryBufferData(b->geom[k], RTC_BUFFER_TYPE_INDEX, 0);
+    int rc = nc_shadow_grid_build(&b->grid, b->src->mesh.v, tri, b->nt[k], sun, GRID_TOL_RAD, nc_v3(0, 0, 0),
+                                  b->src->bounding_radius_m, margin_m);
+    b->grid_level = rc < 0 ? -1 : k;
+    return rc;
+}
+
+/* The shadow grid of the level shown, for the Sun direction the renderer
+ * uses (the direction at bodies[0], or at this body for a Sun at a finite
+ * position; rays in other directions are simply not culled). */
+static int update_grid(struct rt_body *b, const struct nc_scene *s)
+{
+    const int k = b->level;
+    if (b->analytic || !b->closed[k]) {
+        b->grid_level = -1;
+        return 0;
+    }
+    struct nc_vec3 sun;
+    double irr;
+    nc_scene_sun_at(s, s->sun.has_position ? b->src->position_m : s->body[0].position_m, &sun, &irr);
+    sun = nc_mat_tmul_v(&b->R, sun);
+    const double q = GRID_TOL_RAD / 2;
+    sun = nc_v3_unit(nc_v3(q * round(sun.x / q), q * round(sun.y / q), q * round(sun.z / q)));
+    /* The traced geometry's float vertices, instance transform and ray
+     * origins are each within about 1e-7 of (anchor distance + radius) of
+     * the double mesh; the margin is 1e-6 of it rounded up to a power of
+     * two, so that re-anchoring rarely changes it. */
+    const double margin = exp2(ceil(log2(1e-6 * (nc_v3_norm(b->anchor_m) + b->src->bounding_radius_m))));
+    const struct nc_vec3 gs = b->grid.sun;
+    int rc = 0;
+    if (b->grid_level != k || b->grid.margin_m != margin || gs.x != sun.x || gs.y != sun.y || gs.z != sun.z)
+        rc = build_grid(b, k, sun, margin);
+    /* body coordinates: R^T (x - origin_rel) */
+    const struct nc_vec3 ax[3] = {b->grid.u, b->grid.v, b->grid.sun};
+    for (int c = 0; c < 3; c++) {
+        b->grid_axis[c] = nc_mat_mul_v(&b->R, ax[c]);
+        b->grid_off[c] = nc_v3_dot(b->origin_rel, b->grid_axis[c]);
+    }
+    return rc;
+}
+
 int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
 {
     const struct nc_vec3 cam = s->camera.position_m;
+    int rc;
     for (int i = 0; i < rt->nbodies; i++) {
         struct rt_body *b = &rt->body[i];
         const struct nc_body *src = &s->body[i];
@@ -338,6 +405,8 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
         b->origin_rel = nc_v3_sub(src->position_m, cam);
         rtcSetGeometryTransform(b->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(b->inst);
+        if ((rc = update_grid(b, s)) < 0)
+            return rc;
     }
     rtcCommitScene(rt->top);
     return rt_check(rt->dev, "committing the scene");
@@ -419,8 +488,76 @@ int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct
     return 1;
 }
 
+/* Whether ray o + t d (t >= 0) can come within r of c. */
+static int ray_near_sphere(struct nc_vec3 o, struct nc_vec3 d, struct nc_vec3 c, double r)
+{
+    struct nc_vec3 oc = nc_v3_sub(c, o);
+    double tc = nc_v3_dot(oc, d), cc = nc_v3_dot(oc, oc);
+    return tc <= 0 ? cc <= r * r : cc - tc * tc / nc_v3_dot(d, d) <= r * r;
+}
+
+/* Proof that lane i, leaving the outside of body `from`, meets nothing: its
+ * own body's shadow grid (a convex analytic shape cannot shadow itself) and
+ * every other body's bounding sphere, padded for float rays. dir_ok: the
+ * lane's direction suits the body's grid (nc_shadow_grid_dir_ok). */
+static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct nc_ray16 *ray, int i)
+{
+    const struct rt_body *b = &rt->body[from];
+    struct nc_vec3 o = nc_v3(ray->ox[i], ray->oy[i], ray->oz[i]), d = nc_v3(ray->dx[i], ray->dy[i], ray->dz[i]);
+    if (!b->analytic) {
+        if (!dir_ok || b->grid_level != b->level)
+            return 0;
+        double c[3];
+        for (int k = 0; k < 3; k++)
+            c[k] = nc_v3_dot(o, b->grid_axis[k]) - b->grid_off[k];
+        if (!nc_shadow_grid_lit_at(&b->grid, c[0], c[1], c[2]))
+            return 0;
+    }
+    for (int k = 0; k < rt->nbodies; k++) {
+        const struct rt_body *e = &rt->body[k];
+        double r = e->src->bounding_radius_m * (1 + 1e-5) + 1e-5 * nc_v3_norm(e->origin_rel);
+        if (k != from && ray_near_sphere(o, d, e->origin_rel, r))
+            return 0;
+    }
+    return 1;
+}
+
+int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
+{
+    int culled = 0;
+    int last = -1, ok = 0; /* the direction test, redone when body or direction changes */
+    float ld[3] = {0, 0, 0};
+    for (int i = 0; i < NC_PACKET; i++) {
+        if (ray->valid[i] && from[i] >= 0) {
+            const struct rt_body *b = &rt->body[from[i]];
+            if (from[i] != last || ray->dx[i] != ld[0] || ray->dy[i] != ld[1] || ray->dz[i] != ld[2]) {
+                last = from[i];
+                ld[0] = ray->dx[i];
+                ld[1] = ray->dy[i];
+                ld[2] = ray->dz[i];
+                ok = !b->analytic && b->grid_level == b->level &&
+                     nc_shadow_grid_dir_ok(&b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(nc_v3(ld[0], ld[1], ld[2]))));
+            }
+            if (proven_lit(rt, from[i], ok, ray, i)) {
+                ray->valid[i] = 0;
+                culled++;
+            }
+        }
+    }
+    if (culled)
+        atomic_fetch_add_explicit(&rt->shadow_culled, (unsigned long)culled, memory_order_relaxed);
+    return culled;
+}
+
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded)
 {
+    unsigned long traced = 0;
+    for (int i = 0; i < NC_PACKET; i++)
+        traced += ray->valid[i] != 0;
+    if (!traced) {
+        memset(occluded, 0, NC_PACKET * sizeof *occluded);
+        return;
+    }
     struct RTCRay16 r __attribute__((aligned(64)));
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -428,9 +565,15 @@ void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occlude
     rtcOccluded16(ray->valid, rt->top, &ctx, &r);
     for (int i = 0; i < NC_PACKET; i++)
         occluded[i] = ray->valid[i] && r.tfar[i] == -INFINITY;
+    atomic_fetch_add_explicit(&rt->shadow_traced, traced, memory_order_relaxed);
 }
 
-void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st) { *st = rt->stats; }
+void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st)
+{
+    *st = rt->stats;
+    st->shadow_rays_culled = atomic_load(&rt->shadow_culled);
+    st->shadow_rays_traced = atomic_load(&rt->shadow_traced);
+}
 
 double nc_rt_lod_error_m(const struct nc_rt *rt)
 {
@@ -583,7 +726,9 @@ void nc_rt_destroy(struct nc_rt *rt)
         rtcReleaseScene(rt->top);
     if (rt->dev)
         rtcReleaseDevice(rt->dev);
-    for (int i = 0; i < rt->nbodies; i++)
+    for (int i = 0; i < rt->nbodies; i++) {
         free(rt->body[i].verts);
+        nc_shadow_grid_free(&rt->body[i].grid);
+    }
     free(rt);
 }

@@ -1,0 +1,158 @@
+/* shadow_grid.c - the Sun-column height grid of shadow_grid.h: a proof of
+ * "nothing above this point toward the Sun", never an approximation of a
+ * shadow. Built once per Sun direction, level and anchor; queried per ray. */
+#include "render/shadow_grid.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+int nc_shadow_grid_closed(const double *v, size_t nv, const uint32_t *tri, size_t nt)
+{
+    if (nt == 0)
+        return 0;
+    /* Undirected edges, each with (uses a->b) - (uses b->a); a closed surface
+     * has at most 1.5 nt of them (every edge at least twice). */
+    size_t cap = 1;
+    while (cap < 3 * nt)
+        cap <<= 1;
+    uint64_t *key = malloc(cap * sizeof *key);
+    int32_t *count = calloc(cap, sizeof *count);
+    if (!key || !count) {
+        free(key);
+        free(count);
+        return nc_error(-ENOMEM, "out of memory for %zu edges", cap);
+    }
+    memset(key, 0xff, cap * sizeof *key); /* UINT64_MAX: empty */
+    size_t used = 0;
+    int closed = 1;
+    double vol = 0;
+    for (size_t t = 0; t < nt && closed; t++) {
+        const uint32_t *f = &tri[3 * t];
+        for (int e = 0; e < 3; e++) {
+            uint32_t a = f[e], b = f[(e + 1) % 3];
+            uint64_t k = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+            size_t h = (size_t)((k * 0x9e3779b97f4a7c15ull) >> 20) & (cap - 1);
+            while (key[h] != k && key[h] != UINT64_MAX)
+                h = (h + 1) & (cap - 1);
+            if (key[h] == UINT64_MAX) {
+                if (++used > cap / 2) { /* more distinct edges than a closed surface has */
+                    closed = 0;
+                    break;
+                }
+                key[h] = k;
+            }
+            count[h] += a < b ? 1 : -1;
+        }
+        const double *p = &v[3 * (size_t)f[0]], *q = &v[3 * (size_t)f[1]], *r = &v[3 * (size_t)f[2]];
+        if (f[0] >= nv || f[1] >= nv || f[2] >= nv)
+            closed = 0;
+        else /* 6 x the signed volume of the tetrahedron (0, p, q, r) */
+            vol += p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) +
+                   p[2] * (q[0] * r[1] - q[1] * r[0]);
+    }
+    for (size_t h = 0; h < cap && closed; h++)
+        if (key[h] != UINT64_MAX && count[h] != 0)
+            closed = 0;
+    free(key);
+    free(count);
+    return closed && vol > 0;
+}
+
+int nc_shadow_grid_build(struct nc_shadow_grid *g, const double *v, const uint32_t *tri, size_t nt, struct nc_vec3 sun,
+                         double tol_rad, struct nc_vec3 centre, double radius_m, double margin_m)
+{
+    /* Cells about the size of a face: n^2 ~ nt / 2 over the disk. */
+    int n = (int)ceil(sqrt((double)nt / 2.0));
+    n = n < 16 ? 16 : n > 2048 ? 2048 : n;
+    if (n != g->n) {
+        float *h = malloc((size_t)n * (size_t)n * sizeof *h);
+        if (!h)
+            return nc_error(-ENOMEM, "out of memory for a %dx%d shadow grid", n, n);
+        free(g->hmax);
+        g->hmax = h;
+        g->n = n;
+    }
+    g->sun = sun;
+    /* Any axes perpendicular to the Sun. */
+    struct nc_vec3 t = fabs(sun.x) < 0.6 ? nc_v3(1, 0, 0) : nc_v3(0, 1, 0);
+    g->u = nc_v3_unit(nc_v3_cross(sun, t));
+    g->v = nc_v3_cross(sun, g->u);
+    /* A ray within tol_rad of sun drifts off its column by at most
+     * 2 radius_m tol_rad inside the sphere; with the geometry's own margin,
+     * every face's footprint grows by `grow`. */
+    const double grow = 2 * margin_m + 2 * radius_m * tol_rad, half = radius_m + 2 * grow;
+    g->margin_m = margin_m;
+    g->tol_rad = tol_rad;
+    g->cell_m = 2 * half / n;
+    g->u0 = nc_v3_dot(centre, g->u) - half;
+    g->v0 = nc_v3_dot(centre, g->v) - half;
+    for (size_t i = 0; i < (size_t)n * (size_t)n; i++)
+        g->hmax[i] = -INFINITY;
+    const double inv = 1.0 / g->cell_m;
+    for (size_t f = 0; f < nt; f++) {
+        struct nc_vec3 p[3];
+        for (int k = 0; k < 3; k++) {
+            const double *q = &v[3 * (size_t)tri[3 * f + k]];
+            p[k] = nc_v3(q[0], q[1], q[2]);
+        }
+        struct nc_vec3 nrm = nc_v3_cross(nc_v3_sub(p[1], p[0]), nc_v3_sub(p[2], p[0]));
+        double len = nc_v3_norm(nrm);
+        /* A ray that enters through a face has n . d < 0, so n . sun < |sun - d|,
+         * under 2 tol_rad for a direction d within tol_rad of sun. */
+        if (nc_v3_dot(nrm, sun) >= 2 * tol_rad * len)
+            continue; /* faces the Sun: a ray from outside cannot enter through it */
+        double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY, h = -INFINITY;
+        for (int k = 0; k < 3; k++) {
+            double a = nc_v3_dot(p[k], g->u), b = nc_v3_dot(p[k], g->v);
+            umin = fmin(umin, a);
+            umax = fmax(umax, a);
+            vmin = fmin(vmin, b);
+            vmax = fmax(vmax, b);
+            h = fmax(h, nc_v3_dot(p[k], sun));
+        }
+        int i0 = (int)floor((umin - grow - g->u0) * inv), i1 = (int)floor((umax + grow - g->u0) * inv);
+        int j0 = (int)floor((vmin - grow - g->v0) * inv), j1 = (int)floor((vmax + grow - g->v0) * inv);
+        i0 = i0 < 0 ? 0 : i0;
+        j0 = j0 < 0 ? 0 : j0;
+        i1 = i1 >= n ? n - 1 : i1;
+        j1 = j1 >= n ? n - 1 : j1;
+        /* A point of the ray is higher than its start: no tilt allowance.
+         * Rounded up so the float never understates the height. */
+        float hf = nextafterf((float)(h + 2 * margin_m), INFINITY);
+        for (int j = j0; j <= j1; j++)
+            for (int i = i0; i <= i1; i++)
+                if (g->hmax[(size_t)j * n + i] < hf)
+                    g->hmax[(size_t)j * n + i] = hf;
+    }
+    return 0;
+}
+
+int nc_shadow_grid_dir_ok(const struct nc_shadow_grid *g, struct nc_vec3 d)
+{
+    double c = nc_v3_dot(d, g->sun);
+    return c > 0 && nc_v3_norm(nc_v3_sub(d, nc_v3_scale(g->sun, c))) <= g->tol_rad;
+}
+
+int nc_shadow_grid_lit_at(const struct nc_shadow_grid *g, double pu, double pv, double ph)
+{
+    double a = (pu - g->u0) / g->cell_m, b = (pv - g->v0) / g->cell_m;
+    if (!(a >= 0 && b >= 0 && a < g->n && b < g->n))
+        return !isnan(a) && !isnan(b) && !isnan(ph); /* beyond every face's column */
+    return ph > g->hmax[(size_t)(int)b * g->n + (int)a];
+}
+
+int nc_shadow_grid_lit(const struct nc_shadow_grid *g, struct nc_vec3 p, struct nc_vec3 d)
+{
+    return nc_shadow_grid_dir_ok(g, d) &&
+           nc_shadow_grid_lit_at(g, nc_v3_dot(p, g->u), nc_v3_dot(p, g->v), nc_v3_dot(p, g->sun));
+}
+
+void nc_shadow_grid_free(struct nc_shadow_grid *g)
+{
+    free(g->hmax);
+    memset(g, 0, sizeof *g);
+}
