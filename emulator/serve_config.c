@@ -97,13 +97,15 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
     e->udp_port = 5750;
     e->tcp_port = 5751;
     e->max_clients = 64;
+    e->overlap = 1;
     if ((rc = nc_cfg_map(cfg->root, "serve", &sv)) < 0)
         return rc;
     if (sv) {
         static const char *const drops[] = {"drop_newest", "drop_oldest", NULL};
         static const char *const stale[] = {"drop", "render", NULL};
         static const char *const nopose[] = {"scene", "drop", NULL};
-        int np = 0;
+        static const char *const onoff[] = {"false", "true", NULL};
+        int np = 0, ov = 1;
         const char *bind = NULL;
         int d = 0, st = 0;
         if ((rc = nc_cfg_enum(sv, "mode", nc__serve_mode_names, &m)) < 0 ||
@@ -112,8 +114,10 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
             (rc = nc_cfg_double(sv, "max_extrapolation_s", 0, 3600, &max_extrap)) < 0 ||
             (rc = nc_cfg_double(sv, "pose_wait_s", 0, 60, &pose_wait_s)) < 0 ||
             (rc = nc_cfg_enum(sv, "drop_policy", drops, &d)) < 0 || (rc = nc_cfg_enum(sv, "stale_pose", stale, &st)) < 0 ||
-            (rc = nc_cfg_enum(sv, "no_pose", nopose, &np)) < 0 || (rc = nc_cfg_string(sv, "bind", &bind)) < 0)
+            (rc = nc_cfg_enum(sv, "no_pose", nopose, &np)) < 0 || (rc = nc_cfg_string(sv, "bind", &bind)) < 0 ||
+            (rc = nc_cfg_enum(sv, "overlap_camera_model", onoff, &ov)) < 0)
             return rc;
+        e->overlap = ov;
         e->drop_oldest = d;
         e->no_pose_scene = np == 0;
         e->stale_render = st;
@@ -126,6 +130,7 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
             return rc;
     }
     e->mode = (enum nc__serve_mode)m;
+    e->overlap = e->overlap && e->mode != NC__MODE_LOCKSTEP;
     e->pose_wait_ns = llround(pose_wait_s * 1e9);
     if ((rc = nc_timeline_init(&e->tl, 4096, (int64_t)llround(max_extrap * 1e9))) < 0)
         return rc;

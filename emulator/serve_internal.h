@@ -92,6 +92,7 @@ struct nc__emu {
     double frame_rate_hz, stats_interval_s;
     int64_t pose_wait_ns; /* triggered frames: wait this long past the exposure for a later pose */
     int queue_frames, drop_oldest, stale_render, no_pose_scene;
+    int overlap; /* the camera model of frame N runs while N+1 renders (never in lock-step) */
     atomic_llong readout_end_ns; /* CLOCK_MONOTONIC the frame being rendered should be done (0: none) */
     int64_t last_trigger_mono_ns; /* of the trigger or tick before (under jlock) */
     int job_cap; /* jobs that may wait for the render: queue_frames (lock-step) or 1 (the sensor holds one frame) */
@@ -149,6 +150,9 @@ struct nc__emu {
     /* statistics */
     atomic_ulong received, rejected[NC_REJECT_COUNT], dropped[NC__DROP_COUNT], delivered;
     double lat_ms[NC_SERVE_LAT_SAMPLES], render_ms[NC_SERVE_LAT_SAMPLES], wait_ms[NC_SERVE_LAT_SAMPLES];
+    /* the time one frame keeps the camera busy: render + camera model, or
+     * the longer of the two where they overlap (outside lock-step) */
+    double busy_ms[NC_SERVE_LAT_SAMPLES];
     unsigned long nlat;
     pthread_mutex_t stat_lock;
     int64_t last_reject_log_ns;
@@ -194,7 +198,8 @@ void *nc__serve_render_thread(void *arg);
 void *nc__serve_output_thread(void *arg);
 
 /* serve_stats.c */
-/* The median render and camera-model time of the last 16 frames, ms (0: none yet). */
+/* The median time the last 16 frames kept the camera busy (busy_ms), ms
+ * (0: none yet). */
 double nc__serve_render_estimate_ms(struct nc__emu *e);
 /* The frame rate the camera can deliver now: the requested rate (free-run),
  * capped by 1 / nc__serve_render_estimate_ms (0: not known yet, in trigger

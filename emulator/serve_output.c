@@ -2,6 +2,7 @@
  * to every output driver, then the FRAME answer to the client that asked.
  * One failing output (a device gone) never stops the others. */
 #include <errno.h>
+#include <math.h>
 
 #include "core/clock.h"
 #include "core/error.h"
@@ -65,6 +66,9 @@ void *nc__serve_output_thread(void *arg)
         pthread_mutex_lock(&e->stat_lock);
         e->lat_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = (handed - sl->job.ready_mono_ns) * 1e-6;
         e->render_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = sl->rec.render_ms + sl->rec.camera_ms;
+        e->busy_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = !e->overlap
+                                                         ? sl->rec.render_ms + sl->rec.camera_ms
+                                                         : fmax(sl->rec.render_ms, sl->rec.camera_ms);
         e->wait_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = (sl->render_start_mono_ns - sl->job.ready_mono_ns) * 1e-6;
         e->nlat++;
         pthread_mutex_unlock(&e->stat_lock);

@@ -1,9 +1,11 @@
 /* serve_render.c - the render thread (serve_internal.h): a job -> the pose
- * at mid-exposure -> render with motion smear -> camera model -> a slot for
+ * at mid-exposure -> render with motion smear -> camera model (overlapping
+ * the next render, on a thread of its own, outside lock-step) -> a slot for
  * the output thread. The only thread that renders. */
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "core/clock.h"
@@ -117,103 +119,221 @@ static void drop_job(struct nc__emu *e, const struct nc__job *j, enum nc__drop_r
     fill_slot(e);
 }
 
-void *nc__serve_render_thread(void *arg)
-{
-    struct nc__emu *e = arg;
-    const int W = e->cs.width_px, H = e->cs.height_px;
-    const size_t n = (size_t)W * (size_t)H;
-    struct nc_frame f; /* the camera model's render size: the sensor and the PSF's margin */
-    float *el = malloc(n * sizeof *el);
-    if (nc_frame_alloc(&f, e->cs.render_width_px, e->cs.render_height_px) < 0 || !el) {
-        nc_log_error("emulator/render", "out of memory for frames");
-        atomic_store(&e->stop, 2);
-        free(el);
-        return NULL;
-    }
-    /* A warm-up frame of the configured pose, discarded: the first frame
-     * served does not pay for first-touch memory, the render threads' start
-     * and lazy library set-up (nc_serve starts the triggers after it). */
-    struct nc_scene warm = e->scene;
-    struct nc_pose p0;
-    nc_scene_pose(&e->scene, 0, &p0);
-    nc_scene_apply_pose(&warm, &p0);
-    nc_camsys_render_camera(&e->cs, &warm.camera, &warm.camera);
-    if (nc_render_frame(&e->renderer, &warm, &f) >= 0)
-        nc_camsys_electrons(&e->cs, f.radiance, e->cs.exposure_s, el);
-    atomic_store(&e->warm, 1);
+/* A rendered frame on its way to the camera model. */
+struct staged {
     struct nc__job j;
+    struct nc_pose pose;
+    enum nc_pose_quality q;
+    int64_t gap, t0, t1; /* render start and end, CLOCK_MONOTONIC */
+    int rc, ts, buf;
+    double lod_error_m;
+};
+
+/* The camera-model stage: in free-run and trigger modes (unless
+ * serve.overlap_camera_model is false) its own thread, so that the camera
+ * model of frame N runs while frame N+1 renders (two render buffers; the
+ * render of N+2 waits until N's buffer is free). Lock-step runs it in the
+ * render thread, so that its answers keep request order and a capture at
+ * shutdown is answered in turn (hold_job). */
+struct stage {
+    struct nc__emu *e;
+    struct nc_frame f[2];
+    float *el;
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+    struct staged item;
+    int full, end, inuse[2];
+};
+
+/* The camera model of one rendered frame into a slot for the output thread. */
+static void finish_frame(struct stage *st, const struct staged *x)
+{
+    struct nc__emu *e = st->e;
+    const struct nc__job *j = &x->j;
+    struct nc__slot *sl = free_slot(e, j);
+    if (!sl)
+        return;
+    int64_t t1 = nc_mono_ns();
+    struct nc_camsys cs = e->cs; /* per-frame gain */
+    cs.sensor.analog_gain_db = j->gain_db;
+    uint64_t frame = e->next_frame++;
+    int rc = x->rc;
+    if (rc >= 0)
+        rc = nc_camsys_electrons(&cs, st->f[x->buf].radiance, j->exposure_s, st->el);
+    if (rc >= 0)
+        rc = nc_camsys_digitise(&cs, st->el, j->exposure_s, frame, sl->dn);
+    int64_t t2 = nc_mono_ns();
+    if (rc < 0) {
+        nc_log_error("emulator/render", "frame %llu: %s", (unsigned long long)frame, nc_errmsg());
+        if (e->mode != NC__MODE_LOCKSTEP) {
+            nc__serve_drop(e, j, NC__DROP_OUTPUT_BUSY);
+            return;
+        }
+        sl->job = *j; /* the slot is ours: answer in order */
+        sl->dropped = 1;
+        sl->why = NC__DROP_OUTPUT_BUSY;
+        fill_slot(e);
+        return;
+    }
+    int64_t exp_ns = (int64_t)llround(j->exposure_s * 1e9);
+    int64_t start_sim = j->mid_sim_ns - (int64_t)llround(0.5 * j->exposure_s * 1e9);
+    int64_t start_mono = j->trigger_mono_ns + (start_sim - j->trigger_sim_ns);
+    sl->job = *j;
+    sl->dropped = 0;
+    sl->render_start_mono_ns = x->t0;
+    sl->rec = (struct nc_frame_record){
+        .frame = frame, .request_sequence = j->sequence, .trigger_source = j->source,
+        .trigger_sim_ns = j->trigger_sim_ns, .exposure_start_sim_ns = start_sim,
+        .exposure_end_sim_ns = start_sim + exp_ns, .trigger_mono_ns = j->trigger_mono_ns,
+        .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = x->pose,
+        .pose_quality = x->q, .pose_gap_ns = x->gap, .exposure_s = j->exposure_s, .gain_db = j->gain_db,
+        .time_samples = x->ts, .lod_error_m = x->lod_error_m, .render_ms = (x->t1 - x->t0) * 1e-6,
+        .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
+        .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
+    fill_slot(e);
+}
+
+static void *camera_thread(void *arg)
+{
+    struct stage *st = arg;
+    pthread_mutex_lock(&st->lock);
+    for (;;) {
+        while (!st->full && !st->end)
+            pthread_cond_wait(&st->cond, &st->lock);
+        if (!st->full)
+            break; /* ended, and nothing left */
+        struct staged x = st->item;
+        st->full = 0;
+        pthread_cond_broadcast(&st->cond);
+        pthread_mutex_unlock(&st->lock);
+        finish_frame(st, &x);
+        pthread_mutex_lock(&st->lock);
+        st->inuse[x.buf] = 0;
+        pthread_cond_broadcast(&st->cond);
+    }
+    pthread_mutex_unlock(&st->lock);
+    return NULL;
+}
+
+/* Render buffer b, once the camera model is done with it. */
+static struct nc_frame *take_buffer(struct stage *st, int b)
+{
+    pthread_mutex_lock(&st->lock);
+    while (st->inuse[b])
+        pthread_cond_wait(&st->cond, &st->lock);
+    pthread_mutex_unlock(&st->lock);
+    return &st->f[b];
+}
+
+static void hand_over(struct stage *st, const struct staged *x)
+{
+    pthread_mutex_lock(&st->lock);
+    while (st->full)
+        pthread_cond_wait(&st->cond, &st->lock);
+    st->item = *x;
+    st->full = 1;
+    st->inuse[x->buf] = 1;
+    pthread_cond_broadcast(&st->cond);
+    pthread_mutex_unlock(&st->lock);
+}
+
+/* The render loop proper: jobs until shutdown, each rendered into the next
+ * buffer and finished in line (lock-step) or handed to the camera thread. */
+static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
+{
+    struct nc__job j;
+    int buf = 0;
     while (!e->have_held && next_job(e, &j)) {
-        struct nc_pose pose;
-        enum nc_pose_quality q;
-        int64_t gap;
+        struct staged x = {.j = j};
         if (j.rejected) {
             drop_job(e, &j, NC__DROP_REJECTED);
             continue;
         }
-        if (!pose_for(e, &j, &pose, &q, &gap)) {
+        if (!pose_for(e, &j, &x.pose, &x.q, &x.gap)) {
             hold_job(e, &j); /* shutting down: answered with the rest of the queue */
             break;
         }
-        if (q == NC_POSE_NONE) {
+        if (x.q == NC_POSE_NONE) {
             drop_job(e, &j, NC__DROP_NO_POSE);
             continue;
         }
-        if (q == NC_POSE_STALE && !e->stale_render) {
+        if (x.q == NC_POSE_STALE && !e->stale_render) {
             drop_job(e, &j, NC__DROP_STALE_POSE);
             continue;
         }
         struct nc_scene at = e->scene; /* shallow: shares meshes and materials */
-        nc_scene_apply_pose(&at, &pose);
+        nc_scene_apply_pose(&at, &x.pose);
         nc_camsys_render_camera(&e->cs, &at.camera, &at.camera);
         struct nc_exposure ex = {.exposure_s = j.exposure_s, .rolling = e->cs.sensor.shutter == NC_SHUTTER_ROLLING,
                                  .line_time_s = e->cs.sensor.line_time_s};
-        int ts = 1;
-        int64_t t0 = nc_mono_ns(); /* from here on the frame is being read out */
+        struct nc_frame *f = take_buffer(st, buf);
+        x.ts = 1;
+        x.buf = buf;
+        x.t0 = nc_mono_ns(); /* from here on the frame is being read out */
         double est_ms = nc__serve_render_estimate_ms(e); /* 0 before the first frame: no tick waits for it */
-        atomic_store(&e->readout_end_ns, est_ms > 0 ? t0 + llround(est_ms * 1e6) : INT64_MAX);
-        int rc = nc_render_exposure(&e->renderer, &at, &ex, &f, &ts);
-        int64_t t1 = nc_mono_ns();
-        struct nc__slot *sl = free_slot(e, &j);
-        if (!sl)
-            continue;
-        struct nc_camsys cs = e->cs; /* per-frame gain */
-        cs.sensor.analog_gain_db = j.gain_db;
-        uint64_t frame = e->next_frame++;
-        if (rc >= 0)
-            rc = nc_camsys_electrons(&cs, f.radiance, j.exposure_s, el);
-        if (rc >= 0)
-            rc = nc_camsys_digitise(&cs, el, j.exposure_s, frame, sl->dn);
-        int64_t t2 = nc_mono_ns();
-        atomic_store(&e->readout_end_ns, 0);
-        if (rc < 0) {
-            nc_log_error("emulator/render", "frame %llu: %s", (unsigned long long)frame, nc_errmsg());
-            if (e->mode != NC__MODE_LOCKSTEP) {
-                nc__serve_drop(e, &j, NC__DROP_OUTPUT_BUSY);
-                continue;
-            }
-            sl->job = j; /* the slot is ours: answer in order */
-            sl->dropped = 1;
-            sl->why = NC__DROP_OUTPUT_BUSY;
-            fill_slot(e);
-            continue;
+        atomic_store(&e->readout_end_ns, est_ms > 0 ? x.t0 + llround(est_ms * 1e6) : INT64_MAX);
+        x.rc = nc_render_exposure(&e->renderer, &at, &ex, f, &x.ts);
+        x.t1 = nc_mono_ns();
+        x.lod_error_m = nc_rt_lod_error_m(e->renderer.rt);
+        if (overlap) {
+            atomic_store(&e->readout_end_ns, 0); /* the next exposure may start rendering */
+            hand_over(st, &x);
+            buf ^= 1;
+        } else {
+            finish_frame(st, &x);
+            atomic_store(&e->readout_end_ns, 0);
         }
-        int64_t exp_ns = (int64_t)llround(j.exposure_s * 1e9);
-        int64_t start_sim = j.mid_sim_ns - (int64_t)llround(0.5 * j.exposure_s * 1e9);
-        int64_t start_mono = j.trigger_mono_ns + (start_sim - j.trigger_sim_ns);
-        sl->job = j;
-        sl->dropped = 0;
-        sl->render_start_mono_ns = t0;
-        sl->rec = (struct nc_frame_record){
-            .frame = frame, .request_sequence = j.sequence, .trigger_source = j.source,
-            .trigger_sim_ns = j.trigger_sim_ns, .exposure_start_sim_ns = start_sim,
-            .exposure_end_sim_ns = start_sim + exp_ns, .trigger_mono_ns = j.trigger_mono_ns,
-            .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = pose,
-            .pose_quality = q, .pose_gap_ns = gap, .exposure_s = j.exposure_s, .gain_db = j.gain_db,
-            .time_samples = ts, .lod_error_m = nc_rt_lod_error_m(e->renderer.rt), .render_ms = (t1 - t0) * 1e-6, .camera_ms = (t2 - t1) * 1e-6, .width_px = W,
-            .height_px = H, .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
-        fill_slot(e);
     }
-    nc_frame_free(&f);
-    free(el);
+}
+
+void *nc__serve_render_thread(void *arg)
+{
+    struct nc__emu *e = arg;
+    const size_t n = (size_t)e->cs.width_px * (size_t)e->cs.height_px;
+    const int overlap = e->overlap;
+    struct stage st = {.e = e, .el = malloc(n * sizeof(float))};
+    pthread_mutex_init(&st.lock, NULL);
+    pthread_cond_init(&st.cond, NULL);
+    pthread_t cam;
+    /* The camera model's render size: the sensor and the PSF's margin. */
+    int ok = st.el && nc_frame_alloc(&st.f[0], e->cs.render_width_px, e->cs.render_height_px) >= 0 &&
+             (!overlap || nc_frame_alloc(&st.f[1], e->cs.render_width_px, e->cs.render_height_px) >= 0);
+    if (!ok)
+        nc_log_error("emulator/render", "out of memory for frames");
+    /* A warm-up frame of the configured pose, discarded: the first frame
+     * served does not pay for first-touch memory, the render threads' start
+     * and lazy library set-up (nc_serve starts the triggers after it). */
+    if (ok) {
+        struct nc_scene warm = e->scene;
+        struct nc_pose p0;
+        nc_scene_pose(&e->scene, 0, &p0);
+        nc_scene_apply_pose(&warm, &p0);
+        nc_camsys_render_camera(&e->cs, &warm.camera, &warm.camera);
+        if (nc_render_frame(&e->renderer, &warm, &st.f[0]) >= 0)
+            nc_camsys_electrons(&e->cs, st.f[0].radiance, e->cs.exposure_s, st.el);
+    }
+    int err = ok && overlap ? pthread_create(&cam, NULL, camera_thread, &st) : 0;
+    if (err) {
+        nc_log_error("emulator/render", "cannot start the camera-model thread: %s", strerror(err));
+        ok = 0;
+    }
+    if (!ok) {
+        atomic_store(&e->stop, 2);
+    } else {
+        atomic_store(&e->warm, 1);
+        render_loop(e, &st, overlap);
+    }
+    if (ok && overlap) {
+        pthread_mutex_lock(&st.lock);
+        st.end = 1;
+        pthread_cond_broadcast(&st.cond);
+        pthread_mutex_unlock(&st.lock);
+        pthread_join(cam, NULL); /* it finishes the frame handed over last */
+    }
+    pthread_cond_destroy(&st.cond);
+    pthread_mutex_destroy(&st.lock);
+    nc_frame_free(&st.f[0]);
+    nc_frame_free(&st.f[1]);
+    free(st.el);
     return NULL;
 }

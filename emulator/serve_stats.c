@@ -52,7 +52,7 @@ double nc__serve_render_estimate_ms(struct nc__emu *e)
     pthread_mutex_lock(&e->stat_lock);
     unsigned long n = e->nlat < 16 ? e->nlat : 16;
     for (unsigned long i = 0; i < n; i++)
-        r[i] = e->render_ms[(e->nlat - 1 - i) % NC_SERVE_LAT_SAMPLES];
+        r[i] = e->busy_ms[(e->nlat - 1 - i) % NC_SERVE_LAT_SAMPLES];
     pthread_mutex_unlock(&e->stat_lock);
     if (n == 0)
         return 0.0;
