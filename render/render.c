@@ -168,6 +168,7 @@ static void shade_tile(struct job *j, int tile)
     struct nc_vec3 dir[NC_PACKET], orig[NC_PACKET]; /* the camera rays in double precision */
     struct nc_hit16 hit;
     int occluded[NC_PACKET], from[NC_PACKET], lit[NC_PACKET];
+    unsigned long shadow_culled = 0, shadow_traced = 0;
     double mu0[NC_PACKET], irr[NC_PACKET];
     struct nc_photometry geo[NC_PACKET];
 
@@ -272,7 +273,10 @@ static void shade_tile(struct job *j, int tile)
                 }
                 if (!any)
                     continue;
-                if (!j->r->no_shadow_cull && nc_rt_shadow_cull16(j->rt, &shadow, from) == any) {
+                int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, &shadow, from);
+                shadow_culled += (unsigned long)culled;
+                shadow_traced += (unsigned long)(any - culled);
+                if (culled == any) {
                     memset(occluded, 0, sizeof occluded); /* every ray proven: nothing to trace */
                 } else {
                     if (j->r->ray_hook)
@@ -308,6 +312,7 @@ static void shade_tile(struct job *j, int tile)
                 }
             }
     }
+    nc_rt_count_shadow_rays(j->rt, shadow_culled, shadow_traced);
     const double inv = 1.0 / spp;
     for (int y = y0; y < y0 + TILE && y < H; y++)
         for (int x = x0; x < x0 + TILE && x < W; x++) {

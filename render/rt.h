@@ -36,8 +36,8 @@ struct nc_rt_stats {
     int lod_level[NC_MAX_BODIES];
     size_t lod_triangles[NC_MAX_BODIES];
     double lod_error_m[NC_MAX_BODIES];
-    /* Since creation: shadow rays proven unoccluded (nc_rt_shadow_cull16), and
-     * rays traced by nc_rt_occluded16. */
+    /* Since creation, as the renderer reports them (nc_rt_count_shadow_rays):
+     * shadow rays proven unoccluded (nc_rt_shadow_cull16), and traced. */
     unsigned long shadow_rays_culled, shadow_rays_traced;
 };
 
@@ -60,6 +60,9 @@ void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occlude
  * ray). Rays proven to meet nothing (shadow_grid.h for the body's own shape,
  * the bounding spheres for the others) are made inactive; returns how many. */
 int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from);
+/* Add to the shadow-ray counts of nc_rt_get_stats (callers add a tile's
+ * worth at a time: the counters are shared by every render thread). */
+void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced);
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
 /* The largest error bound of the levels of detail shown at the last update,
  * metres (0: every body at full resolution). */

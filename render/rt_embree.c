@@ -43,6 +43,7 @@ struct rt_body {
      * offsets that give a point's grid coordinates from it: x . axis - off. */
     struct nc_vec3 grid_axis[3];
     double grid_off[3];
+    double cull_radius_m; /* the bounding sphere padded for float rays, at the last update */
     struct nc_vec3 anchor_m; /* body frame; geometry is stored relative to it */
     int anchored;
     unsigned anchor_gen;
@@ -403,6 +404,7 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             b->rot[e] = (float)R.m[e / 3][e % 3];
         b->R = R;
         b->origin_rel = nc_v3_sub(src->position_m, cam);
+        b->cull_radius_m = src->bounding_radius_m * (1 + 1e-5) + 1e-5 * nc_v3_norm(b->origin_rel);
         rtcSetGeometryTransform(b->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(b->inst);
         if ((rc = update_grid(b, s)) < 0)
@@ -505,7 +507,7 @@ static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct
     const struct rt_body *b = &rt->body[from];
     struct nc_vec3 o = nc_v3(ray->ox[i], ray->oy[i], ray->oz[i]), d = nc_v3(ray->dx[i], ray->dy[i], ray->dz[i]);
     if (!b->analytic) {
-        if (!dir_ok || b->grid_level != b->level)
+        if (!dir_ok)
             return 0;
         double c[3];
         for (int k = 0; k < 3; k++)
@@ -513,12 +515,9 @@ static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct
         if (!nc_shadow_grid_lit_at(&b->grid, c[0], c[1], c[2]))
             return 0;
     }
-    for (int k = 0; k < rt->nbodies; k++) {
-        const struct rt_body *e = &rt->body[k];
-        double r = e->src->bounding_radius_m * (1 + 1e-5) + 1e-5 * nc_v3_norm(e->origin_rel);
-        if (k != from && ray_near_sphere(o, d, e->origin_rel, r))
+    for (int k = 0; k < rt->nbodies; k++)
+        if (k != from && ray_near_sphere(o, d, rt->body[k].origin_rel, rt->body[k].cull_radius_m))
             return 0;
-    }
     return 1;
 }
 
@@ -544,17 +543,15 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
             }
         }
     }
-    if (culled)
-        atomic_fetch_add_explicit(&rt->shadow_culled, (unsigned long)culled, memory_order_relaxed);
     return culled;
 }
 
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded)
 {
-    unsigned long traced = 0;
+    int any = 0;
     for (int i = 0; i < NC_PACKET; i++)
-        traced += ray->valid[i] != 0;
-    if (!traced) {
+        any |= ray->valid[i];
+    if (!any) {
         memset(occluded, 0, NC_PACKET * sizeof *occluded);
         return;
     }
@@ -565,6 +562,11 @@ void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occlude
     rtcOccluded16(ray->valid, rt->top, &ctx, &r);
     for (int i = 0; i < NC_PACKET; i++)
         occluded[i] = ray->valid[i] && r.tfar[i] == -INFINITY;
+}
+
+void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced)
+{
+    atomic_fetch_add_explicit(&rt->shadow_culled, culled, memory_order_relaxed);
     atomic_fetch_add_explicit(&rt->shadow_traced, traced, memory_order_relaxed);
 }
 
