@@ -40,6 +40,7 @@ bench: build
 	$(BUILD)/bench_sensor
 	$(BUILD)/bench_latency
 	$(BUILD)/bench_gige
+	bench/freerun.sh $(BUILD)
 	@if command -v qemu-system-x86_64 >/dev/null && [ -x $(BUILD)/tests/v4l2_capture ]; then \
 	  bench/bench_edge_to_frame.sh $(BUILD); \
 	else echo "bench_edge_to_frame: needs the qemu guest of tests/vm (scripts/install-deps.sh --test)"; fi

@@ -8,11 +8,12 @@
  * - The device thread (Aravis) answers GVCP: registers, acquisition start
  *   and stop, heartbeats. It never streams: its own trigger stays in
  *   software mode and its latch is never raised.
- * - The sender thread sends each finished frame the moment submit() hands
- *   it over (gige/gvsp.c): ROI and pixel format as the registers say, the
- *   optional metadata row, the exposure start as GVSP timestamp. A frame
- *   whose exposure started before the client's AcquisitionStart is never
- *   sent; a newer frame replaces one not yet sent.
+ * - submit() packs each finished frame as the stream carries it (ROI and
+ *   pixel format as the registers say, the optional metadata row) into one
+ *   of three buffers, and the sender thread sends it at once (gige/gvsp.c),
+ *   the exposure start as GVSP timestamp. A frame whose exposure started
+ *   before the client's AcquisitionStart is never sent; a newer frame
+ *   replaces one not yet sent.
  * - NavCam's poll thread reads what clients wrote (ExposureTime, Gain,
  *   AcquisitionFrameRate, TriggerMode/Source/Activation/Delay) poll_hz times
  *   a second and hands changes to the emulator (struct nc_camera_control),
@@ -70,13 +71,17 @@ struct gige {
     const struct nc_camera_control *ctl;
     int W, H, adc_bits, meta_rows;
     char iface[IF_NAMESIZE], addr[INET_ADDRSTRLEN];
-    /* the newest finished frame, for the sender thread */
+    /* Frames as the stream carries them, in three buffers: submit() packs
+     * into buf[fill] and swaps it with buf[ready]; the sender swaps
+     * buf[ready] with buf[send] and sends that one. */
     pthread_mutex_t lock;
-    pthread_cond_t cond; /* a frame was handed over, or stop */
-    uint16_t *dn;
-    uint8_t *payload; /* the frame as the stream carries it */
-    struct nc_frame_record rec;
-    uint64_t seq, sent_seq, submitted;
+    pthread_cond_t cond; /* a frame is ready, or stop */
+    uint8_t *buf[3];
+    atomic_size_t packed[3]; /* bytes of buf[k] packed so far */
+    struct nc__gvsp_image im[3];
+    struct nc_frame_record rec[3]; /* only its times and numbers: not dn */
+    int fill, ready, send, pending;
+    uint64_t submitted;
     unsigned long sent, skipped, not_acquiring, before_start, send_failed;
     struct nc__gvsp gvsp;
     atomic_llong acq_start_ns; /* CLOCK_MONOTONIC of AcquisitionStart (settings applied); 0: stopped */
@@ -208,10 +213,11 @@ static void *poll_thread(void *arg)
 
 /* ---- frames ----------------------------------------------------------------- */
 
-/* The newest frame (lock held) as the registers ask for it now: ROI, pixel
- * format, the metadata row on top. Returns 0, or -1 for settings NavCam does
- * not serve (a format it lacks, a size beyond 65536): nothing is sent then. */
-static int pack(struct gige *g, struct nc__gvsp_image *im)
+/* The layout of frame r in buf[fill] as the registers ask for it now (ROI,
+ * pixel format, the metadata row on top); pack() fills it. Returns 0, or -1
+ * for settings NavCam does not serve (a format it lacks, a size beyond the
+ * sensor plus a row): nothing is sent then. */
+static int layout(struct gige *g, const struct nc_frame_record *r)
 {
     /* Clients may write anything into these registers (GenICam range checks
      * are the client's): offsets are clamped to the sensor. */
@@ -223,14 +229,23 @@ static int pack(struct gige *g, struct nc__gvsp_image *im)
     if ((pf != PF_MONO8 && pf != PF_MONO12 && pf != PF_MONO16) || w == 0 || h == 0 ||
         (size_t)w * h > (size_t)g->W * (g->H + 1))
         return -1;
-    const int bpp = pf == PF_MONO8 ? 1 : 2;
-    uint8_t *out = g->payload;
-    nc__gige_image(g->dn, g->W, g->H, g->adc_bits, g->meta_rows ? &g->rec : NULL, pf, w, h, ox, oy, out);
-    *im = (struct nc__gvsp_image){.pixel_format = pf, .width = w, .height = h, .offset_x = (uint32_t)ox,
-                                  .offset_y = (uint32_t)oy, .data = out, .size = (size_t)w * h * bpp,
-                                  /* the GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns */
-                                  .timestamp_ns = (uint64_t)g->rec.exposure_start_mono_ns};
+    const int bpp = pf == PF_MONO8 ? 1 : 2, k = g->fill;
+    atomic_store(&g->packed[k], 0);
+    g->im[k] = (struct nc__gvsp_image){.pixel_format = pf, .width = w, .height = h, .offset_x = (uint32_t)ox,
+                                       .offset_y = (uint32_t)oy, .data = g->buf[k], .size = (size_t)w * h * bpp,
+                                       /* the GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns */
+                                       .timestamp_ns = (uint64_t)r->exposure_start_mono_ns, .ready = &g->packed[k]};
+    g->rec[k] = *r;
+    g->rec[k].dn = NULL;
     return 0;
+}
+
+/* Frame r into buf[k] as layout() set it, announcing the rows done. */
+static void pack(struct gige *g, const struct nc_frame_record *r, int k)
+{
+    const struct nc__gvsp_image *im = &g->im[k];
+    nc__gige_image(r->dn, g->W, g->H, g->adc_bits, g->meta_rows ? r : NULL, im->pixel_format, im->width, im->height,
+                   (int)im->offset_x, (int)im->offset_y, g->buf[k], &g->packed[k]);
 }
 
 /* Where the client wants the stream (GevSCDA, GevSCPHostPort); 0 if nowhere. */
@@ -243,41 +258,37 @@ static int stream_dest(struct gige *g, struct sockaddr_in *dest)
     return ok;
 }
 
-/* Each frame handed over is sent at once, unless no client acquires or it
- * was exposed before AcquisitionStart. */
+/* Each frame packed is sent at once, unless no client acquires or it was
+ * exposed before AcquisitionStart. */
 static void *sender_thread(void *arg)
 {
     struct gige *g = arg;
     pthread_mutex_lock(&g->lock);
     while (!atomic_load(&g->stop)) {
-        if (g->seq == g->sent_seq) {
+        if (!g->pending) {
             pthread_cond_wait(&g->cond, &g->lock);
             continue;
         }
-        if (g->sent_seq && g->seq > g->sent_seq + 1)
-            g->skipped += g->seq - g->sent_seq - 1; /* replaced by newer ones while sending */
-        g->sent_seq = g->seq;
+        int k = g->ready;
+        g->ready = g->send;
+        g->send = k;
+        g->pending = 0;
         int64_t start = atomic_load(&g->acq_start_ns);
         struct sockaddr_in dest;
-        struct nc__gvsp_image im;
         if (!start || !stream_dest(g, &dest)) {
             g->not_acquiring++;
             continue;
         }
-        if (g->rec.exposure_start_mono_ns < start) {
+        if (g->rec[k].exposure_start_mono_ns < start) {
             g->before_start++; /* the client asked for frames exposed from AcquisitionStart on */
             continue;
         }
         uint32_t packet = reg_get(g, REG_PACKET_SIZE) & 0xffff;
-        if (pack(g, &im) < 0) {
-            g->send_failed++;
-            continue;
-        }
-        pthread_mutex_unlock(&g->lock); /* submit() may hand over the next frame meanwhile */
-        int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &im);
+        pthread_mutex_unlock(&g->lock); /* submit() may pack and hand over the next frame meanwhile */
+        int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &g->im[k]);
         pthread_mutex_lock(&g->lock);
         if (rc < 0 && g->send_failed++ == 0)
-            nc_log_warn("output/gige", "frame %llu: %s", (unsigned long long)g->rec.frame, nc_errmsg());
+            nc_log_warn("output/gige", "frame %llu: %s", (unsigned long long)g->rec[k].frame, nc_errmsg());
         g->sent += rc == 0;
     }
     pthread_mutex_unlock(&g->lock);
@@ -368,17 +379,18 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
             unlink(path);
         return rc;
     }
-    g->dn = calloc((size_t)g->W * g->H, sizeof *g->dn);
-    g->payload = malloc((size_t)g->W * (g->H + 1) * 2);
-    if (!g->dn || !g->payload || (rc = nc__gvsp_open(&g->gvsp, g->addr)) < 0) {
+    int nbuf = 0;
+    while (nbuf < 3 && (g->buf[nbuf] = calloc((size_t)g->W * (g->H + 1), 2)))
+        nbuf++;
+    if (nbuf < 3 || (rc = nc__gvsp_open(&g->gvsp, g->addr)) < 0) {
         if (!xml)
             unlink(path);
-        free(g->dn);
-        free(g->payload);
-        g->dn = NULL;
-        g->payload = NULL;
+        for (int i = 0; i < 3; i++)
+            free(g->buf[i]);
+        memset(g->buf, 0, sizeof g->buf);
         return rc < 0 ? rc : nc_error(-ENOMEM, "out of memory");
     }
+    g->fill = 0, g->ready = 1, g->send = 2;
     pthread_mutex_init(&g->lock, NULL);
     pthread_cond_init(&g->cond, NULL);
     g->gv = arv_gv_fake_camera_new_full(g->iface, serial, path);
@@ -434,14 +446,31 @@ static int gige_submit(void *priv, const struct nc_frame_record *r)
     struct gige *g = priv;
     if (r->width_px != g->W || r->height_px != g->H)
         return nc_error(NC_ERANGE, "gige: frame %dx%d, camera %dx%d", r->width_px, r->height_px, g->W, g->H);
+    /* buf[fill] is submit()'s alone: laid out, handed over, then packed
+     * while the sender streams the rows already done. Only submit() swaps
+     * fill, so no one writes buf[k] meanwhile. */
+    int64_t start = atomic_load(&g->acq_start_ns);
+    int early = start && r->exposure_start_mono_ns < start;
+    int ok = start && !early && layout(g, r) == 0, k = g->fill;
     pthread_mutex_lock(&g->lock);
-    memcpy(g->dn, r->dn, (size_t)g->W * g->H * sizeof *g->dn);
-    g->rec = *r;
-    g->rec.dn = g->dn;
-    g->seq++;
     g->submitted++;
-    pthread_cond_signal(&g->cond); /* the sender sends it now */
+    if (!start) {
+        g->not_acquiring++;
+    } else if (early) {
+        g->before_start++; /* the client asked for frames exposed from AcquisitionStart on */
+    } else if (!ok) {
+        g->send_failed++;
+    } else {
+        if (g->pending)
+            g->skipped++; /* replaced by a newer one while the sender was busy */
+        g->fill = g->ready;
+        g->ready = k;
+        g->pending = 1;
+        pthread_cond_signal(&g->cond); /* the sender starts now */
+    }
     pthread_mutex_unlock(&g->lock);
+    if (ok)
+        pack(g, r, k);
     return 0;
 }
 
@@ -465,13 +494,13 @@ static void gige_close(void *priv)
                     g->send_failed, g->rejected_settings);
     if (g->gv)
         g_object_unref(g->gv); /* stops and joins the device thread */
-    if (g->dn) {
+    if (g->buf[0]) {
         pthread_mutex_destroy(&g->lock);
         pthread_cond_destroy(&g->cond);
         nc__gvsp_close(&g->gvsp);
     }
-    free(g->dn);
-    free(g->payload);
+    for (int i = 0; i < 3; i++)
+        free(g->buf[i]);
 }
 
 const struct nc_output_driver nc_output_gige = {

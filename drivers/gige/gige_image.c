@@ -44,21 +44,20 @@ void nc__gige_metadata(const struct nc_frame_record *r, uint8_t m[NC_GIGE_META_B
     put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
 }
 
-/* One DN as the pixel format stores it. */
-static inline uint16_t convert(uint16_t dn, uint32_t pf, int bits)
+/* A DN as the pixel format stores it: (dn << left) >> right. */
+static void shifts(uint32_t pf, int bits, int *left, int *right)
 {
-    if (pf == PF_MONO8)
-        return (uint16_t)(bits > 8 ? dn >> (bits - 8) : dn << (8 - bits));
-    if (pf == PF_MONO12)
-        return (uint16_t)(bits > 12 ? dn >> (bits - 12) : dn);
-    return (uint16_t)(dn << (16 - bits)); /* Mono16: most significant bits */
+    int keep = pf == PF_MONO8 ? 8 : pf == PF_MONO12 ? 12 : 16;
+    *left = pf == PF_MONO12 || bits >= keep ? 0 : keep - bits; /* Mono8, Mono16: most significant bits */
+    *right = bits > keep ? bits - keep : 0;
 }
 
 void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct nc_frame_record *meta, uint32_t pf,
-                    uint32_t w, uint32_t h, int ox, int oy, uint8_t *out)
+                    uint32_t w, uint32_t h, int ox, int oy, uint8_t *out, atomic_size_t *done)
 {
     const int bpp = pf == PF_MONO8 ? 1 : 2;
-    int row0 = 0;
+    int row0 = 0, left, right;
+    shifts(pf, adc_bits, &left, &right);
     if (meta) { /* the metadata row on top */
         uint8_t m[NC_GIGE_META_BYTES];
         nc__gige_metadata(meta, m);
@@ -78,12 +77,20 @@ void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct
         int n = ox + (int)w <= W ? (int)w : W - ox; /* >= 0: ox <= W */
         if (bpp == 1) {
             for (int x = 0; x < n; x++)
-                o[x] = (uint8_t)convert(src[x], pf, adc_bits);
+                o[x] = (uint8_t)((src[x] << left) >> right);
         } else {
-            for (int x = 0; x < n; x++)
-                put_u16(o + 2 * x, convert(src[x], pf, adc_bits));
+            for (int x = 0; x < n; x++) {
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+                uint16_t v = (uint16_t)((src[x] << left) >> right);
+                memcpy(o + 2 * x, &v, 2); /* one vectorised store */
+#else
+                put_u16(o + 2 * x, (uint16_t)((src[x] << left) >> right));
+#endif
+            }
         }
         if (n < (int)w)
             memset(o + (size_t)n * bpp, 0, (size_t)((int)w - n) * bpp);
+        if (done && (y % 16 == 15 || y == (int)h - 1))
+            atomic_store_explicit(done, (size_t)(y + 1) * w * bpp, memory_order_release);
     }
 }

@@ -1,10 +1,11 @@
 /* gvsp.c - GVSP image blocks (gvsp.h): headers built in place, the payload
- * sent straight from the frame (two iovecs a packet), 64 packets a
+ * sent straight from the frame (two iovecs a packet), 8 packets a
  * sendmmsg() call. */
 #include "drivers/gige/gvsp.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
+#include <sched.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
@@ -118,6 +119,9 @@ int nc__gvsp_send(struct nc__gvsp *s, const struct sockaddr_in *dest, uint32_t p
         m[n].msg_hdr.msg_name = (void *)dest;
         m[n].msg_hdr.msg_namelen = sizeof *dest;
         if (++n == BATCH || id == npay + 1) {
+            size_t need = id * chunk < im->size ? id * chunk : im->size; /* the batch's last byte */
+            while (im->ready && atomic_load_explicit(im->ready, memory_order_acquire) < need)
+                sched_yield(); /* rarely: the packer runs 3 times faster than this sends */
             rc = flush(s, m, n);
             n = 0;
         }

@@ -16,6 +16,7 @@
 #define NC_GVSP_H
 
 #include <netinet/in.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -31,6 +32,9 @@ struct nc__gvsp_image {
     uint64_t timestamp_ns;
     const uint8_t *data;
     size_t size; /* width x height x bytes per pixel */
+    /* NULL, or the bytes of data written so far: packets are sent as the
+     * bytes they carry are ready. */
+    const atomic_size_t *ready;
 };
 
 /* A UDP socket bound to addr (the device's IPv4 address), any port. */
