@@ -10,24 +10,9 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/rng.h"
 
 /* ---- procedural asteroid ---------------------------------------------- */
-
-static uint64_t splitmix64(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-static double uniform01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
-
-static struct nc_vec3 random_dir(uint64_t *s)
-{
-    double z = 2 * uniform01(s) - 1, phi = 2 * M_PI * uniform01(s), r = sqrt(1 - z * z);
-    return nc_v3(r * cos(phi), r * sin(phi), z);
-}
 
 /* Edge -> midpoint vertex map, open addressing. */
 struct edge_map {
@@ -125,15 +110,15 @@ int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
         return nc_error(-ENOMEM, "asteroid: out of memory");
     }
     for (int i = 0; i < nlump; i++) {
-        ft[i].c = random_dir(&rng);
-        ft[i].a = 0.35 + 0.65 * uniform01(&rng);
-        ft[i].amp = ap->lump_amplitude * (2 * uniform01(&rng) - 1);
+        ft[i].c = nc_rng_dir(&rng);
+        ft[i].a = 0.35 + 0.65 * nc_rng_uniform(&rng);
+        ft[i].amp = ap->lump_amplitude * (2 * nc_rng_uniform(&rng) - 1);
         ft[i].cos_reach = cos(fmin(M_PI, 3 * ft[i].a));
     }
     for (int i = nlump; i < nlump + ncr; i++) {
-        ft[i].c = random_dir(&rng);
+        ft[i].c = nc_rng_dir(&rng);
         /* Power-law sizes: many small craters, few large (cumulative ~ a^-1.5). */
-        ft[i].a = fmin(0.5, 0.03 * pow(1 - uniform01(&rng), -1 / 1.5));
+        ft[i].a = fmin(0.5, 0.03 * pow(1 - nc_rng_uniform(&rng), -1 / 1.5));
         ft[i].amp = 0.2 * ft[i].a; /* depth/diameter ~ 0.1 */
         ft[i].cos_reach = cos(fmin(M_PI, 1.8 * ft[i].a));
     }

@@ -1,7 +1,8 @@
 /* rt_embree.c - the Embree 3 back-end: device, per-body scenes, instances,
  * the exact analytic ellipsoid as user geometry, and packet tracing.
  *
- * Every Embree call in NavCam is in this file (Embree 4 changes the API).
+ * Every Embree call in NavCam is in this file or rt_rocks.c (Embree 4
+ * changes the API).
  * Nothing here knows about reflectance, cameras or images.
  */
 #include "render/rt.h"
@@ -17,6 +18,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "render/rt_rocks.h"
 #include "render/shadow_grid.h"
 
 struct rt_body {
@@ -33,6 +35,9 @@ struct rt_body {
     float *verts; /* anchor-relative vertices of every level, padded for Embree's 16-byte loads */
     unsigned inst_id;
     RTCGeometry inst;
+    /* boulders (rt_rocks.h), in every level's scene */
+    struct nc__rt_rocks rocks;
+    RTCGeometry rock_geom;
     int analytic;
     /* Shadow-ray culling (shadow_grid.h): which levels are closed outward
      * surfaces, and the grid of the level shown (body frame, body origin). */
@@ -218,6 +223,15 @@ static int body_init(struct nc_rt *rt, struct rt_body *b, const struct nc_body *
         nc_mesh_lod_free(&lod);
         if (rc < 0)
             return rc;
+        if (src->boulders.n) { /* rocks shadow the body: no grid proves a point lit */
+            b->rocks = (struct nc__rt_rocks){&src->boulders, &b->anchor_m};
+            if (!(b->rock_geom = nc__rt_rocks_geometry(rt->dev, &b->rocks)))
+                return nc_error(NC_ERENDER, "embree: cannot create the boulders of '%s'", src->name);
+            for (int k = 0; k < b->nlevels; k++) {
+                rtcAttachGeometry(b->scene[k], b->rock_geom);
+                b->closed[k] = 0;
+            }
+        }
     }
     b->inst = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(b->inst, b->scene[0]);
@@ -234,6 +248,8 @@ static void fit_level(struct rt_body *b, int k)
     if (!b->analytic)
         rtcUpdateGeometryBuffer(b->geom[k], RTC_BUFFER_TYPE_VERTEX, 0);
     rtcCommitGeometry(b->geom[k]);
+    if (b->rock_geom)
+        rtcCommitGeometry(b->rock_geom); /* their bounds move with the anchor */
     rtcCommitScene(b->scene[k]);
     b->fitted[k] = b->anchor_gen;
 }
@@ -717,6 +733,8 @@ void nc_rt_destroy(struct nc_rt *rt)
         struct rt_body *b = &rt->body[i];
         if (b->inst)
             rtcReleaseGeometry(b->inst);
+        if (b->rock_geom)
+            rtcReleaseGeometry(b->rock_geom);
         for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
             if (b->geom[k])
                 rtcReleaseGeometry(b->geom[k]);

@@ -13,6 +13,7 @@
 
 #include "core/config.h"
 #include "core/pose.h"
+#include "render/boulders.h"
 #include "render/camera.h"
 #include "render/material.h"
 #include "render/mesh.h"
@@ -28,6 +29,7 @@ struct nc_body {
     enum nc_shape_type shape;
     struct nc_vec3 radii_m; /* sphere/ellipsoid semi-axes along body x, y, z */
     struct nc_mesh mesh;    /* mesh and asteroid */
+    struct nc_boulder_field boulders; /* none when boulders.n == 0 (meshes only) */
     double bounding_radius_m;
     struct nc_material material;
     struct nc_vec3 position_m; /* scene frame */

@@ -1,0 +1,225 @@
+/* boulders.c - boulder populations and rock shapes (boulders.h). */
+#include "render/boulders.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/rng.h"
+
+/* Stream tags, so that shapes and faces never share a stream. */
+#define TAG_SHAPE 0x5348415045ull
+#define OCTAVE_MIN (-20) /* 1 um: below anything a camera resolves */
+#define OCTAVE_MAX 20    /* 1 km */
+
+int nc_boulder_preset(const char *name, struct nc_boulder_params *p)
+{
+    /* C = N(>D0) D0^b from a published density at D0 (docs/terrain.md). */
+    static const struct {
+        const char *name;
+        double slope, d0_m, n_per_km2;
+    } presets[] = {
+        /* Tricarico et al. 2021 (index about -2.9); density: Ryugu's N(>20 m),
+         * about 50 per km^2, is "twice as large as on ... Bennu"
+         * (Michikami et al. 2019). */
+        {"bennu", 2.9, 20, 25},
+        /* about 4400 boulders over 5 m on about 2.7 km^2, index -2.65
+         * (Michikami et al. 2019; Michikami & Hagermann 2021). */
+        {"ryugu", 2.65, 5, 4400 / 2.7},
+        /* 373 boulders over 5 m on 0.393 km^2, index -3.1 (Michikami et al. 2008). */
+        {"itokawa", 3.1, 5, 373 / 0.393},
+    };
+    for (size_t i = 0; i < sizeof presets / sizeof presets[0]; i++)
+        if (!strcmp(name, presets[i].name)) {
+            p->slope = presets[i].slope;
+            p->c_per_km2 = presets[i].n_per_km2 * pow(presets[i].d0_m, presets[i].slope);
+            return 0;
+        }
+    return nc_error(NC_ECONFIG, "unknown boulder preset '%s' (bennu, ryugu, itokawa)", name);
+}
+
+double nc_boulders_expected(const struct nc_boulder_params *p, double area_km2)
+{
+    return area_km2 * p->c_per_km2 * (pow(p->d_min_m, -p->slope) - pow(p->d_max_m, -p->slope));
+}
+
+/* A Poisson count of mean lambda from stream s. */
+static size_t poisson(uint64_t *s, double lambda)
+{
+    if (lambda > 30) { /* normal approximation (Box-Muller) */
+        double u = nc_rng_uniform(s), v = nc_rng_uniform(s);
+        double k = lambda + sqrt(lambda) * sqrt(-2 * log(1 - u)) * cos(2 * M_PI * v);
+        return k > 0 ? (size_t)llround(k) : 0;
+    }
+    double p = exp(-lambda), c = p, u = nc_rng_uniform(s);
+    size_t k = 0;
+    while (u > c && k < 1000) {
+        k++;
+        p *= lambda / (double)k;
+        c += p;
+    }
+    return k;
+}
+
+/* Shape i: an ellipsoid of half-axes 1 >= b >= c, cut by its three pairs of
+ * axis planes and by planes tangent to it in random directions pushed in by
+ * up to 20 %: faceted, flat-sided rocks of distinct outlines. */
+static void rock_shape(uint64_t seed, int i, struct nc_rock_shape *r)
+{
+    uint64_t s = nc_rng_seed(seed, TAG_SHAPE, (uint64_t)i);
+    /* around 2 : sqrt(2) : 1, spread by +-20 % */
+    double ax[3] = {1, M_SQRT1_2 * (0.8 + 0.4 * nc_rng_uniform(&s)), 0};
+    ax[2] = fmin(ax[1], 0.5 * (0.8 + 0.4 * nc_rng_uniform(&s)));
+    int n = 0;
+    for (int k = 0; k < 3; k++)
+        for (int sg = -1; sg <= 1; sg += 2) {
+            float *pl = r->plane[n++];
+            pl[0] = pl[1] = pl[2] = 0;
+            pl[k] = (float)sg;
+            pl[3] = (float)(ax[k] * (k == 0 ? 1 : 0.9 + 0.1 * nc_rng_uniform(&s)));
+        }
+    r->nplanes = 16 + (int)(nc_rng_uniform(&s) * (NC_ROCK_PLANES - 16 + 1));
+    if (r->nplanes > NC_ROCK_PLANES)
+        r->nplanes = NC_ROCK_PLANES;
+    for (; n < r->nplanes; n++) {
+        struct nc_vec3 d = nc_rng_dir(&s);
+        double t = sqrt(ax[0] * ax[0] * d.x * d.x + ax[1] * ax[1] * d.y * d.y + ax[2] * ax[2] * d.z * d.z);
+        float *pl = r->plane[n];
+        pl[0] = (float)d.x, pl[1] = (float)d.y, pl[2] = (float)d.z;
+        pl[3] = (float)(t * (0.8 + 0.2 * nc_rng_uniform(&s)));
+    }
+    for (int k = 0; k < 3; k++) /* the farther of the two axis planes */
+        r->half[k] = fmaxf(r->plane[2 * k][3], r->plane[2 * k + 1][3]);
+}
+
+/* A uniformly random rotation (Shoemake). */
+static struct nc_quat random_rotation(uint64_t *s)
+{
+    double u1 = nc_rng_uniform(s), u2 = 2 * M_PI * nc_rng_uniform(s), u3 = 2 * M_PI * nc_rng_uniform(s);
+    double a = sqrt(1 - u1), b = sqrt(u1);
+    return (struct nc_quat){a * sin(u2), a * cos(u2), b * sin(u3), b * cos(u3)};
+}
+
+/* Half-extent along unit n of shape r rotated by q and scaled by half_m
+ * (its bounding box's support). */
+static double extent_along(const struct nc_rock_shape *r, struct nc_quat q, double half_m, struct nc_vec3 n)
+{
+    struct nc_vec3 l = nc_quat_rotate(nc_quat_conj(q), n);
+    return half_m * (fabs(l.x) * r->half[0] + fabs(l.y) * r->half[1] + fabs(l.z) * r->half[2]);
+}
+
+static int grow(struct nc_boulder_field *f, size_t *cap, size_t max_rocks)
+{
+    if (f->n < *cap)
+        return 0;
+    if (*cap >= max_rocks)
+        return nc_error(NC_ERANGE, "more than %zu boulders: raise min_diameter_m or lower the density", max_rocks);
+    size_t nc = *cap ? 2 * *cap : 4096;
+    if (nc > max_rocks)
+        nc = max_rocks;
+    struct nc_boulder *r = realloc(f->rock, nc * sizeof *r);
+    if (!r)
+        return nc_error(-ENOMEM, "out of memory for %zu boulders", nc);
+    f->rock = r;
+    *cap = nc;
+    return 0;
+}
+
+/* The rocks of octave j on face t (area_km2, unit normal nrm, corners v0-v2). */
+static int face_octave(struct nc_boulder_field *f, size_t *cap, size_t max_rocks, size_t t, int j,
+                       const double *v0, const double *v1, const double *v2, struct nc_vec3 nrm, double area_km2)
+{
+    const struct nc_boulder_params *p = &f->params;
+    double lo = exp2(j), hi = exp2(j + 1);
+    double plo = pow(lo, -p->slope), phi = pow(hi, -p->slope);
+    uint64_t s = nc_rng_seed(p->seed, (uint64_t)t, (uint64_t)(j - OCTAVE_MIN));
+    size_t k = poisson(&s, area_km2 * p->c_per_km2 * (plo - phi));
+    for (size_t i = 0; i < k; i++) {
+        /* every draw is made whatever the cut, so each rock stays the same */
+        double d = pow(plo - nc_rng_uniform(&s) * (plo - phi), -1 / p->slope);
+        double a = sqrt(nc_rng_uniform(&s)), b = nc_rng_uniform(&s);
+        double w0 = 1 - a, w1 = a * (1 - b), w2 = a * b;
+        struct nc_quat q = random_rotation(&s);
+        int shape = (int)(nc_rng_uniform(&s) * f->nshapes);
+        double burial = p->burial_min + (p->burial_max - p->burial_min) * nc_rng_uniform(&s);
+        if (d < p->d_min_m || d >= p->d_max_m)
+            continue;
+        int rc = grow(f, cap, max_rocks);
+        if (rc < 0)
+            return rc;
+        struct nc_boulder *r = &f->rock[f->n++];
+        r->half_m = (float)(d / 2);
+        r->shape = (uint16_t)(shape < f->nshapes ? shape : f->nshapes - 1);
+        r->pad = 0;
+        r->q[0] = (float)q.w, r->q[1] = (float)q.x, r->q[2] = (float)q.y, r->q[3] = (float)q.z;
+        /* the rock's float rotation, renormalised, is what the tracer uses */
+        struct nc_quat qf = {r->q[0], r->q[1], r->q[2], r->q[3]};
+        double h = (1 - 2 * burial) * extent_along(&f->shape[r->shape], qf, r->half_m, nrm);
+        for (int c = 0; c < 3; c++)
+            r->centre_m[c] = w0 * v0[c] + w1 * v1[c] + w2 * v2[c] + h * (&nrm.x)[c];
+    }
+    return 0;
+}
+
+int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params *p, size_t max_rocks,
+                         struct nc_boulder_field *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!(p->slope > 0) || !(p->c_per_km2 >= 0) || !(p->d_min_m > 0) || !(p->d_max_m > p->d_min_m) ||
+        p->shapes < 1 || p->shapes > NC_ROCK_SHAPES_MAX || !(p->burial_min >= 0) ||
+        !(p->burial_max >= p->burial_min) || !(p->burial_max <= 1))
+        return nc_error(NC_ERANGE, "boulders: need slope > 0, density >= 0, 0 < min diameter < max diameter, "
+                                   "1..%d shapes, 0 <= burial <= 1", NC_ROCK_SHAPES_MAX);
+    if (p->d_min_m < exp2(OCTAVE_MIN) || p->d_max_m > exp2(OCTAVE_MAX + 1))
+        return nc_error(NC_ERANGE, "boulders: diameters from %g to %g m", exp2(OCTAVE_MIN), exp2(OCTAVE_MAX + 1));
+    out->params = *p;
+    out->nshapes = p->shapes;
+    if (!(out->shape = calloc((size_t)p->shapes, sizeof *out->shape)))
+        return nc_error(-ENOMEM, "out of memory");
+    for (int i = 0; i < p->shapes; i++)
+        rock_shape(p->seed, i, &out->shape[i]);
+    double area_km2 = 0; /* refuse an absurd population before drawing it */
+    for (size_t t = 0; t < m->nt; t++) {
+        const double *v0 = m->v + 3 * m->tri[3 * t], *v1 = m->v + 3 * m->tri[3 * t + 1],
+                     *v2 = m->v + 3 * m->tri[3 * t + 2];
+        area_km2 += 0.5e-6 * nc_v3_norm(nc_v3_cross(nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]),
+                                                    nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2])));
+    }
+    if (nc_boulders_expected(p, area_km2) > 1.01 * (double)max_rocks) {
+        nc_boulders_free(out);
+        return nc_error(NC_ERANGE, "about %.3g boulders expected on %.4g km^2, more than %zu: raise min_diameter_m or "
+                                   "lower the density", nc_boulders_expected(p, area_km2), area_km2, max_rocks);
+    }
+    const int j0 = (int)floor(log2(p->d_min_m)), j1 = (int)floor(log2(p->d_max_m));
+    size_t cap = 0;
+    int rc = 0;
+    for (size_t t = 0; t < m->nt && rc == 0; t++) {
+        const double *v0 = m->v + 3 * m->tri[3 * t], *v1 = m->v + 3 * m->tri[3 * t + 1],
+                     *v2 = m->v + 3 * m->tri[3 * t + 2];
+        struct nc_vec3 e1 = nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]);
+        struct nc_vec3 e2 = nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]);
+        struct nc_vec3 c = nc_v3_cross(e1, e2);
+        double len = nc_v3_norm(c);
+        if (!(len > 0))
+            continue; /* a degenerate face holds no rock */
+        for (int j = j0; j <= j1 && rc == 0; j++)
+            rc = face_octave(out, &cap, max_rocks, t, j, v0, v1, v2, nc_v3_scale(c, 1 / len), 0.5 * len * 1e-6);
+    }
+    if (rc < 0) {
+        nc_boulders_free(out);
+        return rc;
+    }
+    struct nc_boulder *fit = out->n ? realloc(out->rock, out->n * sizeof *fit) : NULL;
+    if (fit)
+        out->rock = fit; /* the list at its size, not its last doubling */
+    return 0;
+}
+
+void nc_boulders_free(struct nc_boulder_field *f)
+{
+    free(f->rock);
+    free(f->shape);
+    memset(f, 0, sizeof *f);
+}

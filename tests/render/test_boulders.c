@@ -1,0 +1,230 @@
+/* test_boulders.c - boulder populations (boulders.h) and their rendering:
+ * the configured SFD slope and density recovered from the generated list,
+ * the same rocks from the same seed and a subset when the smallest
+ * diameter rises, every rock resting on its face, a rock seen where it is
+ * (a ray down onto it stops at its top, not the ground), the frame with
+ * boulders deterministic on any thread count, and the memory a million
+ * rocks take in the ray tracer. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/boulders.h"
+#include "render/rt.h"
+#include "testutil.h"
+
+/* Slope b of a power law truncated to [lo, hi] by maximum likelihood:
+ * mean ln(D/lo) = 1/b + ln(r) r^-b / (r^-b - 1)... solved by bisection on
+ * the mean of ln(D/lo), with r = hi/lo. */
+static double fit_slope(const struct nc_boulder_field *f, double lo, double hi)
+{
+    double m = 0;
+    for (size_t i = 0; i < f->n; i++)
+        m += log(2.0 * f->rock[i].half_m / lo);
+    m /= (double)f->n;
+    double L = log(hi / lo), a = 0.05, b = 10;
+    for (int it = 0; it < 200; it++) {
+        double s = 0.5 * (a + b);
+        /* E[ln(D/lo)] for density ~ D^-(s+1) on [lo, hi] */
+        double e = 1 / s - L * exp(-s * L) / (1 - exp(-s * L));
+        if (e > m)
+            a = s; /* too shallow */
+        else
+            b = s;
+    }
+    return 0.5 * (a + b);
+}
+
+static double mesh_area_km2(const struct nc_mesh *m)
+{
+    double a = 0;
+    for (size_t t = 0; t < m->nt; t++) {
+        const double *p0 = m->v + 3 * m->tri[3 * t], *p1 = m->v + 3 * m->tri[3 * t + 1], *p2 = m->v + 3 * m->tri[3 * t + 2];
+        struct nc_vec3 c = nc_v3_cross(nc_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]),
+                                       nc_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]));
+        a += 0.5 * nc_v3_norm(c);
+    }
+    return a * 1e-6;
+}
+
+static void check_population(const struct nc_mesh *m)
+{
+    const char *presets[] = {"bennu", "ryugu", "itokawa"};
+    double area = mesh_area_km2(m);
+    for (int k = 0; k < 3; k++) {
+        struct nc_boulder_params p = {.d_min_m = 0.5, .d_max_m = 200, .burial_min = 0.1, .burial_max = 0.5,
+                                      .shapes = 16, .seed = 11};
+        CHECK(nc_boulder_preset(presets[k], &p) == 0, "preset %s", presets[k]);
+        struct nc_boulder_field f;
+        CHECK(nc_boulders_generate(m, &p, 20000000, &f) == 0, "%s: %s", presets[k], nc_errmsg());
+        double want = nc_boulders_expected(&p, area), b = fit_slope(&f, p.d_min_m, p.d_max_m);
+        double density = (double)f.n / area, c = density / (pow(p.d_min_m, -p.slope) - pow(p.d_max_m, -p.slope));
+        printf("%s: %zu rocks on %.4f km^2 (expected %.0f), slope %.3f (configured %.3f), C %.4g (configured %.4g)\n",
+               presets[k], f.n, area, want, b, p.slope, c, p.c_per_km2);
+        CHECK(fabs(b / p.slope - 1) < 0.05, "%s: slope %.3f against %.3f", presets[k], b, p.slope);
+        CHECK(fabs(c / p.c_per_km2 - 1) < 0.05, "%s: density %.4g against %.4g", presets[k], c, p.c_per_km2);
+        CHECK(f.n > 10000, "%s: only %zu rocks for the fit", presets[k], f.n);
+        /* every rock within its diameter range, buried as configured, finite */
+        int bad = 0;
+        for (size_t i = 0; i < f.n; i++) {
+            double d = 2.0 * f.rock[i].half_m;
+            bad += !(d >= p.d_min_m * (1 - 1e-6) && d < p.d_max_m) || !isfinite(f.rock[i].centre_m[0]) ||
+                   f.rock[i].shape >= f.nshapes;
+        }
+        CHECK(bad == 0, "%s: %d rocks out of range", presets[k], bad);
+        nc_boulders_free(&f);
+    }
+}
+
+/* Same seed: the same bytes; a larger smallest diameter: exactly the rocks
+ * of the first list at or above it, in the same places. */
+static void check_determinism(const struct nc_mesh *m)
+{
+    struct nc_boulder_params p = {.c_per_km2 = 2e5, .slope = 2.9, .d_min_m = 0.5, .d_max_m = 64, .burial_min = 0.1,
+                                  .burial_max = 0.5, .shapes = 32, .seed = 5};
+    struct nc_boulder_field a, b, c;
+    CHECK(nc_boulders_generate(m, &p, 20000000, &a) == 0, "%s", nc_errmsg());
+    CHECK(nc_boulders_generate(m, &p, 20000000, &b) == 0, "%s", nc_errmsg());
+    CHECK(a.n == b.n && !memcmp(a.rock, b.rock, a.n * sizeof *a.rock) &&
+              !memcmp(a.shape, b.shape, (size_t)a.nshapes * sizeof *a.shape),
+          "two generations differ");
+    p.d_min_m = 3;
+    CHECK(nc_boulders_generate(m, &p, 20000000, &c) == 0, "%s", nc_errmsg());
+    size_t j = 0, big = 0;
+    for (size_t i = 0; i < a.n; i++)
+        if (2.0 * a.rock[i].half_m >= 3) {
+            big++;
+            j += j < c.n && !memcmp(&a.rock[i], &c.rock[j], sizeof *a.rock);
+        }
+    printf("subset: %zu rocks of 3 m or more in the 0.5 m list, %zu in the 3 m list, %zu identical\n", big, c.n, j);
+    CHECK(j == big && c.n == big, "the 3 m list is not the large rocks of the 0.5 m list");
+    p.seed = 6;
+    nc_boulders_free(&b);
+    CHECK(nc_boulders_generate(m, &p, 20000000, &b) == 0, "%s", nc_errmsg());
+    CHECK(b.n != c.n || memcmp(b.rock, c.rock, b.n * sizeof *b.rock), "another seed gives the same rocks");
+    /* too many rocks: an error, not the memory filled */
+    p.d_min_m = 0.5;
+    nc_boulders_free(&c);
+    CHECK(nc_boulders_generate(m, &p, 1000, &c) < 0 && nc_test_contains(nc_errmsg(), "min_diameter_m"),
+          "the rock limit: %s", nc_errmsg());
+    nc_boulders_free(&a);
+    nc_boulders_free(&b);
+}
+
+static long rss_kb(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    long v = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "VmRSS:", 6))
+            v = atol(line + 6);
+    if (f)
+        fclose(f);
+    return v;
+}
+
+static const char *scene_yaml =
+    "bodies:\n"
+    "  - shape: {type: asteroid, radii_m: [280, 230, 200], subdivisions: 5, seed: 7, craters: 30}\n"
+    "    material: {model: lambert, A: 0.1}\n"
+    "sun: {direction: [0.643, -0.766, 0.3]}\n"
+    "camera: {width_px: 256, height_px: 256, focal_length_m: 0.025, pixel_pitch_m: 2.2e-5,\n"
+    "         position_m: [0, -3000, 0], look_at_m: [0, 0, 0], up: [0, 0, 1]}\n"
+    "render: {samples_per_pixel: 4}\n";
+
+/* The frame with boulders: darker spots (shadows) and bright faces appear,
+ * the same bytes on 1 and 2 threads; a ray down onto the largest rock
+ * stops at its top. And the memory of a million rocks. */
+static void check_render(void)
+{
+    const char *sets[] = {"bodies[0].boulders={preset: bennu, min_diameter_m: 2, seed: 3}"};
+    struct nc_scene bare, rocky;
+    nc_test_scene(scene_yaml, NULL, 0, &bare);
+    nc_test_scene(scene_yaml, sets, 1, &rocky);
+    const struct nc_boulder_field *f = &rocky.body[0].boulders;
+    printf("render: %zu rocks of 2 m or more\n", f->n);
+    CHECK(f->n > 1000, "only %zu rocks", f->n);
+    struct nc_frame a, b, c;
+    nc_test_render(&bare, 2, &a);
+    nc_test_render(&rocky, 2, &b);
+    nc_test_render(&rocky, 1, &c);
+    size_t n = (size_t)b.width_px * b.height_px, differ = 0;
+    for (size_t i = 0; i < n; i++)
+        differ += a.radiance[i] != b.radiance[i];
+    CHECK(!memcmp(b.radiance, c.radiance, n * sizeof *b.radiance), "1 and 2 threads differ with boulders");
+    CHECK(differ > n / 20, "only %zu of %zu pixels changed by the rocks", differ, n);
+    int finite = 1;
+    for (size_t i = 0; i < n; i++)
+        finite &= isfinite(b.radiance[i]) && b.radiance[i] >= 0;
+    CHECK(finite, "a non-finite or negative pixel");
+    /* The largest rock: a ray from 50 m above its centre, straight down the
+     * body's radial direction, hits it above the ground. */
+    size_t big = 0;
+    for (size_t i = 1; i < f->n; i++)
+        if (f->rock[i].half_m > f->rock[big].half_m)
+            big = i;
+    const struct nc_boulder *r = &f->rock[big];
+    struct nc_vec3 c0 = nc_v3(r->centre_m[0], r->centre_m[1], r->centre_m[2]), up = nc_v3_unit(c0);
+    rocky.camera.position_m = nc_v3_add(c0, nc_v3_scale(up, 50));
+    bare.camera.position_m = rocky.camera.position_m;
+    struct nc_rt *rt_rock, *rt_bare;
+    CHECK(nc_rt_create(&rocky, 1, &rt_rock) == 0 && nc_rt_create(&bare, 1, &rt_bare) == 0, "%s", nc_errmsg());
+    struct nc_ray16 ray = {0};
+    for (int i = 0; i < NC_PACKET; i++) {
+        ray.dx[i] = (float)-up.x, ray.dy[i] = (float)-up.y, ray.dz[i] = (float)-up.z;
+        ray.tfar[i] = 1e4f;
+        ray.valid[i] = i == 0 ? -1 : 0;
+    }
+    struct nc_hit16 h1, h2;
+    nc_rt_intersect16(rt_rock, &ray, &h1, 0);
+    nc_rt_intersect16(rt_bare, &ray, &h2, 0);
+    printf("rock %zu: %.2f m across; the ray down stops %.2f m above the ground\n", big, 2.0 * r->half_m,
+           h2.t[0] - h1.t[0]);
+    CHECK(h1.body[0] == 0 && h2.body[0] == 0 && h1.t[0] < h2.t[0] - 0.1 * r->half_m && h1.t[0] > 50 - 2.0 * r->half_m,
+          "the ray meets the rock at %g m, the ground at %g m", h1.t[0], h2.t[0]);
+    nc_rt_destroy(rt_rock);
+    nc_rt_destroy(rt_bare);
+    nc_frame_free(&a);
+    nc_frame_free(&b);
+    nc_frame_free(&c);
+    nc_scene_free(&rocky);
+
+    /* A million rocks: the ray tracer's memory beyond the bare body. */
+    /* The scene and tracer with rocks, less the tracer of the bare body
+     * (kept alive, so that no freed memory is reused): the list, its
+     * generation and the tracer's tree, as resident memory. */
+    const char *many[] = {"bodies[0].boulders={preset: bennu, min_diameter_m: 0.45, seed: 3}"};
+    long r0 = rss_kb();
+    CHECK(nc_rt_create(&bare, 1, &rt_bare) == 0, "%s", nc_errmsg());
+    long r1 = rss_kb();
+    nc_test_scene(scene_yaml, many, 1, &rocky);
+    size_t nrock = rocky.body[0].boulders.n;
+    CHECK(nc_rt_create(&rocky, 1, &rt_rock) == 0, "%s", nc_errmsg());
+    long r2 = rss_kb();
+    double mb = ((r2 - r1) - (r1 - r0)) / 1024.0, list = nrock * sizeof(struct nc_boulder) / 1048576.0;
+    printf("memory: %zu rocks take %.1f MB beyond the bare body (their list %.1f MB)\n", nrock, mb, list);
+    CHECK(mb > list, "%.1f MB measured, less than the list itself", mb);
+    CHECK(nrock >= 1000000, "only %zu rocks", nrock);
+#ifndef __SANITIZE_ADDRESS__ /* AddressSanitizer's red zones and shadow are not NavCam's memory */
+    CHECK(mb < 200, "%.1f MB for %zu rocks", mb, nrock);
+#endif
+    nc_rt_destroy(rt_rock);
+    nc_rt_destroy(rt_bare);
+    nc_scene_free(&rocky);
+    nc_scene_free(&bare);
+}
+
+int main(void)
+{
+    struct nc_asteroid_params p = {.radii_m = {280, 230, 200}, .subdivisions = 5, .seed = 3, .craters = 40,
+                                   .lump_amplitude = 0.1};
+    struct nc_mesh m;
+    CHECK(nc_mesh_asteroid(&p, &m) == 0, "asteroid: %s", nc_errmsg());
+    check_population(&m);
+    check_determinism(&m);
+    nc_mesh_free(&m);
+    check_render();
+    return nc_test_end();
+}
