@@ -90,7 +90,9 @@ void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct
         }
         if (n < (int)w)
             memset(o + (size_t)n * bpp, 0, (size_t)((int)w - n) * bpp);
-        if (done && (y % 16 == 15 || y == (int)h - 1))
+        if (done && y % 16 == 15)
             atomic_store_explicit(done, (size_t)(y + 1) * w * bpp, memory_order_release);
     }
+    if (done) /* all, even when the metadata row is the whole image */
+        atomic_store_explicit(done, (size_t)h * w * bpp, memory_order_release);
 }
