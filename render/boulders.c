@@ -102,12 +102,19 @@ static struct nc_quat random_rotation(uint64_t *s)
     return (struct nc_quat){a * sin(u2), a * cos(u2), b * sin(u3), b * cos(u3)};
 }
 
-/* Half-extent along unit n of shape r rotated by q and scaled by half_m
- * (its bounding box's support). */
-static double extent_along(const struct nc_rock_shape *r, struct nc_quat q, double half_m, struct nc_vec3 n)
+/* How far below its centre shape r, rotated by q and scaled by half_m,
+ * reaches along -n (n unit): the nearest plane crossed going down. */
+static double depth_below(const struct nc_rock_shape *r, struct nc_quat q, double half_m, struct nc_vec3 n)
 {
     struct nc_vec3 l = nc_quat_rotate(nc_quat_conj(q), n);
-    return half_m * (fabs(l.x) * r->half[0] + fabs(l.y) * r->half[1] + fabs(l.z) * r->half[2]);
+    double t = INFINITY;
+    for (int k = 0; k < r->nplanes; k++) {
+        const float *p = r->plane[k];
+        double down = -(p[0] * l.x + p[1] * l.y + p[2] * l.z);
+        if (down > 0)
+            t = fmin(t, p[3] / down);
+    }
+    return half_m * (isfinite(t) ? t : 0);
 }
 
 static int grow(struct nc_boulder_field *f, size_t *cap, size_t max_rocks)
@@ -156,7 +163,10 @@ static int face_octave(struct nc_boulder_field *f, size_t *cap, size_t max_rocks
         r->q[0] = (float)q.w, r->q[1] = (float)q.x, r->q[2] = (float)q.y, r->q[3] = (float)q.z;
         /* the rock's float rotation, renormalised, is what the tracer uses */
         struct nc_quat qf = {r->q[0], r->q[1], r->q[2], r->q[3]};
-        double h = (1 - 2 * burial) * extent_along(&f->shape[r->shape], qf, r->half_m, nrm);
+        double qn = nc_quat_norm(qf);
+        qf = (struct nc_quat){qf.w / qn, qf.x / qn, qf.y / qn, qf.z / qn};
+        /* the point under the centre sits (1 - 2 burial) of the way down: 0 rests on the face */
+        double h = (1 - 2 * burial) * depth_below(&f->shape[r->shape], qf, r->half_m, nrm);
         for (int c = 0; c < 3; c++)
             r->centre_m[c] = w0 * v0[c] + w1 * v1[c] + w2 * v2[c] + h * (&nrm.x)[c];
     }
