@@ -120,9 +120,8 @@ static double ell_hit(const struct rt_body *b, const float o[3], const float d[3
 static void ell_intersect(const struct RTCIntersectFunctionNArguments *a)
 {
     const struct rt_body *b = a->geometryUserPtr;
-    float *ray = (float *)a->rayhit;
+    const float *ray = (const float *)a->rayhit;
     unsigned N = a->N;
-    float *hit = ray + 12 * N;
     for (unsigned i = 0; i < N; i++) {
         if (a->valid[i] != -1)
             continue;
@@ -131,16 +130,12 @@ static void ell_intersect(const struct RTCIntersectFunctionNArguments *a)
         double t = ell_hit(b, o, d, ray[3 * N + i], ray[8 * N + i]);
         if (!(t < INFINITY))
             continue;
-        ray[8 * N + i] = (float)t;
+        float n[3];
         for (int k = 0; k < 3; k++) {
             double p = (double)o[k] + t * (double)d[k] - b->centre[k];
-            hit[k * N + i] = (float)(p / (b->radii[k] * b->radii[k]));
+            n[k] = (float)(p / (b->radii[k] * b->radii[k]));
         }
-        hit[3 * N + i] = 0;
-        hit[4 * N + i] = 0;
-        ((unsigned *)hit)[5 * N + i] = a->primID;
-        ((unsigned *)hit)[6 * N + i] = a->geomID;
-        ((unsigned *)hit)[7 * N + i] = a->context->instID[0];
+        nc__rt_user_hit(a, i, (float)t, n);
     }
 }
 

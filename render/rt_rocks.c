@@ -91,25 +91,16 @@ static int rock_hit(const struct nc__rt_rocks *r, unsigned i, const float o[3], 
 static void rock_intersect(const struct RTCIntersectFunctionNArguments *a)
 {
     const struct nc__rt_rocks *r = a->geometryUserPtr;
-    float *ray = (float *)a->rayhit;
+    const float *ray = (const float *)a->rayhit;
     unsigned N = a->N;
-    float *hit = ray + 12 * N;
     for (unsigned i = 0; i < N; i++) {
         if (a->valid[i] != -1)
             continue;
         float o[3] = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]};
         float d[3] = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]};
         float t, n[3];
-        if (!rock_hit(r, a->primID, o, d, ray[3 * N + i], ray[8 * N + i], &t, n))
-            continue;
-        ray[8 * N + i] = t;
-        for (int k = 0; k < 3; k++)
-            hit[k * N + i] = n[k];
-        hit[3 * N + i] = 0;
-        hit[4 * N + i] = 0;
-        ((unsigned *)hit)[5 * N + i] = a->primID;
-        ((unsigned *)hit)[6 * N + i] = a->geomID;
-        ((unsigned *)hit)[7 * N + i] = a->context->instID[0];
+        if (rock_hit(r, a->primID, o, d, ray[3 * N + i], ray[8 * N + i], &t, n))
+            nc__rt_user_hit(a, i, t, n);
     }
 }
 
