@@ -211,11 +211,12 @@ int main(int argc, char **argv)
     if (rc >= 0)
         rc = nc_render_exposure(&r, &drawn, &ex, &f, &tsamples);
     double t2 = now_ms(), scale = 0;
-    /* Levels of detail: the error bound of those used (0: full meshes). */
-    char lod[40];
+    /* Levels of detail and the smallest boulder traced (0: every rock). */
+    char lod[40], rocks[40];
     snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r.rt));
-    struct nc_image_attr extra[2] = {{"navcam:lod_error_m", lod}, {0}};
-    int nextra = 1;
+    snprintf(rocks, sizeof rocks, "%.17g", nc_rt_boulder_min_m(r.rt));
+    struct nc_image_attr extra[3] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}};
+    int nextra = 2;
     if (rows)
         extra[nextra++] = row_attr;
     if (rc >= 0 && q <= NC_Q_RANGE)
@@ -230,6 +231,13 @@ int main(int argc, char **argv)
         if (scene.render.lod_error_px > 0)
             printf("  levels of detail: surface error bound %.3g m (render.lod_error_px %g)\n", nc_rt_lod_error_m(r.rt),
                    scene.render.lod_error_px);
+        struct nc_rt_stats st;
+        nc_rt_get_stats(r.rt, &st);
+        for (int i = 0; i < scene.nbodies; i++)
+            if (scene.body[i].boulders.n)
+                printf("  boulders of '%s': %zu of %zu traced, %.3g m and larger (render.boulder_min_px %g)\n",
+                       scene.body[i].name, st.boulders_traced[i], scene.body[i].boulders.n, st.boulder_min_m[i],
+                       scene.render.boulder_min_px);
         if (scale > 0)
             printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));
     }

@@ -29,6 +29,7 @@ struct nc_frame_record {
     double exposure_s, gain_db;
     int time_samples;            /* motion-smear time samples */
     double lod_error_m;          /* error bound of the meshes' levels of detail used, m (0: full meshes) */
+    double boulder_min_m;        /* smallest boulder diameter traced, m (0: every rock, or none) */
     double render_ms, camera_ms; /* render (incl. smear) and camera model time */
     int width_px, height_px, adc_bits;
     const uint16_t *dn;          /* the digitised frame */

@@ -11,8 +11,8 @@
 
 /* Stream tags, so that shapes and faces never share a stream. */
 #define TAG_SHAPE 0x5348415045ull
-#define OCTAVE_MIN (-20) /* 1 um: below anything a camera resolves */
-#define OCTAVE_MAX 20    /* 1 km */
+#define OCTAVE_MIN NC_BOULDER_OCTAVE_MIN
+#define OCTAVE_MAX NC_BOULDER_OCTAVE_MAX
 
 int nc_boulder_preset(const char *name, struct nc_boulder_params *p)
 {
@@ -74,11 +74,11 @@ static void rock_shape(uint64_t seed, int i, struct nc_rock_shape *r)
     ax[2] = fmin(ax[1], 0.5 * (0.8 + 0.4 * nc_rng_uniform(&s)));
     int n = 0;
     for (int k = 0; k < 3; k++)
-        for (int sg = -1; sg <= 1; sg += 2) {
-            float *pl = r->plane[n++];
-            pl[0] = pl[1] = pl[2] = 0;
-            pl[k] = (float)sg;
-            pl[3] = (float)(ax[k] * (k == 0 ? 1 : 0.9 + 0.1 * nc_rng_uniform(&s)));
+        for (int sg = -1; sg <= 1; sg += 2, n++) {
+            r->nx[n] = k == 0 ? (float)sg : 0;
+            r->ny[n] = k == 1 ? (float)sg : 0;
+            r->nz[n] = k == 2 ? (float)sg : 0;
+            r->d[n] = (float)(ax[k] * (k == 0 ? 1 : 0.9 + 0.1 * nc_rng_uniform(&s)));
         }
     r->nplanes = 16 + (int)(nc_rng_uniform(&s) * (NC_ROCK_PLANES - 16 + 1));
     if (r->nplanes > NC_ROCK_PLANES)
@@ -86,12 +86,13 @@ static void rock_shape(uint64_t seed, int i, struct nc_rock_shape *r)
     for (; n < r->nplanes; n++) {
         struct nc_vec3 d = nc_rng_dir(&s);
         double t = sqrt(ax[0] * ax[0] * d.x * d.x + ax[1] * ax[1] * d.y * d.y + ax[2] * ax[2] * d.z * d.z);
-        float *pl = r->plane[n];
-        pl[0] = (float)d.x, pl[1] = (float)d.y, pl[2] = (float)d.z;
-        pl[3] = (float)(t * (0.8 + 0.2 * nc_rng_uniform(&s)));
+        r->nx[n] = (float)d.x, r->ny[n] = (float)d.y, r->nz[n] = (float)d.z;
+        r->d[n] = (float)(t * (0.8 + 0.2 * nc_rng_uniform(&s)));
     }
+    for (; n < NC_ROCK_PLANES; n++) /* padding: plane 0 again */
+        r->nx[n] = r->nx[0], r->ny[n] = r->ny[0], r->nz[n] = r->nz[0], r->d[n] = r->d[0];
     for (int k = 0; k < 3; k++) /* the farther of the two axis planes */
-        r->half[k] = fmaxf(r->plane[2 * k][3], r->plane[2 * k + 1][3]);
+        r->half[k] = fmaxf(r->d[2 * k], r->d[2 * k + 1]);
 }
 
 /* A uniformly random rotation (Shoemake). */
@@ -109,10 +110,9 @@ static double depth_below(const struct nc_rock_shape *r, struct nc_quat q, doubl
     struct nc_vec3 l = nc_quat_rotate(nc_quat_conj(q), n);
     double t = INFINITY;
     for (int k = 0; k < r->nplanes; k++) {
-        const float *p = r->plane[k];
-        double down = -(p[0] * l.x + p[1] * l.y + p[2] * l.z);
+        double down = -(r->nx[k] * l.x + r->ny[k] * l.y + r->nz[k] * l.z);
         if (down > 0)
-            t = fmin(t, p[3] / down);
+            t = fmin(t, r->d[k] / down);
     }
     return half_m * (isfinite(t) ? t : 0);
 }
@@ -173,6 +173,38 @@ static int face_octave(struct nc_boulder_field *f, size_t *cap, size_t max_rocks
     return 0;
 }
 
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Rocks r[0 .. n) largest first, equal sizes in the order drawn. */
+static int sort_octave(struct nc_boulder *r, size_t n)
+{
+    if (n > UINT32_MAX)
+        return nc_error(NC_ERANGE, "more than %lu boulders in one octave", (unsigned long)UINT32_MAX);
+    uint64_t *key = malloc(n * sizeof *key);
+    struct nc_boulder *copy = malloc(n * sizeof *copy);
+    if (!key || !copy) {
+        free(key);
+        free(copy);
+        return nc_error(-ENOMEM, "out of memory sorting %zu boulders", n);
+    }
+    for (size_t i = 0; i < n; i++) {
+        uint32_t bits; /* a positive float's bits order as its value */
+        memcpy(&bits, &r[i].half_m, sizeof bits);
+        key[i] = (uint64_t)(UINT32_MAX - bits) << 32 | (uint64_t)i;
+    }
+    qsort(key, n, sizeof *key, cmp_u64);
+    memcpy(copy, r, n * sizeof *r);
+    for (size_t i = 0; i < n; i++)
+        r[i] = copy[key[i] & UINT32_MAX];
+    free(key);
+    free(copy);
+    return 0;
+}
+
 int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params *p, size_t max_rocks,
                          struct nc_boulder_field *out)
 {
@@ -205,17 +237,22 @@ int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params
     const int j0 = (int)floor(log2(p->d_min_m)), j1 = (int)floor(log2(p->d_max_m));
     size_t cap = 0;
     int rc = 0;
-    for (size_t t = 0; t < m->nt && rc == 0; t++) {
-        const double *v0 = m->v + 3 * m->tri[3 * t], *v1 = m->v + 3 * m->tri[3 * t + 1],
-                     *v2 = m->v + 3 * m->tri[3 * t + 2];
-        struct nc_vec3 e1 = nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]);
-        struct nc_vec3 e2 = nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]);
-        struct nc_vec3 c = nc_v3_cross(e1, e2);
-        double len = nc_v3_norm(c);
-        if (!(len > 0))
-            continue; /* a degenerate face holds no rock */
-        for (int j = j0; j <= j1 && rc == 0; j++)
-            rc = face_octave(out, &cap, max_rocks, t, j, v0, v1, v2, nc_v3_scale(c, 1 / len), 0.5 * len * 1e-6);
+    for (int j = j1; j >= j0 && rc == 0; j--) { /* the largest octave first */
+        size_t first = out->n;
+        for (size_t t = 0; t < m->nt && rc == 0; t++) {
+            const double *v0 = m->v + 3 * m->tri[3 * t], *v1 = m->v + 3 * m->tri[3 * t + 1],
+                         *v2 = m->v + 3 * m->tri[3 * t + 2];
+            struct nc_vec3 e1 = nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]);
+            struct nc_vec3 e2 = nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]);
+            struct nc_vec3 c = nc_v3_cross(e1, e2);
+            double len = nc_v3_norm(c);
+            if (len > 0) /* a degenerate face holds no rock */
+                rc = face_octave(out, &cap, max_rocks, t, j, v0, v1, v2, nc_v3_scale(c, 1 / len), 0.5 * len * 1e-6);
+        }
+        if (rc == 0 && out->n > first) {
+            rc = sort_octave(out->rock + first, out->n - first);
+            out->octave[out->noctaves++] = (struct nc_boulder_octave){.j = j, .first = first, .n = out->n - first};
+        }
     }
     if (rc < 0) {
         nc_boulders_free(out);
@@ -225,6 +262,32 @@ int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params
     if (fit)
         out->rock = fit; /* the list at its size, not its last doubling */
     return 0;
+}
+
+size_t nc_boulders_at_least(const struct nc_boulder_field *f, double d_m)
+{
+    size_t lo = 0, hi = f->n; /* the list is sorted by size, largest first */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (2.0 * f->rock[mid].half_m >= d_m)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+double nc_boulders_bounding_radius(const struct nc_boulder_field *f)
+{
+    double r = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        const struct nc_boulder *b = &f->rock[i];
+        const float *h = f->shape[b->shape].half;
+        double c = sqrt(b->centre_m[0] * b->centre_m[0] + b->centre_m[1] * b->centre_m[1] +
+                        b->centre_m[2] * b->centre_m[2]);
+        r = fmax(r, c + b->half_m * sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]));
+    }
+    return r;
 }
 
 void nc_boulders_free(struct nc_boulder_field *f)

@@ -24,13 +24,20 @@
 #define NC_ROCK_SHAPES_MAX 256
 
 /* A rock in its own frame, in units of half its longest dimension: the
- * points x with n . x <= d for every plane (n unit), inside the box of
- * half-extents half (half[0] = 1, the longest). */
+ * points x with n . x <= d for every plane k (n = (nx[k], ny[k], nz[k])
+ * unit), inside the box of half-extents half (half[0] = 1, the longest).
+ * Planes are stored by component, and every slot from nplanes on repeats
+ * plane 0, so that a loop may run over all NC_ROCK_PLANES. */
 struct nc_rock_shape {
-    float plane[NC_ROCK_PLANES][4]; /* nx, ny, nz, d */
+    float nx[NC_ROCK_PLANES], ny[NC_ROCK_PLANES], nz[NC_ROCK_PLANES], d[NC_ROCK_PLANES];
     float half[3];
     int nplanes;
 };
+
+/* Octaves of diameter [2^j, 2^(j+1)) m that a population may use. */
+#define NC_BOULDER_OCTAVE_MIN (-20) /* 1 um: below anything a camera resolves */
+#define NC_BOULDER_OCTAVE_MAX 20    /* 1 km */
+#define NC_BOULDER_OCTAVES (NC_BOULDER_OCTAVE_MAX - NC_BOULDER_OCTAVE_MIN + 1)
 
 /* 48 bytes a rock: a million cost 46 MiB here (plus the ray tracer's tree). */
 struct nc_boulder {
@@ -50,9 +57,20 @@ struct nc_boulder_params {
     uint64_t seed;
 };
 
+/* The rocks of one octave: rock[first .. first + n), largest first. */
+struct nc_boulder_octave {
+    int j;
+    size_t first, n;
+};
+
+/* The list runs from the largest octave to the smallest and, within each,
+ * from the largest rock to the smallest (ties in the order drawn): the
+ * rocks of diameter D or more are always a prefix. */
 struct nc_boulder_field {
     struct nc_boulder *rock;
     size_t n;
+    struct nc_boulder_octave octave[NC_BOULDER_OCTAVES];
+    int noctaves;
     struct nc_rock_shape *shape;
     int nshapes;
     struct nc_boulder_params params;
@@ -67,6 +85,11 @@ int nc_boulder_preset(const char *name, struct nc_boulder_params *p);
  * diameter does not fill the memory. */
 int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params *p, size_t max_rocks,
                          struct nc_boulder_field *out);
+/* How many rocks have a diameter of at least d_m (a prefix of the list). */
+size_t nc_boulders_at_least(const struct nc_boulder_field *f, double d_m);
+/* The radius of the sphere about the body origin that holds every rock
+ * (0 for none). */
+double nc_boulders_bounding_radius(const struct nc_boulder_field *f);
 /* The expected number of rocks on area_km2 of surface. */
 double nc_boulders_expected(const struct nc_boulder_params *p, double area_km2);
 void nc_boulders_free(struct nc_boulder_field *f);

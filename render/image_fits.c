@@ -54,6 +54,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:preview_rule", "PRVRULE"},
     {"navcam:fits_row_order", "ROWORDER"},
     {"navcam:lod_error_m", "LODERR"},
+    {"navcam:boulder_min_m", "ROCKMIN"},
 };
 
 /* 1 when attrs ask for the archive row order (row 1 at the bottom). */

@@ -37,6 +37,10 @@ struct nc_rt_stats {
     int lod_level[NC_MAX_BODIES];
     size_t lod_triangles[NC_MAX_BODIES];
     double lod_error_m[NC_MAX_BODIES];
+    /* Per body with boulders, at the last update: the smallest diameter
+     * traced, m (0: every rock), and how many rocks that leaves. */
+    double boulder_min_m[NC_MAX_BODIES];
+    size_t boulders_traced[NC_MAX_BODIES];
     /* Since creation, as the renderer reports them (nc_rt_count_shadow_rays):
      * shadow rays proven unoccluded (nc_rt_shadow_cull16), and traced. */
     unsigned long shadow_rays_culled, shadow_rays_traced;
@@ -68,6 +72,9 @@ void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
 /* The largest error bound of the levels of detail shown at the last update,
  * metres (0: every body at full resolution). */
 double nc_rt_lod_error_m(const struct nc_rt *rt);
+/* The largest of the bodies' smallest boulder diameters traced at the last
+ * update, metres (0: every rock of every body, or no boulders). */
+double nc_rt_boulder_min_m(const struct nc_rt *rt);
 
 /* For benchmarks: Embree alone on pre-built native packets. The packets are
  * converted once (untimed); nc_rt_batch_trace() then only resets each packet

@@ -35,9 +35,11 @@ struct rt_body {
     float *verts; /* anchor-relative vertices of every level, padded for Embree's 16-byte loads */
     unsigned inst_id;
     RTCGeometry inst;
-    /* boulders (rt_rocks.h), in every level's scene */
+    /* boulders (rt_rocks.h): a scene of their own, instanced with the
+     * body's transform, placed at the anchor generation rocks_fitted */
     struct nc__rt_rocks rocks;
-    RTCGeometry rock_geom;
+    RTCGeometry rock_inst;
+    unsigned rock_inst_id, rocks_fitted;
     int analytic;
     /* Shadow-ray culling (shadow_grid.h): which levels are closed outward
      * surfaces, and the grid of the level shown (body frame, body origin). */
@@ -64,7 +66,8 @@ struct nc_rt {
     RTCScene top;
     struct rt_body body[NC_MAX_BODIES];
     int nbodies;
-    unsigned geom_to_body[NC_MAX_BODIES];
+    unsigned geom_to_body[2 * NC_MAX_BODIES]; /* instance ID -> body (the body's, its rocks') */
+    unsigned ninst;
     struct nc_rt_stats stats;
     atomic_ulong shadow_culled, shadow_traced;
 };
@@ -185,8 +188,9 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
  * level worth having. */
 #define LOD_MIN_TRIANGLES 4096
 
-static int body_init(struct nc_rt *rt, struct rt_body *b, const struct nc_body *src, double lod_error_px)
+static int body_init(struct nc_rt *rt, unsigned index, const struct nc_body *src, double lod_error_px)
 {
+    struct rt_body *b = &rt->body[index];
     b->src = src;
     b->grid_level = -1;
     int rc = 0;
@@ -219,18 +223,22 @@ static int body_init(struct nc_rt *rt, struct rt_body *b, const struct nc_body *
         if (rc < 0)
             return rc;
         if (src->boulders.n) { /* rocks shadow the body: no grid proves a point lit */
-            b->rocks = (struct nc__rt_rocks){&src->boulders, &b->anchor_m};
-            if (!(b->rock_geom = nc__rt_rocks_geometry(rt->dev, &b->rocks)))
-                return nc_error(NC_ERENDER, "embree: cannot create the boulders of '%s'", src->name);
-            for (int k = 0; k < b->nlevels; k++) {
-                rtcAttachGeometry(b->scene[k], b->rock_geom);
+            if ((rc = nc__rt_rocks_init(rt->dev, &src->boulders, &b->anchor_m, &b->rocks)) < 0)
+                return rc;
+            for (int k = 0; k < b->nlevels; k++)
                 b->closed[k] = 0;
-            }
+            b->rock_inst = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(b->rock_inst, b->rocks.scene);
+            b->rock_inst_id = rtcAttachGeometry(rt->top, b->rock_inst);
+            rt->geom_to_body[b->rock_inst_id] = index;
+            rt->ninst = b->rock_inst_id + 1 > rt->ninst ? b->rock_inst_id + 1 : rt->ninst;
         }
     }
     b->inst = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(b->inst, b->scene[0]);
     b->inst_id = rtcAttachGeometry(rt->top, b->inst);
+    rt->geom_to_body[b->inst_id] = index;
+    rt->ninst = b->inst_id + 1 > rt->ninst ? b->inst_id + 1 : rt->ninst;
     return rt_check(rt->dev, "creating geometry");
 }
 
@@ -243,8 +251,6 @@ static void fit_level(struct rt_body *b, int k)
     if (!b->analytic)
         rtcUpdateGeometryBuffer(b->geom[k], RTC_BUFFER_TYPE_VERTEX, 0);
     rtcCommitGeometry(b->geom[k]);
-    if (b->rock_geom)
-        rtcCommitGeometry(b->rock_geom); /* their bounds move with the anchor */
     rtcCommitScene(b->scene[k]);
     b->fitted[k] = b->anchor_gen;
 }
@@ -265,9 +271,8 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
     rtcSetSceneBuildQuality(rt->top, RTC_BUILD_QUALITY_LOW);
     int rc = 0;
     for (int i = 0; i < s->nbodies && rc == 0; i++) {
-        rc = body_init(rt, &rt->body[i], &s->body[i], s->render.lod_error_px);
+        rc = body_init(rt, (unsigned)i, &s->body[i], s->render.lod_error_px);
         rt->nbodies = i + 1;
-        rt->geom_to_body[rt->body[i].inst_id] = (unsigned)i;
     }
     if (rc == 0)
         rc = nc_rt_update(rt, s);
@@ -391,10 +396,9 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
          * render.lod_error_px pixels at the nearest possible range (the
          * bounding sphere; the finest pixel axis). A function of the pose. */
         int k = 0;
-        if (b->nlevels > 1 && dmin > 0) {
-            double px_m = dmin / fmax(s->camera.fx_px, s->camera.fy_px);
+        const double px_m = dmin > 0 ? dmin / fmax(s->camera.fx_px, s->camera.fy_px) : 0;
+        if (b->nlevels > 1 && dmin > 0)
             k = nc_mesh_lod_pick_error(b->error_m, b->nlevels, s->render.lod_error_px * px_m);
-        }
         fit_level(b, k);
         if (k != b->level) {
             rtcSetGeometryInstancedScene(b->inst, b->scene[k]);
@@ -418,6 +422,18 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
         b->cull_radius_m = src->bounding_radius_m * (1 + 1e-5) + 1e-5 * nc_v3_norm(b->origin_rel);
         rtcSetGeometryTransform(b->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(b->inst);
+        if (b->rock_inst) {
+            /* Boulders: those spanning render.boulder_min_px pixels at the
+             * nearest possible range (every one from inside the bounding
+             * sphere), like the level of detail a function of the pose. */
+            nc__rt_rocks_cut(&b->rocks, s->render.boulder_min_px * px_m);
+            nc__rt_rocks_commit(&b->rocks, b->rocks_fitted != b->anchor_gen);
+            b->rocks_fitted = b->anchor_gen;
+            rtcSetGeometryTransform(b->rock_inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+            rtcCommitGeometry(b->rock_inst);
+            rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
+            rt->stats.boulders_traced[i] = b->rocks.traced;
+        }
         if ((rc = update_grid(b, s)) < 0)
             return rc;
     }
@@ -459,7 +475,7 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
     rtcIntersect16(ray->valid, rt->top, &ctx, &rh);
     for (int i = 0; i < NC_PACKET; i++) {
         unsigned inst = rh.hit.instID[0][i];
-        if (!ray->valid[i] || rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID || inst >= (unsigned)rt->nbodies) {
+        if (!ray->valid[i] || rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID || inst >= rt->ninst) {
             hit->body[i] = -1;
             continue;
         }
@@ -596,6 +612,14 @@ double nc_rt_lod_error_m(const struct nc_rt *rt)
     return e;
 }
 
+double nc_rt_boulder_min_m(const struct nc_rt *rt)
+{
+    double d = 0;
+    for (int i = 0; i < rt->nbodies; i++)
+        d = fmax(d, rt->stats.boulder_min_m[i]);
+    return d;
+}
+
 /* ---- raw batches (benchmarks) --------------------------------------------- */
 
 struct nc_rt_batch {
@@ -728,8 +752,9 @@ void nc_rt_destroy(struct nc_rt *rt)
         struct rt_body *b = &rt->body[i];
         if (b->inst)
             rtcReleaseGeometry(b->inst);
-        if (b->rock_geom)
-            rtcReleaseGeometry(b->rock_geom);
+        if (b->rock_inst)
+            rtcReleaseGeometry(b->rock_inst);
+        nc__rt_rocks_free(&b->rocks);
         for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
             if (b->geom[k])
                 rtcReleaseGeometry(b->geom[k]);

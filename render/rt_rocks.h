@@ -1,8 +1,12 @@
-/* rt_rocks.h - boulders (boulders.h) as one Embree user geometry per body:
- * each rock a primitive that refers to its shared shape, 48 bytes plus the
- * tree's share, where an Embree instance costs about 390 bytes (measured
- * with Embree 3.13: a million instances take 368 MiB). Internal to the
- * Embree back-end (rt_embree.c). */
+/* rt_rocks.h - boulders (boulders.h) for the Embree back-end: a scene per
+ * body of its own, instanced with the body's transform, holding one user
+ * geometry per octave of diameter. Each rock is a primitive that refers to
+ * its shared shape: 48 bytes in the list, 64 here, plus the tree's share,
+ * where an Embree instance costs about 390 bytes (measured with Embree
+ * 3.13: a million instances take 368 MiB). Rocks smaller than a
+ * cut are not traced: octaves wholly below it are disabled, and the rest of
+ * the boulders below it are refused in the intersection test. Internal to
+ * the Embree back-end (rt_embree.c). */
 #ifndef NC_RT_ROCKS_H
 #define NC_RT_ROCKS_H
 
@@ -11,9 +15,35 @@
 #include "core/vec.h"
 #include "render/boulders.h"
 
+struct nc__rt_rocks;
+
+struct nc__rt_rock_octave {
+    struct nc__rt_rocks *rocks;
+    size_t first; /* its first rock in the list */
+    RTCGeometry geom;
+    int enabled;
+};
+
+/* What the intersection test reads of a rock: one cache line. */
+struct nc__rt_rock {
+    float c[3];   /* centre relative to the anchor, body frame, m */
+    float M[9];   /* body frame -> rock frame over half_m: R^T / half_m, row-major */
+    float ext[3]; /* the rock's extent from c along each body axis, m */
+    uint32_t shape;
+};
+
+_Static_assert(sizeof(struct nc__rt_rock) == 64, "a rock record is one cache line");
+
 struct nc__rt_rocks {
     const struct nc_boulder_field *field;
     const struct nc_vec3 *anchor_m; /* the body's anchor (body frame): geometry is relative to it */
+    struct nc__rt_rock *rock;       /* field->rock[i] as traced */
+    RTCScene scene;
+    struct nc__rt_rock_octave octave[NC_BOULDER_OCTAVES];
+    int noctaves;
+    double min_d_m; /* the cut: the smallest diameter traced */
+    size_t traced;  /* rocks at or above the cut: rock[0 .. traced) */
+    int dirty;        /* the scene needs a commit */
 };
 
 /* A user geometry's hit for lane i of a's packet: tfar = t, geometric
@@ -34,7 +64,15 @@ static inline void nc__rt_user_hit(const struct RTCIntersectFunctionNArguments *
     ((unsigned *)hit)[7 * N + i] = a->context->instID[0];
 }
 
-/* The user geometry of r's rocks, committed; NULL if Embree refused. */
-RTCGeometry nc__rt_rocks_geometry(RTCDevice dev, struct nc__rt_rocks *r);
+/* The rock scene of field f, rocks relative to *anchor_m, every rock traced
+ * until the first nc__rt_rocks_cut. Not committed: nc__rt_rocks_commit. */
+int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, const struct nc_vec3 *anchor_m,
+                      struct nc__rt_rocks *r);
+/* Trace rocks of diameter min_d_m or more only (0: all). */
+void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m);
+/* Move the rocks to the anchor (moved: after a re-anchor) and, if that or a
+ * cut changed the scene, commit it (a rebuild of its tree). */
+void nc__rt_rocks_commit(struct nc__rt_rocks *r, int moved);
+void nc__rt_rocks_free(struct nc__rt_rocks *r);
 
 #endif

@@ -208,6 +208,8 @@ static int nc_boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
         snprintf(why, sizeof why, "%s", nc_errmsg());
         return nc_cfg_error(map, "%s", why);
     }
+    /* rocks standing out past the mesh's farthest vertex widen the body */
+    b->bounding_radius_m = fmax(b->bounding_radius_m, nc_boulders_bounding_radius(&b->boulders));
     nc_log_info("scene", "body '%s': %zu boulders of %g to %g m (N(>1 m) = %.4g per km^2, slope %g, seed %llu)",
                 b->name, b->boulders.n, p.d_min_m, p.d_max_m, p.c_per_km2, p.slope, (unsigned long long)p.seed);
     return 0;
@@ -290,6 +292,7 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     r->seed = 0;
     r->threads = 0;
     r->lod_error_px = 0;
+    r->boulder_min_px = 0;
     if (!map)
         return 0;
     if ((rc = nc_cfg_int(map, "samples_per_pixel", 1, 1024, &v)) < 0)
@@ -310,6 +313,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     if (rc)
         r->threads = (int)v;
     if ((rc = nc_cfg_double(map, "lod_error_px", 0, 100, &r->lod_error_px)) < 0)
+        return rc;
+    if ((rc = nc_cfg_double(map, "boulder_min_px", 0, 1000, &r->boulder_min_px)) < 0)
         return rc;
     return 0;
 }

@@ -53,6 +53,10 @@ struct nc_render_settings {
     /* Meshes: the coarsest level of detail whose surface error is at most
      * this many pixels at the body's nearest range; 0 = always the full mesh. */
     double lod_error_px;
+    /* Boulders: only rocks whose longest dimension spans at least this many
+     * pixels at the body's nearest range are traced; 0 = every rock (the
+     * rocks left out are not yet folded into the reflectance). */
+    double boulder_min_px;
 };
 
 struct nc_scene {

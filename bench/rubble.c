@@ -1,0 +1,161 @@
+/* bench/rubble.c - what boulders cost (docs/terrain.md).
+ *
+ * The default scene (its asteroid, Hapke, shadows, 4 samples per pixel,
+ * 1024x1024) bare and covered with the Bennu boulder preset down to 0.45 m
+ * (over a million rocks), seen along -y from far (6 km: the whole body),
+ * medium (1.5 km: the body fills the frame) and close (300 m above the
+ * surface, 7 cm pixels). Per range: the frame time of each (median of N
+ * frames after one untimed), their ratio; the same with the rocks under
+ * one pixel at the nearest range left out (render.boulder_min_px: 1), the
+ * rocks that leaves and how much brighter the frame is without them
+ * (cut_flux: total radiance / that with every rock - 1; they are not folded
+ * into the reflectance yet); and the time of a pose update that moves the
+ * anchor (the rocks' tree rebuilt). Memory: resident memory the rubble
+ * scene and its renderer take beyond the bare ones.
+ * Usage: bench_rubble [--frames N] [--threads N]
+ * One line per range:
+ *   range=far ... bare_ms=... rubble_ms=... ratio=... memory_mb=... cut_ms=... cut_ratio=... traced=...
+ *   cut_flux=... reanchor_ms=...
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_util.h"
+#include "camera/load.h"
+#include "core/error.h"
+#include "core/proc.h"
+#include "render/render.h"
+#include "render/rt.h"
+
+static void die(void)
+{
+    fprintf(stderr, "bench_rubble: %s\n", nc_errmsg());
+    exit(1);
+}
+
+/* A scene and its renderer, and the resident memory they took. */
+struct setup {
+    struct nc_scene s;
+    struct nc_renderer r;
+    struct nc_frame f;
+    double mem_mb;
+};
+
+static void setup(const char *const *sets, int nsets, int threads, struct setup *u)
+{
+    long before = nc_resident_kb();
+    struct nc_camsys cs;
+    if (nc_setup_load(NULL, sets, nsets, &u->s, &cs) < 0)
+        die();
+    nc_camsys_render_camera(&cs, &u->s.camera, &u->s.camera);
+    nc_camsys_free(&cs);
+    if (nc_renderer_init(&u->r, &u->s, threads) < 0 || nc_frame_alloc(&u->f, u->s.camera.width_px,
+                                                                       u->s.camera.height_px) < 0)
+        die();
+    if (nc_render_frame(&u->r, &u->s, &u->f) < 0) /* every tree built */
+        die();
+    u->mem_mb = (double)(nc_resident_kb() - before) / 1024;
+}
+
+static void place(struct nc_scene *s, double y_m)
+{
+    s->camera.position_m = nc_v3(0, y_m, 0);
+    /* looking at the origin along +y, image up +z: the default scene's attitude */
+}
+
+static double sum(const struct nc_frame *f)
+{
+    double s = 0;
+    for (size_t i = 0; i < (size_t)f->width_px * f->height_px; i++)
+        s += f->radiance[i];
+    return s;
+}
+
+static double frame_ms(struct setup *u, int frames)
+{
+    if (nc_render_frame(&u->r, &u->s, &u->f) < 0) /* a level or cut picked: its tree built */
+        die();
+    double *t = calloc((size_t)frames, sizeof *t);
+    for (int i = 0; i < frames; i++) {
+        double a = now_ms();
+        if (nc_render_frame(&u->r, &u->s, &u->f) < 0)
+            die();
+        t[i] = now_ms() - a;
+    }
+    double m = median(t, frames);
+    free(t);
+    return m;
+}
+
+/* A pose update that moves the anchor: the camera steps a quarter of its
+ * range sideways and back (each step leaves the anchor's cell). */
+static double reanchor_ms(struct setup *u, double range_m)
+{
+    struct nc_vec3 p = u->s.camera.position_m;
+    double t[4];
+    for (int i = 0; i < 4; i++) {
+        u->s.camera.position_m = nc_v3(p.x + (i % 2 ? 0 : 0.25 * range_m), p.y, p.z);
+        double a = now_ms();
+        if (nc_rt_update(u->r.rt, &u->s) < 0)
+            die();
+        t[i] = now_ms() - a;
+    }
+    u->s.camera.position_m = p;
+    if (nc_rt_update(u->r.rt, &u->s) < 0)
+        die();
+    return median(t, 4);
+}
+
+int main(int argc, char **argv)
+{
+    int frames = 3, threads;
+    int status = bench_frames_threads(argc, argv, "bench_rubble", &frames, &threads);
+    if (status >= 0)
+        return status;
+    struct setup bare, rubble;
+    setup(NULL, 0, threads, &bare);
+    const char *sets[] = {"bodies.0.boulders={preset: bennu, min_diameter_m: 0.45}"};
+    double t0 = now_ms();
+    setup(sets, 1, threads, &rubble);
+    const struct nc_boulder_field *f = &rubble.s.body[0].boulders;
+    printf("bench_rubble: %zu triangles; %zu rocks of 0.45 to 64 m (Bennu preset), %d shapes, set up in %.0f ms; "
+           "%dx%d, %d samples/pixel, %d threads, median of %d frames\n",
+           rubble.s.body[0].mesh.nt, f->n, f->nshapes, now_ms() - t0, rubble.s.camera.width_px,
+           rubble.s.camera.height_px, rubble.s.render.samples_per_pixel, rubble.r.threads, frames);
+    /* the surface along -y: the body's extent there */
+    double surface = 0;
+    for (size_t i = 0; i < rubble.s.body[0].mesh.nv; i++) {
+        const double *v = &rubble.s.body[0].mesh.v[3 * i];
+        if (fabs(v[0]) < 5 && fabs(v[2]) < 5)
+            surface = fmin(surface, v[1]);
+    }
+    const struct {
+        const char *name;
+        double y_m;
+    } ranges[] = {{"far", -6000}, {"medium", -1500}, {"close", surface - 300}};
+    for (int k = 0; k < 3; k++) {
+        place(&bare.s, ranges[k].y_m);
+        place(&rubble.s, ranges[k].y_m);
+        rubble.s.render.boulder_min_px = 0;
+        double b = frame_ms(&bare, frames), r = frame_ms(&rubble, frames), all = sum(&rubble.f);
+        double re = reanchor_ms(&rubble, fabs(ranges[k].y_m)), re_bare = reanchor_ms(&bare, fabs(ranges[k].y_m));
+        rubble.s.render.boulder_min_px = 1;
+        double c = frame_ms(&rubble, frames), flux = sum(&rubble.f) / all - 1;
+        struct nc_rt_stats st;
+        nc_rt_get_stats(rubble.r.rt, &st);
+        printf("range=%s distance_m=%.0f bare_ms=%.1f rubble_ms=%.1f ratio=%.2f memory_mb=%.1f rocks=%zu cut_ms=%.1f "
+               "cut_ratio=%.2f traced=%zu min_d_m=%.3f cut_flux=%+.4f reanchor_ms=%.1f reanchor_bare_ms=%.1f\n",
+               ranges[k].name, fabs(ranges[k].y_m), b, r, r / b, rubble.mem_mb - bare.mem_mb, f->n, c, c / b,
+               st.boulders_traced[0], st.boulder_min_m[0], flux, re, re_bare);
+        fflush(stdout);
+    }
+    nc_frame_free(&rubble.f);
+    nc_frame_free(&bare.f);
+    nc_renderer_free(&rubble.r);
+    nc_renderer_free(&bare.r);
+    nc_scene_free(&rubble.s);
+    nc_scene_free(&bare.s);
+    return 0;
+}
