@@ -128,14 +128,13 @@ static void ell_intersect(const struct RTCIntersectFunctionNArguments *a)
     for (unsigned i = 0; i < N; i++) {
         if (a->valid[i] != -1)
             continue;
-        float o[3] = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]};
-        float d[3] = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]};
-        double t = ell_hit(b, o, d, ray[3 * N + i], ray[8 * N + i]);
+        struct nc__rt_lane l = nc__rt_lane(ray, N, i);
+        double t = ell_hit(b, l.o, l.d, l.tnear, l.tfar);
         if (!(t < INFINITY))
             continue;
         float n[3];
         for (int k = 0; k < 3; k++) {
-            double p = (double)o[k] + t * (double)d[k] - b->centre[k];
+            double p = (double)l.o[k] + t * (double)l.d[k] - b->centre[k];
             n[k] = (float)(p / (b->radii[k] * b->radii[k]));
         }
         nc__rt_user_hit(a, i, (float)t, n);
@@ -150,9 +149,8 @@ static void ell_occluded(const struct RTCOccludedFunctionNArguments *a)
     for (unsigned i = 0; i < N; i++) {
         if (a->valid[i] != -1)
             continue;
-        float o[3] = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]};
-        float d[3] = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]};
-        if (ell_hit(b, o, d, ray[3 * N + i], ray[8 * N + i]) < INFINITY)
+        struct nc__rt_lane l = nc__rt_lane(ray, N, i);
+        if (ell_hit(b, l.o, l.d, l.tnear, l.tfar) < INFINITY)
             ray[8 * N + i] = -INFINITY;
     }
 }

@@ -106,36 +106,34 @@ static int rock_hit(const struct nc__rt_rocks *r, size_t i, const float o[3], co
     return 1;
 }
 
+/* The rocks' packet callbacks: prim against the valid lanes of ray (width
+ * N); a hit is written through hit (intersection) or, without it, ends the
+ * lane (occlusion: tfar = -inf). */
+static void rock_packet(const struct nc__rt_rock_octave *oc, unsigned prim, const int *valid, float *ray, unsigned N,
+                        const struct RTCIntersectFunctionNArguments *hit)
+{
+    for (unsigned i = 0; i < N; i++) {
+        if (valid[i] != -1)
+            continue;
+        struct nc__rt_lane l = nc__rt_lane(ray, N, i);
+        float t, n[3];
+        if (!rock_hit(oc->rocks, oc->first + prim, l.o, l.d, l.tnear, l.tfar, &t, n))
+            continue;
+        if (hit)
+            nc__rt_user_hit(hit, i, t, n);
+        else
+            ray[8 * N + i] = -INFINITY;
+    }
+}
+
 static void rock_intersect(const struct RTCIntersectFunctionNArguments *a)
 {
-    const struct nc__rt_rock_octave *oc = a->geometryUserPtr;
-    const float *ray = (const float *)a->rayhit;
-    unsigned N = a->N;
-    for (unsigned i = 0; i < N; i++) {
-        if (a->valid[i] != -1)
-            continue;
-        float o[3] = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]};
-        float d[3] = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]};
-        float t, n[3];
-        if (rock_hit(oc->rocks, oc->first + a->primID, o, d, ray[3 * N + i], ray[8 * N + i], &t, n))
-            nc__rt_user_hit(a, i, t, n);
-    }
+    rock_packet(a->geometryUserPtr, a->primID, a->valid, (float *)a->rayhit, a->N, a);
 }
 
 static void rock_occluded(const struct RTCOccludedFunctionNArguments *a)
 {
-    const struct nc__rt_rock_octave *oc = a->geometryUserPtr;
-    float *ray = (float *)a->ray;
-    unsigned N = a->N;
-    for (unsigned i = 0; i < N; i++) {
-        if (a->valid[i] != -1)
-            continue;
-        float o[3] = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]};
-        float d[3] = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]};
-        float t, n[3];
-        if (rock_hit(oc->rocks, oc->first + a->primID, o, d, ray[3 * N + i], ray[8 * N + i], &t, n))
-            ray[8 * N + i] = -INFINITY;
-    }
+    rock_packet(a->geometryUserPtr, a->primID, a->valid, (float *)a->ray, a->N, NULL);
 }
 
 /* The corners of shape sh (rock units): every point where three of its

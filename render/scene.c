@@ -154,7 +154,8 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
 }
 
 /* Rocks beyond this are a mistake in the density or the smallest diameter
- * (a million cost about 120 MB with the ray tracer's tree). */
+ * (a million cost about 180 MB with the ray tracer's records and tree:
+ * test_boulders). */
 #define MAX_BOULDERS 16000000
 
 /* `boulders:` of a body (docs/terrain.md): a preset or C and slope, the
