@@ -215,8 +215,16 @@ int main(int argc, char **argv)
     char lod[40], rocks[40];
     snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r.rt));
     snprintf(rocks, sizeof rocks, "%.17g", nc_rt_boulder_min_m(r.rt));
-    struct nc_image_attr extra[3] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}};
+    /* How each mesh is shaded: name=flat or name=smooth, comma-separated. */
+    char normals[NC_MAX_BODIES * 72] = "";
+    for (int i = 0, o = 0; i < scene.nbodies; i++)
+        if (scene.body[i].shape == NC_SHAPE_MESH || scene.body[i].shape == NC_SHAPE_ASTEROID)
+            o += snprintf(normals + o, sizeof normals - (size_t)o, "%s%s=%s", o ? "," : "", scene.body[i].name,
+                          scene.body[i].smooth_normals ? "smooth" : "flat");
+    struct nc_image_attr extra[4] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}};
     int nextra = 2;
+    if (normals[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:normals", normals};
     if (rows)
         extra[nextra++] = row_attr;
     if (rc >= 0 && q <= NC_Q_RANGE)

@@ -35,4 +35,22 @@ static inline uint64_t nc_rng_seed(uint64_t seed, uint64_t a, uint64_t b)
     return nc_rng_next(&s);
 }
 
+/* A Poisson count of mean lambda (normal approximation above 30). */
+static inline uint64_t nc_rng_poisson(uint64_t *s, double lambda)
+{
+    if (lambda > 30) { /* Box-Muller */
+        double u = nc_rng_uniform(s), v = nc_rng_uniform(s);
+        double k = lambda + sqrt(lambda) * sqrt(-2 * log(1 - u)) * cos(2 * M_PI * v);
+        return k > 0 ? (uint64_t)llround(k) : 0;
+    }
+    double p = exp(-lambda), c = p, u = nc_rng_uniform(s);
+    uint64_t k = 0;
+    while (u > c && k < 1000) {
+        k++;
+        p *= lambda / (double)k;
+        c += p;
+    }
+    return k;
+}
+
 #endif

@@ -45,24 +45,6 @@ double nc_boulders_expected(const struct nc_boulder_params *p, double area_km2)
     return area_km2 * p->c_per_km2 * (pow(p->d_min_m, -p->slope) - pow(p->d_max_m, -p->slope));
 }
 
-/* A Poisson count of mean lambda from stream s. */
-static size_t poisson(uint64_t *s, double lambda)
-{
-    if (lambda > 30) { /* normal approximation (Box-Muller) */
-        double u = nc_rng_uniform(s), v = nc_rng_uniform(s);
-        double k = lambda + sqrt(lambda) * sqrt(-2 * log(1 - u)) * cos(2 * M_PI * v);
-        return k > 0 ? (size_t)llround(k) : 0;
-    }
-    double p = exp(-lambda), c = p, u = nc_rng_uniform(s);
-    size_t k = 0;
-    while (u > c && k < 1000) {
-        k++;
-        p *= lambda / (double)k;
-        c += p;
-    }
-    return k;
-}
-
 /* Shape i: an ellipsoid of half-axes 1 >= b >= c, cut by its three pairs of
  * axis planes and by planes tangent to it in random directions pushed in by
  * up to 20 %: faceted, flat-sided rocks of distinct outlines. */
@@ -142,7 +124,7 @@ static int face_octave(struct nc_boulder_field *f, size_t *cap, size_t max_rocks
     double lo = exp2(j), hi = exp2(j + 1);
     double plo = pow(lo, -p->slope), phi = pow(hi, -p->slope);
     uint64_t s = nc_rng_seed(p->seed, (uint64_t)t, (uint64_t)(j - OCTAVE_MIN));
-    size_t k = poisson(&s, area_km2 * p->c_per_km2 * (plo - phi));
+    size_t k = nc_rng_poisson(&s, area_km2 * p->c_per_km2 * (plo - phi));
     for (size_t i = 0; i < k; i++) {
         /* every draw is made whatever the cut, so each rock stays the same */
         double d = pow(plo - nc_rng_uniform(&s) * (plo - phi), -1 / p->slope);
@@ -222,13 +204,7 @@ int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params
         return nc_error(-ENOMEM, "out of memory");
     for (int i = 0; i < p->shapes; i++)
         rock_shape(p->seed, i, &out->shape[i]);
-    double area_km2 = 0; /* refuse an absurd population before drawing it */
-    for (size_t t = 0; t < m->nt; t++) {
-        const double *v0 = m->v + 3 * m->tri[3 * t], *v1 = m->v + 3 * m->tri[3 * t + 1],
-                     *v2 = m->v + 3 * m->tri[3 * t + 2];
-        area_km2 += 0.5e-6 * nc_v3_norm(nc_v3_cross(nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]),
-                                                    nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2])));
-    }
+    double area_km2 = 1e-6 * nc_mesh_area_m2(m); /* refuse an absurd population before drawing it */
     if (nc_boulders_expected(p, area_km2) > 1.01 * (double)max_rocks) {
         nc_boulders_free(out);
         return nc_error(NC_ERANGE, "about %.3g boulders expected on %.4g km^2, more than %zu: raise min_diameter_m or "
@@ -242,12 +218,10 @@ int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params
         for (size_t t = 0; t < m->nt && rc == 0; t++) {
             const double *v0 = m->v + 3 * m->tri[3 * t], *v1 = m->v + 3 * m->tri[3 * t + 1],
                          *v2 = m->v + 3 * m->tri[3 * t + 2];
-            struct nc_vec3 e1 = nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]);
-            struct nc_vec3 e2 = nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]);
-            struct nc_vec3 c = nc_v3_cross(e1, e2);
-            double len = nc_v3_norm(c);
-            if (len > 0) /* a degenerate face holds no rock */
-                rc = face_octave(out, &cap, max_rocks, t, j, v0, v1, v2, nc_v3_scale(c, 1 / len), 0.5 * len * 1e-6);
+            struct nc_vec3 nrm;
+            double a = nc_mesh_face(m, t, &nrm);
+            if (a > 0) /* a degenerate face holds no rock */
+                rc = face_octave(out, &cap, max_rocks, t, j, v0, v1, v2, nrm, a * 1e-6);
         }
         if (rc == 0 && out->n > first) {
             rc = sort_octave(out->rock + first, out->n - first);

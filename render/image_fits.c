@@ -55,6 +55,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:fits_row_order", "ROWORDER"},
     {"navcam:lod_error_m", "LODERR"},
     {"navcam:boulder_min_m", "ROCKMIN"},
+    {"navcam:normals", "NORMALS"},
 };
 
 /* 1 when attrs ask for the archive row order (row 1 at the bottom). */

@@ -26,15 +26,17 @@ int nc_mesh_load_obj(const char *path, double scale_to_m, struct nc_mesh *out);
 int nc_mesh_load_ply(const char *path, double scale_to_m, struct nc_mesh *out);
 
 /* Procedural cratered asteroid: an icosphere (20 * 4^subdivisions triangles)
- * on a triaxial ellipsoid, with smooth lumps and bowl craters with raised rims.
+ * on a triaxial ellipsoid, with smooth lumps, then craters (craters.h).
  * Fully determined by its arguments. */
 struct nc_asteroid_params {
     struct nc_vec3 radii_m;
     int subdivisions;  /* 0..9 */
     uint64_t seed;
-    int craters;       /* number of craters */
+    int craters;       /* mean number of craters of the default population (craters.h) */
     double lump_amplitude; /* relative radius variation of the lumps, e.g. 0.08 */
 };
+/* More craters than this on one body is an error (a typo in the density). */
+#define NC_CRATERS_MAX 4000000
 int nc_mesh_asteroid(const struct nc_asteroid_params *p, struct nc_mesh *out);
 
 /* Levels of detail (mesh_lod.c): level 0 is the mesh itself (its own
@@ -63,5 +65,13 @@ int nc_mesh_lod_pick_error(const double *error_m, int nlevels, double max_error_
 
 /* Largest distance of a used vertex from the body origin, metres. */
 double nc_mesh_bounding_radius(const struct nc_mesh *m);
+
+/* Measures (mesh_geom.c). Face t's area, m^2, and its unit normal by the
+ * winding (zero for a degenerate face; unit_normal may be NULL). */
+double nc_mesh_face(const struct nc_mesh *m, size_t t, struct nc_vec3 *unit_normal);
+double nc_mesh_area_m2(const struct nc_mesh *m);
+/* Unit normals at the vertices (3 per vertex, into n), the area-weighted
+ * mean of the faces around each; zero for a vertex no face uses. */
+void nc_mesh_vertex_normals(const struct nc_mesh *m, double *n);
 
 #endif

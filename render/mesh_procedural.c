@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "render/craters.h"
 
 /* ---- procedural asteroid ---------------------------------------------- */
 
@@ -101,42 +102,25 @@ int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
     free(em.key);
     free(em.val);
 
-    /* Features: centre direction, angular radius (rad), kind. */
+    /* Lumps: centre direction, angular radius (rad), relative amplitude. */
     uint64_t rng = ap->seed ^ 0x4e6176436d417374ull;
-    int nlump = 24, ncr = ap->craters;
-    struct feature { struct nc_vec3 c; double a, amp, cos_reach; } *ft = malloc((size_t)(nlump + ncr) * sizeof *ft);
-    if (!ft) {
-        nc_mesh_free(&m);
-        return nc_error(-ENOMEM, "asteroid: out of memory");
-    }
-    for (int i = 0; i < nlump; i++) {
+    enum { NLUMP = 24 };
+    struct { struct nc_vec3 c; double a, amp, cos_reach; } ft[NLUMP];
+    for (int i = 0; i < NLUMP; i++) {
         ft[i].c = nc_rng_dir(&rng);
         ft[i].a = 0.35 + 0.65 * nc_rng_uniform(&rng);
         ft[i].amp = ap->lump_amplitude * (2 * nc_rng_uniform(&rng) - 1);
         ft[i].cos_reach = cos(fmin(M_PI, 3 * ft[i].a));
     }
-    for (int i = nlump; i < nlump + ncr; i++) {
-        ft[i].c = nc_rng_dir(&rng);
-        /* Power-law sizes: many small craters, few large (cumulative ~ a^-1.5). */
-        ft[i].a = fmin(0.5, 0.03 * pow(1 - nc_rng_uniform(&rng), -1 / 1.5));
-        ft[i].amp = 0.2 * ft[i].a; /* depth/diameter ~ 0.1 */
-        ft[i].cos_reach = cos(fmin(M_PI, 1.8 * ft[i].a));
-    }
     for (size_t v = 0; v < m.nv; v++) {
         struct nc_vec3 d = nc_v3(m.v[3 * v], m.v[3 * v + 1], m.v[3 * v + 2]);
         double h = 0;
-        for (int i = 0; i < nlump + ncr; i++) {
+        for (int i = 0; i < NLUMP; i++) {
             double cs = nc_v3_dot(d, ft[i].c);
             if (cs < ft[i].cos_reach)
                 continue;
             double x = acos(fmin(1.0, cs)) / ft[i].a;
-            if (i < nlump)
-                h += ft[i].amp * exp(-x * x);
-            else {
-                double bowl = x < 1 ? (x * x - 1) : 0;
-                double rim = 0.25 * exp(-((x - 1) * (x - 1)) / (0.3 * 0.3));
-                h += ft[i].amp * (bowl + rim);
-            }
+            h += ft[i].amp * exp(-x * x);
         }
         /* Radius of the ellipsoid along d, then the relative relief. */
         double q = d.x * d.x / (ap->radii_m.x * ap->radii_m.x) + d.y * d.y / (ap->radii_m.y * ap->radii_m.y) +
@@ -146,7 +130,20 @@ int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
         m.v[3 * v + 1] = d.y * r;
         m.v[3 * v + 2] = d.z * r;
     }
-    free(ft);
+    /* Craters (craters.h): about `craters` of the default population. */
+    struct nc_crater_params cp;
+    nc_crater_params_default(&m, &cp);
+    cp.seed = ap->seed;
+    cp.c_per_km2 = nc_craters_density_for(&cp, 1e-6 * nc_mesh_area_m2(&m), ap->craters);
+    struct nc_crater_field cf;
+    int rc = nc_craters_generate(&m, &cp, NC_CRATERS_MAX, &cf);
+    if (rc == 0)
+        rc = nc_craters_apply(&cf, &m);
+    nc_craters_free(&cf);
+    if (rc < 0) {
+        nc_mesh_free(&m);
+        return rc;
+    }
     *out = m;
     return 0;
 }

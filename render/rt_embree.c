@@ -33,6 +33,8 @@ struct rt_body {
     unsigned fitted[NC_LOD_MAX_LEVELS]; /* the anchor generation each level's tree was fitted to */
     int nlevels, level;
     float *verts; /* anchor-relative vertices of every level, padded for Embree's 16-byte loads */
+    float *vnormal; /* smooth shading: unit normals at the vertices, body frame (NULL: flat) */
+    const unsigned *tri[NC_LOD_MAX_LEVELS]; /* each level's triangles (Embree's index buffer) */
     unsigned inst_id;
     RTCGeometry inst;
     /* boulders (rt_rocks.h): a scene of their own, instanced with the
@@ -172,6 +174,7 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
     if (!ib)
         return rt_check(rt->dev, "allocating mesh buffers");
     memcpy(ib, lv->tri, lv->nt * 3 * sizeof(unsigned));
+    b->tri[k] = ib;
     rtcAttachGeometry(b->scene[k], g);
     b->nt[k] = lv->nt;
     b->error_m[k] = lv->error_m;
@@ -180,6 +183,22 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
         return closed;
     b->closed[k] = closed;
     return rt_check(rt->dev, "creating geometry");
+}
+
+/* Smooth shading: the mesh's vertex normals, in float (every level of
+ * detail keeps a subset of the full mesh's vertices, so one set serves all). */
+static int vertex_normals(struct rt_body *b, const struct nc_mesh *m)
+{
+    double *n = malloc(3 * m->nv * sizeof *n);
+    if (!n || !(b->vnormal = malloc(3 * m->nv * sizeof *b->vnormal))) {
+        free(n);
+        return nc_error(-ENOMEM, "out of memory for %zu vertex normals", m->nv);
+    }
+    nc_mesh_vertex_normals(m, n);
+    for (size_t i = 0; i < 3 * m->nv; i++)
+        b->vnormal[i] = (float)n[i];
+    free(n);
+    return 0;
 }
 
 /* Levels of detail only pay where a mesh is much finer than the coarsest
@@ -219,6 +238,8 @@ static int body_init(struct nc_rt *rt, unsigned index, const struct nc_body *src
         }
         nc_mesh_lod_free(&lod);
         if (rc < 0)
+            return rc;
+        if (src->smooth_normals && (rc = vertex_normals(b, m)) < 0)
             return rc;
         if (src->boulders.n) { /* rocks shadow the body: no grid proves a point lit */
             if ((rc = nc__rt_rocks_init(rt->dev, &src->boulders, &b->anchor_m, &b->rocks)) < 0)
@@ -480,6 +501,24 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
         const struct rt_body *b = &rt->body[rt->geom_to_body[inst]];
         const float *R = b->rot;
         float x = rh.hit.Ng_x[i], y = rh.hit.Ng_y[i], z = rh.hit.Ng_z[i];
+        if (b->vnormal && inst == b->inst_id) {
+            /* Smooth: the vertex normals at the hit's barycentric point, kept
+             * only where they face the ray as the facet does (else the facet's:
+             * a shading normal never shows a face the geometry hides). */
+            const unsigned *t = b->tri[b->level] + 3 * (size_t)rh.hit.primID[i];
+            const float *n0 = b->vnormal + 3 * (size_t)t[0], *n1 = b->vnormal + 3 * (size_t)t[1],
+                        *n2 = b->vnormal + 3 * (size_t)t[2];
+            float u = rh.hit.u[i], v = rh.hit.v[i], w = 1 - u - v;
+            float sx = w * n0[0] + u * n1[0] + v * n2[0], sy = w * n0[1] + u * n1[1] + v * n2[1],
+                  sz = w * n0[2] + u * n1[2] + v * n2[2];
+            /* the ray in the body frame: R^T d */
+            float dx = R[0] * ray->dx[i] + R[3] * ray->dy[i] + R[6] * ray->dz[i],
+                  dy = R[1] * ray->dx[i] + R[4] * ray->dy[i] + R[7] * ray->dz[i],
+                  dz = R[2] * ray->dx[i] + R[5] * ray->dy[i] + R[8] * ray->dz[i];
+            float gd = x * dx + y * dy + z * dz, sd = sx * dx + sy * dy + sz * dz;
+            if ((gd < 0) == (sd < 0) && sx * x + sy * y + sz * z > 0)
+                x = sx, y = sy, z = sz;
+        }
         hit->body[i] = (int)rt->geom_to_body[inst];
         hit->t[i] = rh.ray.tfar[i];
         hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;
@@ -766,6 +805,7 @@ void nc_rt_destroy(struct nc_rt *rt)
         rtcReleaseDevice(rt->dev);
     for (int i = 0; i < rt->nbodies; i++) {
         free(rt->body[i].verts);
+        free(rt->body[i].vnormal);
         nc_shadow_grid_free(&rt->body[i].grid);
     }
     free(rt);

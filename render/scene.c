@@ -20,7 +20,7 @@ const char nc_default_scene_yaml[] =
     "      radii_m: [280, 230, 200]\n"
     "      subdivisions: 7\n"
     "      seed: 7\n"
-    "      craters: 160\n"
+    "      craters: {saturation: 0.05}   # 5 % of geometric saturation, slope 2\n"
     "      lump_amplitude: 0.08\n"
     "    material:\n"
     "      preset: comet_67p\n"
@@ -106,7 +106,8 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         b->bounding_radius_m = fmax(r[0], fmax(r[1], r[2]));
         if (b->shape == NC_SHAPE_ELLIPSOID)
             return 0;
-        struct nc_asteroid_params ap = {.radii_m = b->radii_m, .subdivisions = 6, .seed = 1, .craters = 100,
+        /* craters come after (scene_detail.c) */
+        struct nc_asteroid_params ap = {.radii_m = b->radii_m, .subdivisions = 6, .seed = 1, .craters = 0,
                                         .lump_amplitude = 0.08};
         long v;
         if ((rc = nc_cfg_int(sh, "subdivisions", 0, 9, &v)) < 0)
@@ -117,10 +118,6 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
             return rc;
         if (rc)
             ap.seed = (uint64_t)v;
-        if ((rc = nc_cfg_int(sh, "craters", 0, 100000, &v)) < 0)
-            return rc;
-        if (rc)
-            ap.craters = (int)v;
         if ((rc = nc_cfg_double(sh, "lump_amplitude", 0, 0.5, &ap.lump_amplitude)) < 0)
             return rc;
         if ((rc = nc_mesh_asteroid(&ap, &b->mesh)) < 0)
@@ -153,69 +150,6 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     return 0;
 }
 
-/* Rocks beyond this are a mistake in the density or the smallest diameter
- * (a million cost about 180 MB with the ray tracer's records and tree:
- * test_boulders). */
-#define MAX_BOULDERS 16000000
-
-/* `boulders:` of a body (docs/terrain.md): a preset or C and slope, the
- * diameter range, burial, shapes, seed. */
-static int nc_boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
-{
-    struct nc_cfg_node *map;
-    int rc, has_c, has_slope;
-    if ((rc = nc_cfg_map(item, "boulders", &map)) <= 0)
-        return rc;
-    if (b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
-        return nc_cfg_error(nc_cfg_get(item, "boulders"), "boulders need a mesh or asteroid shape");
-    struct nc_boulder_params p = {.d_min_m = 1, .d_max_m = 64, .burial_min = 0.1, .burial_max = 0.5, .shapes = 48,
-                                  .seed = 1};
-    const char *preset = NULL;
-    double burial[2];
-    long v;
-    if ((rc = nc_cfg_string(map, "preset", &preset)) < 0)
-        return rc;
-    if (preset && nc_boulder_preset(preset, &p) < 0)
-        return nc_cfg_error(nc_cfg_get(map, "preset"), "unknown preset '%s': bennu, ryugu or itokawa", preset);
-    if ((has_c = nc_cfg_double(map, "density_per_km2", 0, 1e15, &p.c_per_km2)) < 0 ||
-        (has_slope = nc_cfg_double(map, "slope", 0.5, 6, &p.slope)) < 0)
-        return has_c < 0 ? has_c : has_slope;
-    if (!preset && (!has_c || !has_slope))
-        return nc_cfg_missing(map, has_c ? "slope" : "density_per_km2",
-                              "a preset (bennu, ryugu, itokawa), or both density_per_km2 (N(>1 m) per km^2) and slope");
-    if ((rc = nc_cfg_double(map, "min_diameter_m", 1e-6, 1e6, &p.d_min_m)) < 0 ||
-        (rc = nc_cfg_double(map, "max_diameter_m", 1e-6, 2e6, &p.d_max_m)) < 0)
-        return rc;
-    if (!(p.d_max_m > p.d_min_m))
-        return nc_cfg_error(nc_cfg_get(map, "max_diameter_m") ? nc_cfg_get(map, "max_diameter_m") : map,
-                            "max_diameter_m (%g) must exceed min_diameter_m (%g)", p.d_max_m, p.d_min_m);
-    if ((rc = nc_cfg_doubles(map, "burial", burial, 2)) < 0)
-        return rc;
-    if (rc) {
-        if (!(burial[0] >= 0 && burial[1] >= burial[0] && burial[1] <= 1))
-            return nc_cfg_error(nc_cfg_get(map, "burial"), "expected [min, max] fractions of height, 0 <= min <= max <= 1");
-        p.burial_min = burial[0], p.burial_max = burial[1];
-    }
-    if ((rc = nc_cfg_int(map, "shapes", 1, NC_ROCK_SHAPES_MAX, &v)) < 0)
-        return rc;
-    if (rc)
-        p.shapes = (int)v;
-    if ((rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
-        return rc;
-    if (rc)
-        p.seed = (uint64_t)v;
-    if ((rc = nc_boulders_generate(&b->mesh, &p, MAX_BOULDERS, &b->boulders)) < 0) {
-        char why[512];
-        snprintf(why, sizeof why, "%s", nc_errmsg());
-        return nc_cfg_error(map, "%s", why);
-    }
-    /* rocks standing out past the mesh's farthest vertex widen the body */
-    b->bounding_radius_m = fmax(b->bounding_radius_m, nc_boulders_bounding_radius(&b->boulders));
-    nc_log_info("scene", "body '%s': %zu boulders of %g to %g m (N(>1 m) = %.4g per km^2, slope %g, seed %llu)",
-                b->name, b->boulders.n, p.d_min_m, p.d_max_m, p.c_per_km2, p.slope, (unsigned long long)p.seed);
-    return 0;
-}
-
 static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body *b)
 {
     int rc;
@@ -233,7 +167,7 @@ static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body 
         return rc ? rc : nc_cfg_missing(item, "shape", "a map with 'type'");
     if ((rc = shape_from_config(sh, b)) < 0)
         return rc;
-    if ((rc = nc_boulders_from_config(item, b)) < 0)
+    if ((rc = nc__scene_detail_from_config(item, sh, b)) < 0)
         return rc;
     if ((rc = nc_cfg_map(item, "material", &mat)) <= 0)
         return rc ? rc : nc_cfg_missing(item, "material", "a map with model (or preset) and parameters");

@@ -29,6 +29,7 @@ struct nc_body {
     enum nc_shape_type shape;
     struct nc_vec3 radii_m; /* sphere/ellipsoid semi-axes along body x, y, z */
     struct nc_mesh mesh;    /* mesh and asteroid */
+    int smooth_normals;     /* mesh and asteroid: shade with normals interpolated from the vertices' */
     struct nc_boulder_field boulders; /* none when boulders.n == 0 (meshes only) */
     double bounding_radius_m;
     struct nc_material material;
@@ -80,6 +81,9 @@ int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *s
 /* Convenience: load file (NULL = built-in default), apply overrides, build. */
 int nc_scene_load(const char *path, const char *const *sets, int nsets, struct nc_scene *s);
 void nc_scene_free(struct nc_scene *s);
+/* A body's craters and boulders from its config item and shape node, after
+ * its shape is built (scene_detail.c; internal to scene*.c). */
+int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b);
 
 /* Poses dt seconds later: positions move with their velocities, attitudes
  * turn at their angular rates. out shares s's meshes and materials (a shallow

@@ -2,6 +2,7 @@
 #include "testutil.h"
 
 #include <fcntl.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -87,6 +88,26 @@ void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f)
 }
 
 int nc_test_contains(const char *haystack, const char *needle) { return strstr(haystack, needle) != NULL; }
+
+double nc_test_fit_slope(const double *d, size_t n, double lo, double hi)
+{
+    /* Maximum likelihood: the mean of ln(D/lo) equals its expectation
+     * 1/b - L e^(-bL) / (1 - e^(-bL)), L = ln(hi/lo), which falls with b:
+     * bisection. */
+    double m = 0;
+    for (size_t i = 0; i < n; i++)
+        m += log(d[i] / lo);
+    m /= (double)n;
+    double L = log(hi / lo), a = 0.05, b = 10;
+    for (int it = 0; it < 200; it++) {
+        double s = 0.5 * (a + b), e = 1 / s - L * exp(-s * L) / (1 - exp(-s * L));
+        if (e > m)
+            a = s; /* too shallow */
+        else
+            b = s;
+    }
+    return 0.5 * (a + b);
+}
 
 int nc_test_end(void)
 {

@@ -33,6 +33,9 @@ int nc_test_scene_rc(const char *yaml, const char *const *sets, int nsets, struc
 /* Render the scene with the given thread count into a newly allocated frame. */
 void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f);
 int nc_test_contains(const char *haystack, const char *needle);
+/* The slope b of a cumulative power law N(>D) ~ D^-b truncated to [lo, hi],
+ * fitted by maximum likelihood to n diameters. */
+double nc_test_fit_slope(const double *d, size_t n, double lo, double hi);
 /* Start argv[0] (NULL-terminated argv) in directory dir (made if missing),
  * stderr to dir/serve.log, stdout to /dev/null; returns the child's pid. */
 int nc_test_spawn(const char *dir, const char *const *argv);

@@ -18,44 +18,21 @@
 #include "render/rt.h"
 #include "testutil.h"
 
-/* Slope b of a power law truncated to [lo, hi] by maximum likelihood:
- * mean ln(D/lo) = 1/b + ln(r) r^-b / (r^-b - 1)... solved by bisection on
- * the mean of ln(D/lo), with r = hi/lo. */
+/* The slope fitted to the generated diameters. */
 static double fit_slope(const struct nc_boulder_field *f, double lo, double hi)
 {
-    double m = 0;
+    double *d = malloc(f->n * sizeof *d);
     for (size_t i = 0; i < f->n; i++)
-        m += log(2.0 * f->rock[i].half_m / lo);
-    m /= (double)f->n;
-    double L = log(hi / lo), a = 0.05, b = 10;
-    for (int it = 0; it < 200; it++) {
-        double s = 0.5 * (a + b);
-        /* E[ln(D/lo)] for density ~ D^-(s+1) on [lo, hi] */
-        double e = 1 / s - L * exp(-s * L) / (1 - exp(-s * L));
-        if (e > m)
-            a = s; /* too shallow */
-        else
-            b = s;
-    }
-    return 0.5 * (a + b);
-}
-
-static double mesh_area_km2(const struct nc_mesh *m)
-{
-    double a = 0;
-    for (size_t t = 0; t < m->nt; t++) {
-        const double *p0 = m->v + 3 * m->tri[3 * t], *p1 = m->v + 3 * m->tri[3 * t + 1], *p2 = m->v + 3 * m->tri[3 * t + 2];
-        struct nc_vec3 c = nc_v3_cross(nc_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]),
-                                       nc_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]));
-        a += 0.5 * nc_v3_norm(c);
-    }
-    return a * 1e-6;
+        d[i] = 2.0 * f->rock[i].half_m;
+    double b = nc_test_fit_slope(d, f->n, lo, hi);
+    free(d);
+    return b;
 }
 
 static void check_population(const struct nc_mesh *m)
 {
     const char *presets[] = {"bennu", "ryugu", "itokawa"};
-    double area = mesh_area_km2(m);
+    double area = 1e-6 * nc_mesh_area_m2(m);
     for (int k = 0; k < 3; k++) {
         struct nc_boulder_params p = {.d_min_m = 0.5, .d_max_m = 200, .burial_min = 0.1, .burial_max = 0.5,
                                       .shapes = 16, .seed = 11};

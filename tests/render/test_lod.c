@@ -151,7 +151,9 @@ int main(void)
     centroid(&full, &fa, &ax, &ay);
     centroid(&lod, &fb, &bx, &by);
     printf("6 km, level %d: flux %+.2e, centroid shift %.4f px\n", st.lod_level[0], fb / fa - 1, hypot(bx - ax, by - ay));
-    CHECK(fabs(fb / fa - 1) < 2e-3, "flux changed by %g", fb / fa - 1);
+    /* -0.20 % measured on this asteroid since its craters follow craters.h
+     * (under 0.2 % with the shallower bowls before). */
+    CHECK(fabs(fb / fa - 1) < 3e-3, "flux changed by %g", fb / fa - 1);
     CHECK(hypot(bx - ax, by - ay) < 0.1, "centroid moved %g px", hypot(bx - ax, by - ay));
 
     /* Same pose, same level, same pixels on any thread count. */

@@ -1,0 +1,167 @@
+/* scene_detail.c - a body's surface detail from its configuration
+ * (docs/terrain.md): craters carved into its mesh (shape.craters), how
+ * the mesh is shaded (shape.normals), and boulders on it (boulders). Reads config nodes, builds render/ data; no
+ * rendering here. */
+#include "render/scene.h"
+
+#include <stdio.h>
+#include <math.h>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "render/craters.h"
+
+/* `shape.craters` of a mesh or asteroid: a mean count of the default
+ * population (a number), or a map of its parameters. An asteroid without
+ * the key gets 100. */
+static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+{
+    struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
+    if (!node && b->shape != NC_SHAPE_ASTEROID)
+        return 0;
+    if (node && b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+        return nc_cfg_error(node, "craters need a mesh or asteroid shape");
+    struct nc_crater_params p;
+    nc_crater_params_default(&b->mesh, &p);
+    double area_km2 = 1e-6 * nc_mesh_area_m2(&b->mesh), count = 100;
+    long v;
+    int rc;
+    if ((rc = nc_cfg_int(sh, "seed", 0, 0x7fffffffL, &v)) < 0)
+        return rc;
+    if (rc)
+        p.seed = (uint64_t)v;
+    if (node && node->kind == NC_CFG_SCALAR) {
+        if ((rc = nc_cfg_int(sh, "craters", 0, 1000000, &v)) < 0)
+            return rc;
+        count = (double)v;
+    } else if (node) {
+        if ((rc = nc_cfg_map(sh, "craters", &map)) < 0)
+            return rc;
+        int has_n, has_c, has_s, has_b;
+        double sat = 0;
+        if ((has_n = nc_cfg_double(map, "count", 0, 1e7, &count)) < 0 ||
+            (has_c = nc_cfg_double(map, "density_per_km2", 0, 1e15, &p.c_per_km2)) < 0 ||
+            (has_s = nc_cfg_double(map, "saturation", 0, 1, &sat)) < 0)
+            return has_n < 0 ? has_n : has_c < 0 ? has_c : has_s;
+        if (has_n + has_c + has_s != 1)
+            return nc_cfg_error(map, "give one of count (mean number), density_per_km2 (N(>1 m) per km^2) or "
+                                     "saturation (fraction of geometric saturation)");
+        if (has_c || has_s)
+            count = -1;
+        if ((has_b = nc_cfg_double(map, "slope", 0.5, 6, &p.slope)) < 0)
+            return has_b;
+        if (has_s && has_b && p.slope != 2)
+            return nc_cfg_error(nc_cfg_get(map, "slope"), "saturation implies slope 2");
+        if (has_s) /* Gault (1970): geometric saturation N(>D) = 1.54 D^-2 per km^2, D in km */
+            p.c_per_km2 = sat * 1.54e6;
+        if (
+            (rc = nc_cfg_double(map, "min_diameter_m", 1e-6, 1e7, &p.d_min_m)) < 0 ||
+            (rc = nc_cfg_double(map, "max_diameter_m", 1e-6, 2e7, &p.d_max_m)) < 0 ||
+            (rc = nc_cfg_double(map, "depth_ratio", 0, 1, &p.depth_ratio)) < 0 ||
+            (rc = nc_cfg_double(map, "rim_ratio", 0, 1, &p.rim_ratio)) < 0 ||
+            (rc = nc_cfg_double(map, "degradation", 0, 1, &p.degradation)) < 0)
+            return rc;
+        if (!(p.d_max_m > p.d_min_m))
+            return nc_cfg_error(nc_cfg_get(map, "max_diameter_m") ? nc_cfg_get(map, "max_diameter_m") : map,
+                                "max_diameter_m (%g) must exceed min_diameter_m (%g)", p.d_max_m, p.d_min_m);
+        if ((rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+            return rc;
+        if (rc)
+            p.seed = (uint64_t)v;
+    }
+    if (count >= 0)
+        p.c_per_km2 = nc_craters_density_for(&p, area_km2, count);
+    struct nc_crater_field f;
+    if ((rc = nc_craters_generate(&b->mesh, &p, NC_CRATERS_MAX, &f)) == 0)
+        rc = nc_craters_apply(&f, &b->mesh);
+    if (rc < 0) {
+        char why[512];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        nc_craters_free(&f);
+        return nc_cfg_error(node ? node : sh, "%s", why);
+    }
+    if (f.n)
+        nc_log_info("scene", "body '%s': %zu craters of %.3g to %.3g m (N(>1 m) = %.4g per km^2, slope %g, seed %llu), "
+                    "%zu resolved by the mesh", b->name, f.n, p.d_min_m, p.d_max_m, p.c_per_km2, p.slope,
+                    (unsigned long long)p.seed, f.applied);
+    nc_craters_free(&f);
+    b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
+    return 0;
+}
+
+/* Rocks beyond this are a mistake in the density or the smallest diameter
+ * (a million cost about 180 MB with the ray tracer's records and tree:
+ * test_boulders). */
+#define MAX_BOULDERS 16000000
+
+/* `boulders:` of a body (docs/terrain.md): a preset or C and slope, the
+ * diameter range, burial, shapes, seed. */
+static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
+{
+    struct nc_cfg_node *map;
+    int rc, has_c, has_slope;
+    if ((rc = nc_cfg_map(item, "boulders", &map)) <= 0)
+        return rc;
+    if (b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+        return nc_cfg_error(nc_cfg_get(item, "boulders"), "boulders need a mesh or asteroid shape");
+    struct nc_boulder_params p = {.d_min_m = 1, .d_max_m = 64, .burial_min = 0.1, .burial_max = 0.5, .shapes = 48,
+                                  .seed = 1};
+    const char *preset = NULL;
+    double burial[2];
+    long v;
+    if ((rc = nc_cfg_string(map, "preset", &preset)) < 0)
+        return rc;
+    if (preset && nc_boulder_preset(preset, &p) < 0)
+        return nc_cfg_error(nc_cfg_get(map, "preset"), "unknown preset '%s': bennu, ryugu or itokawa", preset);
+    if ((has_c = nc_cfg_double(map, "density_per_km2", 0, 1e15, &p.c_per_km2)) < 0 ||
+        (has_slope = nc_cfg_double(map, "slope", 0.5, 6, &p.slope)) < 0)
+        return has_c < 0 ? has_c : has_slope;
+    if (!preset && (!has_c || !has_slope))
+        return nc_cfg_missing(map, has_c ? "slope" : "density_per_km2",
+                              "a preset (bennu, ryugu, itokawa), or both density_per_km2 (N(>1 m) per km^2) and slope");
+    if ((rc = nc_cfg_double(map, "min_diameter_m", 1e-6, 1e6, &p.d_min_m)) < 0 ||
+        (rc = nc_cfg_double(map, "max_diameter_m", 1e-6, 2e6, &p.d_max_m)) < 0)
+        return rc;
+    if (!(p.d_max_m > p.d_min_m))
+        return nc_cfg_error(nc_cfg_get(map, "max_diameter_m") ? nc_cfg_get(map, "max_diameter_m") : map,
+                            "max_diameter_m (%g) must exceed min_diameter_m (%g)", p.d_max_m, p.d_min_m);
+    if ((rc = nc_cfg_doubles(map, "burial", burial, 2)) < 0)
+        return rc;
+    if (rc) {
+        if (!(burial[0] >= 0 && burial[1] >= burial[0] && burial[1] <= 1))
+            return nc_cfg_error(nc_cfg_get(map, "burial"), "expected [min, max] fractions of height, 0 <= min <= max <= 1");
+        p.burial_min = burial[0], p.burial_max = burial[1];
+    }
+    if ((rc = nc_cfg_int(map, "shapes", 1, NC_ROCK_SHAPES_MAX, &v)) < 0)
+        return rc;
+    if (rc)
+        p.shapes = (int)v;
+    if ((rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+        return rc;
+    if (rc)
+        p.seed = (uint64_t)v;
+    if ((rc = nc_boulders_generate(&b->mesh, &p, MAX_BOULDERS, &b->boulders)) < 0) {
+        char why[512];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_cfg_error(map, "%s", why);
+    }
+    /* rocks standing out past the mesh's farthest vertex widen the body */
+    b->bounding_radius_m = fmax(b->bounding_radius_m, nc_boulders_bounding_radius(&b->boulders));
+    nc_log_info("scene", "body '%s': %zu boulders of %g to %g m (N(>1 m) = %.4g per km^2, slope %g, seed %llu)",
+                b->name, b->boulders.n, p.d_min_m, p.d_max_m, p.c_per_km2, p.slope, (unsigned long long)p.seed);
+    return 0;
+}
+
+int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b)
+{
+    static const char *const normals[] = {"flat", "smooth", NULL};
+    int rc, smooth = 0;
+    if ((rc = nc_cfg_enum(shape, "normals", normals, &smooth)) < 0)
+        return rc;
+    if (rc && b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+        return nc_cfg_error(nc_cfg_get(shape, "normals"), "normals apply to mesh and asteroid shapes");
+    b->smooth_normals = smooth;
+    if ((rc = craters_from_config(shape, b)) < 0)
+        return rc;
+    return boulders_from_config(item, b);
+}

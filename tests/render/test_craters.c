@@ -1,0 +1,237 @@
+/* test_craters.c - crater populations and morphology (craters.h): the
+ * configured SFD slope and density recovered from the generated list and
+ * centres uniform over the surface; the same craters and the same carved
+ * mesh from the same seed; on a flat grid, a fresh crater's floor, rim and
+ * ejecta at the heights of the profile, an old one shallower by its age, a
+ * young crater erasing the older relief inside its cavity, and a crater
+ * smaller than the mesh spacing left out; the config forms (count,
+ * density, saturation) and their errors. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/craters.h"
+#include "testutil.h"
+
+static void check_population(void)
+{
+    struct nc_asteroid_params ap = {.radii_m = {1000, 1000, 1000}, .subdivisions = 4, .seed = 3};
+    struct nc_mesh m;
+    CHECK(nc_mesh_asteroid(&ap, &m) == 0, "%s", nc_errmsg());
+    double area = 1e-6 * nc_mesh_area_m2(&m);
+    const double slopes[] = {1.8, 2.0, 3.0};
+    for (int k = 0; k < 3; k++) {
+        struct nc_crater_params p;
+        nc_crater_params_default(&m, &p);
+        p.slope = slopes[k];
+        p.d_min_m = 1;
+        p.d_max_m = 500;
+        p.seed = 11 + (uint64_t)k;
+        p.c_per_km2 = nc_craters_density_for(&p, area, 200000);
+        struct nc_crater_field f;
+        CHECK(nc_craters_generate(&m, &p, NC_CRATERS_MAX, &f) == 0, "%s", nc_errmsg());
+        double *d = malloc(f.n * sizeof *d);
+        size_t over[4] = {0}, oct[8] = {0};
+        int sorted = 1, on = 1;
+        for (size_t i = 0; i < f.n; i++) {
+            const struct nc_crater *c = &f.crater[i];
+            d[i] = c->d_m;
+            for (int j = 0; j < 4; j++)
+                over[j] += c->d_m > 2 * exp2(j);
+            oct[(c->centre_m[0] > 0) | (c->centre_m[1] > 0) << 1 | (c->centre_m[2] > 0) << 2]++;
+            sorted &= i == 0 || f.crater[i - 1].age >= c->age;
+            double r = sqrt(c->centre_m[0] * c->centre_m[0] + c->centre_m[1] * c->centre_m[1] +
+                            c->centre_m[2] * c->centre_m[2]);
+            on &= r <= 1000 * (1 + 1e-12) && r > 990; /* on a face of the icosphere */
+        }
+        double b = nc_test_fit_slope(d, f.n, p.d_min_m, p.d_max_m);
+        CHECK(fabs(b / p.slope - 1) < 0.05, "slope %.4f fitted, %.4f configured", b, p.slope);
+        CHECK(fabs((double)f.n / 200000 - 1) < 0.05, "%zu craters, 200000 expected", f.n);
+        for (int j = 0; j < 4; j++) { /* N(>D) = C A (D^-b - Dmax^-b) at D = 2, 4, 8, 16 m */
+            double D = 2 * exp2(j), want = p.c_per_km2 * area * (pow(D, -p.slope) - pow(p.d_max_m, -p.slope));
+            if (want > 2000)
+                CHECK(fabs((double)over[j] / want - 1) < 0.05, "N(>%g m) = %zu, %.0f expected (slope %g)", D,
+                      over[j], want, p.slope);
+        }
+        for (int o = 0; o < 8; o++)
+            CHECK(fabs((double)oct[o] / ((double)f.n / 8) - 1) < 0.05, "octant %d holds %zu of %zu", o, oct[o], f.n);
+        CHECK(sorted, "the list runs from the oldest crater to the youngest");
+        CHECK(on, "every centre lies on the surface");
+        /* Same seed, same list, bit for bit. */
+        struct nc_crater_field g;
+        CHECK(nc_craters_generate(&m, &p, NC_CRATERS_MAX, &g) == 0, "%s", nc_errmsg());
+        CHECK(g.n == f.n && !memcmp(g.crater, f.crater, f.n * sizeof *f.crater), "same seed, same craters");
+        nc_craters_free(&g);
+        free(d);
+        nc_craters_free(&f);
+    }
+    /* Too many is an error that names the count. */
+    struct nc_crater_params p;
+    nc_crater_params_default(&m, &p);
+    p.c_per_km2 = 1e12;
+    struct nc_crater_field f;
+    CHECK(nc_craters_generate(&m, &p, 1000, &f) == NC_ERANGE && nc_test_contains(nc_errmsg(), "min_diameter_m"),
+          "an absurd population is refused: %s", nc_errmsg());
+    nc_mesh_free(&m);
+}
+
+/* A flat square grid in z = 0, side n * step metres, centred on the origin,
+ * faces wound toward +z. */
+static void grid_mesh(int n, double step, struct nc_mesh *m)
+{
+    m->nv = (size_t)(n + 1) * (size_t)(n + 1);
+    m->nt = 2 * (size_t)n * (size_t)n;
+    m->v = malloc(3 * m->nv * sizeof *m->v);
+    m->tri = malloc(3 * m->nt * sizeof *m->tri);
+    for (int y = 0; y <= n; y++)
+        for (int x = 0; x <= n; x++) {
+            double *v = m->v + 3 * (size_t)(y * (n + 1) + x);
+            v[0] = (x - n / 2) * step;
+            v[1] = (y - n / 2) * step;
+            v[2] = 0;
+        }
+    size_t t = 0;
+    for (int y = 0; y < n; y++)
+        for (int x = 0; x < n; x++) {
+            uint32_t a = (uint32_t)(y * (n + 1) + x), b = a + 1, c = a + (uint32_t)(n + 1), d = c + 1;
+            const uint32_t q[6] = {a, b, d, a, d, c};
+            memcpy(m->tri + 3 * t, q, sizeof q);
+            t += 2;
+        }
+}
+
+/* Height of the grid vertex at (x, y) metres. */
+static double height_at(const struct nc_mesh *m, int n, double step, double x, double y)
+{
+    int i = (int)lround(x / step) + n / 2, j = (int)lround(y / step) + n / 2;
+    return m->v[3 * (size_t)(j * (n + 1) + i) + 2];
+}
+
+static void carve(struct nc_mesh *m, struct nc_crater *c, size_t n, struct nc_crater_field *f)
+{
+    memset(f, 0, sizeof *f);
+    nc_crater_params_default(m, &f->params);
+    f->crater = c;
+    f->n = n;
+    CHECK(nc_craters_apply(f, m) == 0, "%s", nc_errmsg());
+}
+
+static void check_morphology(void)
+{
+    const int n = 200;
+    const double step = 1; /* 200 m square, 1 m spacing */
+    struct nc_mesh m;
+    grid_mesh(n, step, &m);
+    struct nc_crater_params p;
+    nc_crater_params_default(&m, &p);
+    /* A fresh crater of 40 m centred on a vertex. */
+    struct nc_crater c = {.centre_m = {0, 0, 0}, .normal = {0, 0, 1}, .d_m = 40, .age = 0};
+    struct nc_crater_field f;
+    carve(&m, &c, 1, &f);
+    double rim = 0.036 * 40, depth = 0.196 * 40;
+    CHECK(f.applied == 1, "the crater is carved");
+    CHECK(fabs(height_at(&m, n, step, 0, 0) - (rim - depth)) < 1e-9, "floor at %.6f m, %.6f expected (Pike 1977)",
+          height_at(&m, n, step, 0, 0), rim - depth);
+    CHECK(fabs(height_at(&m, n, step, 20, 0) - rim) < 1e-9, "rim crest at %.6f m, %.6f expected",
+          height_at(&m, n, step, 20, 0), rim);
+    CHECK(fabs(height_at(&m, n, step, 10, 0) - (rim - 0.75 * depth)) < 1e-9, "cavity wall at r = R/2: %.6f m",
+          height_at(&m, n, step, 10, 0));
+    /* Ejecta (r/R)^-3, tapered: at r = 2R, rim * (1 - 1/4) / 8. */
+    CHECK(fabs(height_at(&m, n, step, 0, -40) - rim * 0.75 / 8) < 1e-9, "ejecta at 2R: %.6f m, %.6f expected",
+          height_at(&m, n, step, 0, -40), rim * 0.75 / 8);
+    CHECK(height_at(&m, n, step, 60, 0) == 0 && height_at(&m, n, step, 43, 43) == 0, "nothing beyond 3R");
+    nc_mesh_free(&m);
+
+    /* Age: the oldest keeps half its depth (degradation 0.5) and a quarter of its rim. */
+    grid_mesh(n, step, &m);
+    c.age = 0.999;
+    carve(&m, &c, 1, &f);
+    double k = 1 - 0.5 * 0.999;
+    CHECK(fabs(height_at(&m, n, step, 0, 0) - (rim * k * k - depth * k)) < 1e-9, "old floor at %.6f m",
+          height_at(&m, n, step, 0, 0));
+    nc_mesh_free(&m);
+
+    /* Overlap: an old 80 m crater, then a young 20 m one on its wall. Inside
+     * the young cavity the old slope is gone: the floor is the profile about
+     * the mean height the old crater left there, symmetric about its centre. */
+    grid_mesh(n, step, &m);
+    struct nc_crater two[2] = {{.centre_m = {0, 0, 0}, .normal = {0, 0, 1}, .d_m = 80, .age = 0.8},
+                               {.centre_m = {25, 0, 0}, .normal = {0, 0, 1}, .d_m = 20, .age = 0.1}};
+    carve(&m, two, 2, &f);
+    CHECK(f.applied == 2, "both craters carved");
+    double left = height_at(&m, n, step, 25 - 6, 0), right = height_at(&m, n, step, 25 + 6, 0);
+    double up = height_at(&m, n, step, 25, 6), down = height_at(&m, n, step, 25, -6);
+    CHECK(fabs(left - right) < 1e-9 && fabs(up - down) < 1e-9 && fabs(left - up) < 1e-9,
+          "the young cavity erases the old wall: %.6f %.6f %.6f %.6f m", left, right, up, down);
+    double kk = 1 - 0.5 * 0.1;
+    CHECK(fabs((left - height_at(&m, n, step, 25, 0)) - 0.196 * 20 * kk * 0.36) < 1e-9,
+          "young profile: wall at 0.6 R rises %.6f m above the floor", left - height_at(&m, n, step, 25, 0));
+    /* Order matters: the old crater carved last would cut the young one. */
+    struct nc_mesh m2;
+    grid_mesh(n, step, &m2);
+    struct nc_crater swapped[2] = {two[1], two[0]};
+    carve(&m2, swapped, 2, &f);
+    CHECK(fabs(height_at(&m2, n, step, 25 - 6, 0) - height_at(&m2, n, step, 25 + 6, 0)) > 0.1,
+          "carved in the other order the young crater is cut by the old one");
+    nc_mesh_free(&m2);
+    nc_mesh_free(&m);
+
+    /* Smaller than the spacing, between vertices: not carved, not counted. */
+    grid_mesh(n, step, &m);
+    struct nc_crater tiny = {.centre_m = {0.5, 0.5, 0}, .normal = {0, 0, 1}, .d_m = 0.6, .age = 0};
+    carve(&m, &tiny, 1, &f);
+    CHECK(f.applied == 0 && height_at(&m, n, step, 0, 0) == 0, "a crater holding no vertex is left out");
+    nc_mesh_free(&m);
+}
+
+static void check_config(void)
+{
+    const char *base = "bodies:\n"
+                       "  - shape: {type: asteroid, radii_m: [300, 250, 200], subdivisions: 5, seed: 4}\n"
+                       "    material: {model: lambert, A: 0.1}\n"
+                       "sun: {direction: [1, 0, 0]}\n"
+                       "camera: {width_px: 64, height_px: 64, focal_length_m: 0.05, pixel_pitch_m: 1e-5,\n"
+                       "         position_m: [0, -3000, 0], look_at_m: [0, 0, 0], up: [0, 0, 1]}\n";
+    struct nc_scene a, b;
+    /* The number form and the map form with the same count carve the same mesh. */
+    const char *n1[] = {"bodies[0].shape.craters=300"}, *n2[] = {"bodies[0].shape.craters={count: 300}"};
+    nc_test_scene(base, n1, 1, &a);
+    nc_test_scene(base, n2, 1, &b);
+    CHECK(a.body[0].mesh.nv == b.body[0].mesh.nv &&
+              !memcmp(a.body[0].mesh.v, b.body[0].mesh.v, 3 * a.body[0].mesh.nv * sizeof(double)),
+          "craters: 300 and {count: 300} give the same body");
+    nc_scene_free(&b);
+    const char *n3[] = {"bodies[0].shape.craters=0"};
+    nc_test_scene(base, n3, 1, &b);
+    CHECK(memcmp(a.body[0].mesh.v, b.body[0].mesh.v, 3 * a.body[0].mesh.nv * sizeof(double)) != 0,
+          "the craters move the surface");
+    nc_scene_free(&a);
+    nc_scene_free(&b);
+    static const struct {
+        const char *set, *says;
+    } bad[] = {
+        {"bodies[0].shape.craters={count: 10, saturation: 0.05}", "give one of"},
+        {"bodies[0].shape.craters={slope: 2}", "give one of"},
+        {"bodies[0].shape.craters={saturation: 0.05, slope: 3}", "saturation implies slope 2"},
+        {"bodies[0].shape.craters={count: 10, min_diameter_m: 50, max_diameter_m: 20}", "must exceed"},
+        {"bodies[0].shape.craters={count: 10, depth: 0.2}", "depth"},
+        {"bodies[0].shape.craters={density_per_km2: 1e15, min_diameter_m: 0.001}", "min_diameter_m"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        const char *set[] = {bad[i].set};
+        struct nc_scene s;
+        int rc = nc_test_scene_rc(base, set, 1, &s);
+        CHECK(rc < 0 && nc_test_contains(nc_errmsg(), bad[i].says), "%s: rc %d, '%s'", bad[i].set, rc, nc_errmsg());
+        if (rc == 0)
+            nc_scene_free(&s);
+    }
+}
+
+int main(void)
+{
+    check_population();
+    check_morphology();
+    check_config();
+    return nc_test_end();
+}
