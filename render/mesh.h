@@ -35,6 +35,27 @@ struct nc_asteroid_params {
     int craters;       /* mean number of craters of the default population (craters.h) */
     double lump_amplitude; /* relative radius variation of the lumps, e.g. 0.08 */
 };
+/* Relief below the mesh's resolution (mesh_relief.c): the mesh subdivided
+ * until its mean edge is at most edge_m, each new vertex displaced along
+ * the normal as fractional Brownian motion of Hurst exponent hurst would
+ * put a midpoint, E[(h(x + l) - h(x))^2] = s^2 l^(2H), with s measured on
+ * the mesh itself (times amplitude). The mesh's own vertices do not move. */
+struct nc_relief_params {
+    double edge_m;    /* subdivide until the mean edge is at most this, m */
+    double hurst;     /* 0 < H < 1 */
+    double amplitude; /* factor on the measured s (1: continue the model's roughness) */
+    uint64_t seed;
+};
+struct nc_relief_info {
+    int levels;          /* subdivisions made */
+    double model_edge_m; /* the mesh's mean edge before */
+    double edge_m;       /* and after (halved per level) */
+    double s;            /* the s used, m^(1-H) */
+};
+int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t max_triangles,
+                   struct nc_relief_info *info);
+#define NC_RELIEF_MAX_TRIANGLES 8000000
+
 /* More craters than this on one body is an error (a typo in the density). */
 #define NC_CRATERS_MAX 4000000
 int nc_mesh_asteroid(const struct nc_asteroid_params *p, struct nc_mesh *out);
@@ -73,5 +94,12 @@ double nc_mesh_area_m2(const struct nc_mesh *m);
 /* Unit normals at the vertices (3 per vertex, into n), the area-weighted
  * mean of the faces around each; zero for a vertex no face uses. */
 void nc_mesh_vertex_normals(const struct nc_mesh *m, double *n);
+/* One level of subdivision: each triangle into four, a new vertex at the
+ * middle of each edge (appended in the order the faces meet them). place,
+ * if not NULL, may move each new vertex: it gets the edge's ends a < b, the
+ * new vertex's index and its position (the midpoint) to change. */
+typedef void (*nc_mesh_midpoint_fn)(void *ctx, const struct nc_mesh *m, uint32_t a, uint32_t b, uint32_t index,
+                                    double *xyz);
+int nc_mesh_subdivide(struct nc_mesh *m, nc_mesh_midpoint_fn place, void *ctx);
 
 #endif

@@ -15,31 +15,13 @@
 
 /* ---- procedural asteroid ---------------------------------------------- */
 
-/* Edge -> midpoint vertex map, open addressing. */
-struct edge_map {
-    uint64_t *key;
-    uint32_t *val;
-    size_t mask;
-};
-
-static uint32_t midpoint(struct edge_map *em, struct nc_mesh *m, uint32_t a, uint32_t b)
+/* New vertices on the unit sphere. */
+static void on_sphere(void *ctx, const struct nc_mesh *m, uint32_t a, uint32_t b, uint32_t index, double *p)
 {
-    uint64_t k = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
-    size_t h = (size_t)((k * 0x9e3779b97f4a7c15ull) >> 20) & em->mask;
-    while (em->key[h] != UINT64_MAX) {
-        if (em->key[h] == k)
-            return em->val[h];
-        h = (h + 1) & em->mask;
-    }
-    double *p = m->v + 3 * m->nv;
-    for (int i = 0; i < 3; i++)
-        p[i] = 0.5 * (m->v[3 * a + i] + m->v[3 * b + i]);
+    (void)ctx, (void)m, (void)a, (void)b, (void)index;
     double n = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
     for (int i = 0; i < 3; i++)
         p[i] /= n;
-    em->key[h] = k;
-    em->val[h] = (uint32_t)m->nv;
-    return (uint32_t)m->nv++;
 }
 
 int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
@@ -47,29 +29,12 @@ int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
     memset(out, 0, sizeof *out);
     if (ap->subdivisions < 0 || ap->subdivisions > 9)
         return nc_error(NC_ERANGE, "asteroid subdivisions must be 0..9, got %d", ap->subdivisions);
-    size_t nt = 20, nv = 12, ne = 30;
-    for (int i = 0; i < ap->subdivisions; i++) {
-        nv += ne;
-        ne = 2 * ne + 3 * nt;
-        nt *= 4;
-    }
     struct nc_mesh m = {0};
-    m.v = malloc(nv * 3 * sizeof *m.v);
-    m.tri = malloc(nt * 3 * sizeof *m.tri);
-    uint32_t *tmp = malloc(nt * 3 * sizeof *tmp);
-    struct edge_map em = {0};
-    size_t cap = 64;
-    while (cap < 2 * ne)
-        cap *= 2;
-    em.key = malloc(cap * sizeof *em.key);
-    em.val = malloc(cap * sizeof *em.val);
-    em.mask = cap - 1;
-    if (!m.v || !m.tri || !tmp || !em.key || !em.val) {
-        free(tmp);
-        free(em.key);
-        free(em.val);
+    m.v = malloc(12 * 3 * sizeof *m.v);
+    m.tri = malloc(20 * 3 * sizeof *m.tri);
+    if (!m.v || !m.tri) {
         nc_mesh_free(&m);
-        return nc_error(-ENOMEM, "asteroid: out of memory for %zu triangles", nt);
+        return nc_error(-ENOMEM, "asteroid: out of memory");
     }
     /* Icosahedron. */
     const double t = (1 + sqrt(5.0)) / 2;
@@ -86,21 +51,12 @@ int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
     m.nv = 12;
     m.nt = 20;
     for (int s = 0; s < ap->subdivisions; s++) {
-        memset(em.key, 0xff, cap * sizeof *em.key);
-        size_t n = 0;
-        for (size_t f = 0; f < m.nt; f++) {
-            uint32_t a = m.tri[3 * f], b = m.tri[3 * f + 1], c = m.tri[3 * f + 2];
-            uint32_t ab = midpoint(&em, &m, a, b), bc = midpoint(&em, &m, b, c), ca = midpoint(&em, &m, c, a);
-            const uint32_t nf[4][3] = {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}};
-            memcpy(tmp + 3 * n, nf, sizeof nf);
-            n += 4;
+        int rc = nc_mesh_subdivide(&m, on_sphere, NULL);
+        if (rc < 0) {
+            nc_mesh_free(&m);
+            return rc;
         }
-        memcpy(m.tri, tmp, n * 3 * sizeof *tmp);
-        m.nt = n;
     }
-    free(tmp);
-    free(em.key);
-    free(em.val);
 
     /* Lumps: centre direction, angular radius (rad), relative amplitude. */
     uint64_t rng = ap->seed ^ 0x4e6176436d417374ull;

@@ -1,6 +1,7 @@
 /* scene_detail.c - a body's surface detail from its configuration
- * (docs/terrain.md): craters carved into its mesh (shape.craters), how
- * the mesh is shaded (shape.normals), and boulders on it (boulders). Reads config nodes, builds render/ data; no
+ * (docs/terrain.md): relief below its mesh's resolution (shape.relief),
+ * craters carved into it (shape.craters), how the mesh is shaded
+ * (shape.normals), and boulders on it (boulders). Reads config nodes, builds render/ data; no
  * rendering here. */
 #include "render/scene.h"
 
@@ -152,6 +153,38 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
     return 0;
 }
 
+/* `shape.relief` of a mesh or asteroid: fBm relief below its resolution. */
+static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+{
+    struct nc_cfg_node *map;
+    int rc;
+    if ((rc = nc_cfg_map(sh, "relief", &map)) <= 0)
+        return rc;
+    if (b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+        return nc_cfg_error(nc_cfg_get(sh, "relief"), "relief needs a mesh or asteroid shape");
+    struct nc_relief_params p = {.hurst = 0.8, .amplitude = 1, .seed = 1};
+    long v;
+    if ((rc = nc_cfg_double(map, "edge_m", 1e-6, 1e7, &p.edge_m)) <= 0)
+        return rc ? rc : nc_cfg_missing(map, "edge_m", "the mean edge length to subdivide down to, metres");
+    if ((rc = nc_cfg_double(map, "hurst", 0.01, 0.99, &p.hurst)) < 0 ||
+        (rc = nc_cfg_double(map, "amplitude", 0, 100, &p.amplitude)) < 0 ||
+        (rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+        return rc;
+    if (rc)
+        p.seed = (uint64_t)v;
+    struct nc_relief_info info;
+    if ((rc = nc_mesh_relief(&b->mesh, &p, NC_RELIEF_MAX_TRIANGLES, &info)) < 0) {
+        char why[512];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_cfg_error(map, "%s", why);
+    }
+    nc_log_info("scene", "body '%s': relief from mean edges of %.4g m down to %.4g m (%d subdivisions, %zu triangles; "
+                "Hurst %g, s = %.4g m^%g measured on the mesh x %g)", b->name, info.model_edge_m, info.edge_m,
+                info.levels, b->mesh.nt, p.hurst, info.s, 1 - p.hurst, p.amplitude);
+    b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
+    return 0;
+}
+
 int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b)
 {
     static const char *const normals[] = {"flat", "smooth", NULL};
@@ -161,7 +194,7 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
     if (rc && b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
         return nc_cfg_error(nc_cfg_get(shape, "normals"), "normals apply to mesh and asteroid shapes");
     b->smooth_normals = smooth;
-    if ((rc = craters_from_config(shape, b)) < 0)
+    if ((rc = relief_from_config(shape, b)) < 0 || (rc = craters_from_config(shape, b)) < 0)
         return rc;
     return boulders_from_config(item, b);
 }
