@@ -159,5 +159,13 @@ expect 1 "cam.yaml:3: sensor.gain: unknown key" -- sh -c "sed 's/gain_e_per_dn/g
 expect 2 "missing --radiance L (or --dark)" -- "$navcam" expose "$cam" -o "$tmp/x.fits"
 expect 0 "photon transfer" -- "$navcam" expose --help
 
+# Every example scene renders (the camera-only ones overlay a scene; the
+# shape models come from ../shared/data/shapes, next to the checkout).
+for f in "$src"/configs/examples/*.yaml; do
+  grep -q '^bodies:' "$f" || continue
+  expect 0 "wrote $tmp/example.png: 48x48" -- "$navcam" render "$f" -o "$tmp/example.png" \
+    --set camera.width_px=48 --set camera.height_px=48
+done
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
