@@ -163,6 +163,10 @@ expect 0 "photon transfer" -- "$navcam" expose --help
 # shape models come from ../shared/data/shapes, next to the checkout).
 for f in "$src"/configs/examples/*.yaml; do
   grep -q '^bodies:' "$f" || continue
+  if grep -q 'shared/data/shapes' "$f" && [ ! -d "$src/../shared/data/shapes" ]; then
+    echo "note: $f needs $src/../shared/data/shapes, which this checkout has not beside it"
+    continue
+  fi
   expect 0 "wrote $tmp/example.png: 48x48" -- "$navcam" render "$f" -o "$tmp/example.png" \
     --set camera.width_px=48 --set camera.height_px=48
 done
