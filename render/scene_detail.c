@@ -1,12 +1,12 @@
 /* scene_detail.c - a body's surface detail from its configuration
  * (docs/terrain.md): relief below its mesh's resolution (shape.relief),
  * craters carved into it (shape.craters), how the mesh is shaded
- * (shape.normals), and boulders on it (boulders). Reads config nodes, builds render/ data; no
- * rendering here. */
+ * (shape.normals), and boulders on it (boulders). Reads config nodes and
+ * builds render/ data; no rendering here. */
 #include "render/scene.h"
 
-#include <stdio.h>
 #include <math.h>
+#include <stdio.h>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -55,8 +55,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
             return nc_cfg_error(nc_cfg_get(map, "slope"), "saturation implies slope 2");
         if (has_s) /* Gault (1970): geometric saturation N(>D) = 1.54 D^-2 per km^2, D in km */
             p.c_per_km2 = sat * 1.54e6;
-        if (
-            (rc = nc_cfg_double(map, "min_diameter_m", 1e-6, 1e7, &p.d_min_m)) < 0 ||
+        if ((rc = nc_cfg_double(map, "min_diameter_m", 1e-6, 1e7, &p.d_min_m)) < 0 ||
             (rc = nc_cfg_double(map, "max_diameter_m", 1e-6, 2e7, &p.d_max_m)) < 0 ||
             (rc = nc_cfg_double(map, "depth_ratio", 0, 1, &p.depth_ratio)) < 0 ||
             (rc = nc_cfg_double(map, "rim_ratio", 0, 1, &p.rim_ratio)) < 0 ||
