@@ -273,10 +273,8 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
         return rc;
     if (rc)
         s->adc_bits = (int)v;
-    if ((rc = nc_cfg_int(m, "seed", 0, 0x7fffffffL, &v)) < 0)
+    if ((rc = nc_cfg_seed(m, "seed", &s->seed)) < 0)
         return rc;
-    if (rc)
-        s->seed = (uint64_t)v;
     struct nc_cfg_node *cr;
     if ((rc = nc_cfg_map(m, "cosmic_rays", &cr)) < 0)
         return rc;

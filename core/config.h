@@ -10,6 +10,7 @@
 #define NC_CONFIG_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "core/vec.h"
 
@@ -55,6 +56,8 @@ int nc_cfg_map(struct nc_cfg_node *parent, const char *key, struct nc_cfg_node *
 int nc_cfg_seq(struct nc_cfg_node *parent, const char *key, struct nc_cfg_node **out);
 int nc_cfg_double(struct nc_cfg_node *parent, const char *key, double min, double max, double *out);
 int nc_cfg_int(struct nc_cfg_node *parent, const char *key, long min, long max, long *out);
+/* A random seed: a whole number in [0, 2^31 - 1]. */
+int nc_cfg_seed(struct nc_cfg_node *parent, const char *key, uint64_t *out);
 int nc_cfg_string(struct nc_cfg_node *parent, const char *key, const char **out);
 int nc_cfg_enum(struct nc_cfg_node *parent, const char *key, const char *const *names, int *out);
 int nc_cfg_doubles(struct nc_cfg_node *parent, const char *key, double *out, size_t n);

@@ -106,6 +106,15 @@ int nc_cfg_int(struct nc_cfg_node *parent, const char *key, long min, long max, 
     return 1;
 }
 
+int nc_cfg_seed(struct nc_cfg_node *parent, const char *key, uint64_t *out)
+{
+    long v = 0;
+    int rc = nc_cfg_int(parent, key, 0, 0x7fffffffL, &v);
+    if (rc > 0)
+        *out = (uint64_t)v;
+    return rc;
+}
+
 int nc_cfg_string(struct nc_cfg_node *parent, const char *key, const char **out)
 {
     struct nc_cfg_node *n = nc_cfg_get(parent, key);

@@ -111,7 +111,10 @@ int nc_craters_generate(const struct nc_mesh *m, const struct nc_crater_params *
     return 0;
 }
 
-double nc_crater_profile(const struct nc_crater_params *p, const struct nc_crater *c, double r, double *erase)
+/* Height of a crater's profile above the pre-impact surface at r = distance
+ * / radius, metres, and the weight (0..1) with which it replaces the older
+ * relief there. */
+static double profile(const struct nc_crater_params *p, const struct nc_crater *c, double r, double *erase)
 {
     /* Degradation: the depth falls linearly with age and the rim, the most
      * exposed part, as its square (a stated model, not a fitted one). */
@@ -265,7 +268,7 @@ int nc_craters_apply(struct nc_crater_field *f, struct nc_mesh *m)
         ref /= (double)inside;
         f->applied++;
         for (size_t j = 0; j < nb.n; j++) {
-            double erase, dh = nc_crater_profile(&f->params, c, nb.dist[j] / R, &erase);
+            double erase, dh = profile(&f->params, c, nb.dist[j] / R, &erase);
             double *hv = &h[nb.v[j]];
             *hv += erase * (ref - *hv) + dh;
         }

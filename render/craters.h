@@ -18,6 +18,9 @@
 
 #include "render/mesh.h"
 
+/* More craters than this on one body is an error (a typo in the density). */
+#define NC_CRATERS_MAX 4000000
+
 struct nc_crater_params {
     double c_per_km2;   /* C of N(>D) = C D^-b per km^2, D in metres: N(>1 m) */
     double slope;       /* b > 0 */
@@ -57,10 +60,6 @@ double nc_craters_density_for(const struct nc_crater_params *p, double area_km2,
  * (more is an error naming the count). The count is Poisson. */
 int nc_craters_generate(const struct nc_mesh *m, const struct nc_crater_params *p, size_t max_craters,
                         struct nc_crater_field *out);
-/* Height of a crater's profile above the pre-impact surface at r = distance
- * / radius, metres, and the weight (0..1) with which it replaces the older
- * relief there. */
-double nc_crater_profile(const struct nc_crater_params *p, const struct nc_crater *c, double r, double *erase);
 /* Carve the field into m, oldest crater first: each vertex moves along its
  * (pre-crater) normal. A crater whose cavity holds no vertex is below the
  * mesh's resolution and left out (f->applied counts the others). */

@@ -56,8 +56,6 @@ int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t m
                    struct nc_relief_info *info);
 #define NC_RELIEF_MAX_TRIANGLES 8000000
 
-/* More craters than this on one body is an error (a typo in the density). */
-#define NC_CRATERS_MAX 4000000
 int nc_mesh_asteroid(const struct nc_asteroid_params *p, struct nc_mesh *out);
 
 /* Levels of detail (mesh_lod.c): level 0 is the mesh itself (its own

@@ -13,8 +13,6 @@
 #include "core/error.h"
 #include "core/rng.h"
 
-#define TAG_RELIEF 0x52454c494546ull
-
 /* For fBm with E[(h(x + l) - h(x))^2] = s^2 l^(2H), the midpoint of a
  * segment of length l departs from the mean of its ends by a Gaussian of
  * variance s^2 l^(2H) (2^(-2H) - 1/4) (from the increments' covariance). */

@@ -114,10 +114,8 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
             return rc;
         if (rc)
             ap.subdivisions = (int)v;
-        if ((rc = nc_cfg_int(sh, "seed", 0, 0x7fffffffL, &v)) < 0)
+        if ((rc = nc_cfg_seed(sh, "seed", &ap.seed)) < 0)
             return rc;
-        if (rc)
-            ap.seed = (uint64_t)v;
         if ((rc = nc_cfg_double(sh, "lump_amplitude", 0, 0.5, &ap.lump_amplitude)) < 0)
             return rc;
         if ((rc = nc_mesh_asteroid(&ap, &b->mesh)) < 0)
@@ -239,10 +237,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
                                 "expected a square number (1, 4, 9, 16, ...) for n x n stratified samples, got %ld", v);
         r->samples_per_pixel = (int)v;
     }
-    if ((rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+    if ((rc = nc_cfg_seed(map, "seed", &r->seed)) < 0)
         return rc;
-    if (rc)
-        r->seed = (uint64_t)v;
     if ((rc = nc_cfg_int(map, "threads", 0, 1024, &v)) < 0)
         return rc;
     if (rc)

@@ -12,6 +12,18 @@
 #include "core/log.h"
 #include "render/craters.h"
 
+/* Detail needs a triangle mesh: a loaded one or the asteroid's. */
+static int has_mesh(const struct nc_body *b) { return b->shape == NC_SHAPE_MESH || b->shape == NC_SHAPE_ASTEROID; }
+
+/* The error just set (by a generator) restated at config node n, with its
+ * file and line. */
+static int error_at(const struct nc_cfg_node *n)
+{
+    char why[512];
+    snprintf(why, sizeof why, "%s", nc_errmsg());
+    return nc_cfg_error(n, "%s", why);
+}
+
 /* `shape.craters` of a mesh or asteroid: a mean count of the default
  * population (a number), or a map of its parameters. An asteroid without
  * the key gets 100. */
@@ -20,17 +32,15 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
     if (!node && b->shape != NC_SHAPE_ASTEROID)
         return 0;
-    if (node && b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+    if (node && !has_mesh(b))
         return nc_cfg_error(node, "craters need a mesh or asteroid shape");
     struct nc_crater_params p;
     nc_crater_params_default(&b->mesh, &p);
     double area_km2 = 1e-6 * nc_mesh_area_m2(&b->mesh), count = 100;
     long v;
     int rc;
-    if ((rc = nc_cfg_int(sh, "seed", 0, 0x7fffffffL, &v)) < 0)
+    if ((rc = nc_cfg_seed(sh, "seed", &p.seed)) < 0)
         return rc;
-    if (rc)
-        p.seed = (uint64_t)v;
     if (node && node->kind == NC_CFG_SCALAR) {
         if ((rc = nc_cfg_int(sh, "craters", 0, 1000000, &v)) < 0)
             return rc;
@@ -64,10 +74,8 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         if (!(p.d_max_m > p.d_min_m))
             return nc_cfg_error(nc_cfg_get(map, "max_diameter_m") ? nc_cfg_get(map, "max_diameter_m") : map,
                                 "max_diameter_m (%g) must exceed min_diameter_m (%g)", p.d_max_m, p.d_min_m);
-        if ((rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+        if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
             return rc;
-        if (rc)
-            p.seed = (uint64_t)v;
     }
     if (count >= 0)
         p.c_per_km2 = nc_craters_density_for(&p, area_km2, count);
@@ -75,10 +83,8 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     if ((rc = nc_craters_generate(&b->mesh, &p, NC_CRATERS_MAX, &f)) == 0)
         rc = nc_craters_apply(&f, &b->mesh);
     if (rc < 0) {
-        char why[512];
-        snprintf(why, sizeof why, "%s", nc_errmsg());
         nc_craters_free(&f);
-        return nc_cfg_error(node ? node : sh, "%s", why);
+        return error_at(node ? node : sh);
     }
     if (f.n)
         nc_log_info("scene", "body '%s': %zu craters of %.3g to %.3g m (N(>1 m) = %.4g per km^2, slope %g, seed %llu), "
@@ -102,7 +108,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
     int rc, has_c, has_slope;
     if ((rc = nc_cfg_map(item, "boulders", &map)) <= 0)
         return rc;
-    if (b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+    if (!has_mesh(b))
         return nc_cfg_error(nc_cfg_get(item, "boulders"), "boulders need a mesh or asteroid shape");
     struct nc_boulder_params p = {.d_min_m = 1, .d_max_m = 64, .burial_min = 0.1, .burial_max = 0.5, .shapes = 48,
                                   .seed = 1};
@@ -136,14 +142,10 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
         return rc;
     if (rc)
         p.shapes = (int)v;
-    if ((rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+    if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
         return rc;
-    if (rc)
-        p.seed = (uint64_t)v;
     if ((rc = nc_boulders_generate(&b->mesh, &p, MAX_BOULDERS, &b->boulders)) < 0) {
-        char why[512];
-        snprintf(why, sizeof why, "%s", nc_errmsg());
-        return nc_cfg_error(map, "%s", why);
+        return error_at(map);
     }
     /* rocks standing out past the mesh's farthest vertex widen the body */
     b->bounding_radius_m = fmax(b->bounding_radius_m, nc_boulders_bounding_radius(&b->boulders));
@@ -159,23 +161,18 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     int rc;
     if ((rc = nc_cfg_map(sh, "relief", &map)) <= 0)
         return rc;
-    if (b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+    if (!has_mesh(b))
         return nc_cfg_error(nc_cfg_get(sh, "relief"), "relief needs a mesh or asteroid shape");
     struct nc_relief_params p = {.hurst = 0.8, .amplitude = 1, .seed = 1};
-    long v;
     if ((rc = nc_cfg_double(map, "edge_m", 1e-6, 1e7, &p.edge_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "edge_m", "the mean edge length to subdivide down to, metres");
     if ((rc = nc_cfg_double(map, "hurst", 0.01, 0.99, &p.hurst)) < 0 ||
         (rc = nc_cfg_double(map, "amplitude", 0, 100, &p.amplitude)) < 0 ||
-        (rc = nc_cfg_int(map, "seed", 0, 0x7fffffffL, &v)) < 0)
+        (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
         return rc;
-    if (rc)
-        p.seed = (uint64_t)v;
     struct nc_relief_info info;
     if ((rc = nc_mesh_relief(&b->mesh, &p, NC_RELIEF_MAX_TRIANGLES, &info)) < 0) {
-        char why[512];
-        snprintf(why, sizeof why, "%s", nc_errmsg());
-        return nc_cfg_error(map, "%s", why);
+        return error_at(map);
     }
     nc_log_info("scene", "body '%s': relief from mean edges of %.4g m down to %.4g m (%d subdivisions, %zu triangles; "
                 "Hurst %g, s = %.4g m^%g measured on the mesh x %g)", b->name, info.model_edge_m, info.edge_m,
@@ -190,7 +187,7 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
     int rc, smooth = 0;
     if ((rc = nc_cfg_enum(shape, "normals", normals, &smooth)) < 0)
         return rc;
-    if (rc && b->shape != NC_SHAPE_MESH && b->shape != NC_SHAPE_ASTEROID)
+    if (rc && !has_mesh(b))
         return nc_cfg_error(nc_cfg_get(shape, "normals"), "normals apply to mesh and asteroid shapes");
     b->smooth_normals = smooth;
     if ((rc = relief_from_config(shape, b)) < 0 || (rc = craters_from_config(shape, b)) < 0)
