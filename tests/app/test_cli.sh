@@ -159,6 +159,10 @@ expect 1 "cam.yaml:3: sensor.gain: unknown key" -- sh -c "sed 's/gain_e_per_dn/g
 expect 2 "missing --radiance L (or --dark)" -- "$navcam" expose "$cam" -o "$tmp/x.fits"
 expect 0 "photon transfer" -- "$navcam" expose --help
 
+# The shading choice is recorded in the file.
+"$navcam" render "${small[@]}" --set bodies.0.shape.normals=smooth -o "$tmp/smooth.fits" >/dev/null 2>&1
+head -c 28800 "$tmp/smooth.fits" | grep -aq "NORMALS = 'asteroid=smooth'" && ok || bad "smooth.fits lacks NORMALS = 'asteroid=smooth'"
+
 # Every example scene renders (the camera-only ones overlay a scene; the
 # shape models come from ../shared/data/shapes, next to the checkout).
 for f in "$src"/configs/examples/*.yaml; do
