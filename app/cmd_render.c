@@ -221,10 +221,18 @@ int main(int argc, char **argv)
         if (scene.body[i].shape == NC_SHAPE_MESH || scene.body[i].shape == NC_SHAPE_ASTEROID)
             o += snprintf(normals + o, sizeof normals - (size_t)o, "%s%s=%s", o ? "," : "", scene.body[i].name,
                           scene.body[i].smooth_normals ? "smooth" : "flat");
-    struct nc_image_attr extra[4] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}};
+    /* The roughness each body's rocks not traced were folded into. */
+    char fold[NC_MAX_BODIES * 80] = "";
+    for (int i = 0, o = 0; i < scene.nbodies; i++)
+        if (r.fold_theta_bar_deg[i] >= 0)
+            o += snprintf(fold + o, sizeof fold - (size_t)o, "%s%s=%.6g", o ? "," : "", scene.body[i].name,
+                          r.fold_theta_bar_deg[i]);
+    struct nc_image_attr extra[5] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}, {0}};
     int nextra = 2;
     if (normals[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:normals", normals};
+    if (fold[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:rock_fold_theta_bar_deg", fold};
     if (rows)
         extra[nextra++] = row_attr;
     if (rc >= 0 && q <= NC_Q_RANGE)
@@ -242,10 +250,20 @@ int main(int argc, char **argv)
         struct nc_rt_stats st;
         nc_rt_get_stats(r.rt, &st);
         for (int i = 0; i < scene.nbodies; i++)
-            if (scene.body[i].boulders.n)
-                printf("  boulders of '%s': %zu of %zu traced, %.3g m and larger (render.boulder_min_px %g)\n",
-                       scene.body[i].name, st.boulders_traced[i], scene.body[i].boulders.n, st.boulder_min_m[i],
-                       scene.render.boulder_min_px);
+            if (scene.body[i].boulders.n) {
+                printf("  boulders of '%s': %zu of %zu traced, %.3g m and larger (%g px)", scene.body[i].name,
+                       st.boulders_traced[i], scene.body[i].boulders.n, st.boulder_min_m[i],
+                       nc_scene_boulder_min_px(&scene, i));
+                int k = nc_material_roughness_param(&scene.body[i].material);
+                if (r.fold_theta_bar_deg[i] >= 0)
+                    printf("; the rest (cover %.3g) folded into the reflectance: theta_bar %.3g -> %.3g deg\n",
+                           st.boulder_cut_cover[i], scene.body[i].material.p[k], r.fold_theta_bar_deg[i]);
+                else if (st.boulder_cut_cover[i] > 0)
+                    printf("; the rest (cover %.3g) NOT folded in (%s)\n", st.boulder_cut_cover[i],
+                           k < 0 ? "the material has no roughness parameter" : "render.boulder_fold is false");
+                else
+                    printf("\n");
+            }
         if (scale > 0)
             printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));
     }

@@ -6,16 +6,17 @@
  * medium (1.5 km: the body fills the frame) and close (300 m above the
  * surface, 7 cm pixels). Per range: the frame time of each (median of N
  * frames after one untimed), their ratio; the same with the rocks under
- * one pixel at the nearest range left out (render.boulder_min_px: 1), the
- * rocks that leaves and how much brighter the frame is without them
- * (cut_flux: total radiance / that with every rock - 1; they are not folded
- * into the reflectance yet); and the time of a pose update that moves the
+ * one pixel at the nearest range left out (render.boulder_min_px: 1, the
+ * default for this Hapke material), the rocks that leaves and how the
+ * frame's brightness moves with them folded into the roughness (cut_flux:
+ * total radiance / that with every rock - 1; theta_bar the roughness used)
+ * and without the fold (unfolded_flux); and the time of a pose update that moves the
  * anchor (the rocks' tree rebuilt). Memory: resident memory the rubble
  * scene and its renderer take beyond the bare ones.
  * Usage: bench_rubble [--frames N] [--threads N]
  * One line per range:
  *   range=far ... bare_ms=... rubble_ms=... ratio=... memory_mb=... cut_ms=... cut_ratio=... traced=...
- *   cut_flux=... reanchor_ms=...
+ *   theta_bar=... cut_flux=... unfolded_flux=... reanchor_ms=...
  */
 #include <math.h>
 #include <stdio.h>
@@ -143,12 +144,18 @@ int main(int argc, char **argv)
         double re = reanchor_ms(&rubble, fabs(ranges[k].y_m)), re_bare = reanchor_ms(&bare, fabs(ranges[k].y_m));
         rubble.s.render.boulder_min_px = 1;
         double c = frame_ms(&rubble, frames), flux = sum(&rubble.f) / all - 1;
+        double theta = rubble.r.fold_theta_bar_deg[0];
         struct nc_rt_stats st;
         nc_rt_get_stats(rubble.r.rt, &st);
+        rubble.s.render.boulder_fold = 0;
+        if (nc_render_frame(&rubble.r, &rubble.s, &rubble.f) < 0)
+            die();
+        double unfolded = sum(&rubble.f) / all - 1;
+        rubble.s.render.boulder_fold = 1;
         printf("range=%s distance_m=%.0f bare_ms=%.1f rubble_ms=%.1f ratio=%.2f memory_mb=%.1f rocks=%zu cut_ms=%.1f "
-               "cut_ratio=%.2f traced=%zu min_d_m=%.3f cut_flux=%+.4f reanchor_ms=%.1f reanchor_bare_ms=%.1f\n",
+               "cut_ratio=%.2f traced=%zu min_d_m=%.3f theta_bar=%.2f cut_flux=%+.4f unfolded_flux=%+.4f reanchor_ms=%.1f reanchor_bare_ms=%.1f\n",
                ranges[k].name, fabs(ranges[k].y_m), b, r, r / b, rubble.mem_mb - bare.mem_mb, f->n, c, c / b,
-               st.boulders_traced[0], st.boulder_min_m[0], flux, re, re_bare);
+               st.boulders_traced[0], st.boulder_min_m[0], theta, flux, unfolded, re, re_bare);
         fflush(stdout);
     }
     nc_frame_free(&rubble.f);

@@ -126,7 +126,7 @@ struct staged {
     enum nc_pose_quality q;
     int64_t gap, t0, t1; /* render start and end, CLOCK_MONOTONIC */
     int rc, ts, buf;
-    double lod_error_m, boulder_min_m;
+    double lod_error_m, boulder_min_m, rock_fold_theta_bar_deg;
 };
 
 /* The camera-model stage: in free-run and trigger modes (unless
@@ -187,7 +187,8 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .exposure_end_sim_ns = start_sim + exp_ns, .trigger_mono_ns = j->trigger_mono_ns,
         .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = x->pose,
         .pose_quality = x->q, .pose_gap_ns = x->gap, .exposure_s = j->exposure_s, .gain_db = j->gain_db,
-        .time_samples = x->ts, .lod_error_m = x->lod_error_m, .boulder_min_m = x->boulder_min_m, .render_ms = (x->t1 - x->t0) * 1e-6,
+        .time_samples = x->ts, .lod_error_m = x->lod_error_m, .boulder_min_m = x->boulder_min_m,
+        .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .render_ms = (x->t1 - x->t0) * 1e-6,
         .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
         .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
     fill_slot(e);
@@ -276,6 +277,7 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         x.t1 = nc_mono_ns();
         x.lod_error_m = nc_rt_lod_error_m(e->renderer.rt);
         x.boulder_min_m = nc_rt_boulder_min_m(e->renderer.rt);
+        x.rock_fold_theta_bar_deg = nc_render_fold_theta_bar_deg(&e->renderer, at.nbodies);
         if (overlap) {
             atomic_store(&e->readout_end_ns, 0); /* the next exposure may start rendering */
             hand_over(st, &x);

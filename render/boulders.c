@@ -204,7 +204,8 @@ int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params
         return nc_error(-ENOMEM, "out of memory");
     for (int i = 0; i < p->shapes; i++)
         rock_shape(p->seed, i, &out->shape[i]);
-    double area_km2 = 1e-6 * nc_mesh_area_m2(m); /* refuse an absurd population before drawing it */
+    out->area_m2 = nc_mesh_area_m2(m);
+    double area_km2 = 1e-6 * out->area_m2; /* refuse an absurd population before drawing it */
     if (nc_boulders_expected(p, area_km2) > 1.01 * (double)max_rocks) {
         nc_boulders_free(out);
         return nc_error(NC_ERANGE, "about %.3g boulders expected on %.4g km^2, more than %zu: raise min_diameter_m or "
@@ -249,6 +250,14 @@ size_t nc_boulders_at_least(const struct nc_boulder_field *f, double d_m)
             hi = mid;
     }
     return lo;
+}
+
+double nc_boulders_cover(const struct nc_boulder_field *f, size_t from)
+{
+    double sum = 0; /* in list order: the same bits on every call */
+    for (size_t i = from; i < f->n; i++)
+        sum += (double)f->rock[i].half_m * f->rock[i].half_m;
+    return f->area_m2 > 0 ? M_PI * sum / f->area_m2 : 0.0;
 }
 
 double nc_boulders_bounding_radius(const struct nc_boulder_field *f)

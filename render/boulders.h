@@ -74,6 +74,7 @@ struct nc_boulder_field {
     struct nc_rock_shape *shape;
     int nshapes;
     struct nc_boulder_params params;
+    double area_m2; /* the surface they lie on */
 };
 
 /* Presets from the literature (docs/terrain.md gives the sources): "bennu",
@@ -87,6 +88,10 @@ int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params
                          struct nc_boulder_field *out);
 /* How many rocks have a diameter of at least d_m (a prefix of the list). */
 size_t nc_boulders_at_least(const struct nc_boulder_field *f, double d_m);
+/* The cover of the rocks rock[from .. n): the sum of the disks of their
+ * longest dimensions, pi (D/2)^2, over the surface's area (may exceed 1).
+ * What the reflectance folds in for rocks that are not traced (material.h). */
+double nc_boulders_cover(const struct nc_boulder_field *f, size_t from);
 /* The radius of the sphere about the body origin that holds every rock
  * (0 for none). */
 double nc_boulders_bounding_radius(const struct nc_boulder_field *f);

@@ -56,6 +56,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:lod_error_m", "LODERR"},
     {"navcam:boulder_min_m", "ROCKMIN"},
     {"navcam:normals", "NORMALS"},
+    {"navcam:rock_fold_theta_bar_deg", "ROCKFOLD"},
 };
 
 /* 1 when attrs ask for the archive row order (row 1 at the bottom). */

@@ -108,6 +108,29 @@ int nc_material_finish(struct nc_material *m)
     return 0;
 }
 
+int nc_material_roughness_param(const struct nc_material *m)
+{
+    for (int i = 0; i < m->model->nparams; i++)
+        if (!strcmp(m->model->params[i].key, "theta_bar"))
+            return i;
+    return -1;
+}
+
+double nc_material_fold_rocks(const struct nc_material *m, double cover, struct nc_material *out)
+{
+    *out = *m;
+    int k = nc_material_roughness_param(m);
+    if (k < 0)
+        return -1;
+    const double rad = M_PI / 180.0, t0 = tan(m->p[k] * rad);
+    const double t1sq = NC_ROCK_FOLD_TAN * NC_ROCK_FOLD_TAN * -expm1(-NC_ROCK_FOLD_C * cover);
+    double deg = atan(sqrt(t0 * t0 + t1sq)) / rad;
+    out->p[k] = fmin(deg, m->model->params[k].max);
+    if (m->model->prepare)
+        m->model->prepare(out->p, out->c);
+    return out->p[k];
+}
+
 int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
 {
     static const char *names[8];

@@ -85,6 +85,24 @@ int nc_material_finish(struct nc_material *m);
 int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m);
 void nc_material_free(struct nc_material *m);
 
+/* Rocks too small to trace, folded into the reflectance as macroscopic
+ * roughness (docs/terrain.md). Rocks covering a fraction `cover` of the
+ * surface (nc_boulders_cover) add to the mean square slope, in proportion to
+ * the ground they and their shadows take, which saturates as they overlap:
+ *   tan^2 theta_bar' = tan^2 theta_bar + TAN^2 (1 - exp(-C cover)),
+ * at most the parameter's upper bound. For a small cover the added term is
+ * TAN^2 C cover, linear in the area as a slope variance is; a surface wholly
+ * of rocks adds atan(TAN) = 28.8 deg. TAN and C were fitted to rendered rocks
+ * on two scenes (docs/terrain.md); test_boulders checks them on others.
+ * Only models with a roughness parameter named theta_bar (degrees) can fold:
+ * the index of that parameter, or -1. */
+#define NC_ROCK_FOLD_TAN 0.55
+#define NC_ROCK_FOLD_C 4.0
+int nc_material_roughness_param(const struct nc_material *m);
+/* out = m with the rocks folded in (sharing m's albedo map: never free
+ * out); returns the theta_bar used, degrees, or -1 (out = m) where m cannot fold. */
+double nc_material_fold_rocks(const struct nc_material *m, double cover, struct nc_material *out);
+
 /* Photometric quantities of one geometry given in degrees: out = {r, BRDF,
  * RADF, REFF}. i >= 90 or e >= 90 gives zeros. Returns < 0 (message naming
  * the problem) for a geometry that cannot exist: any angle outside 0..180, or

@@ -52,7 +52,17 @@ int nc_renderer_init(struct nc_renderer *r, const struct nc_scene *s, int thread
         threads = n > 0 ? (int)n : 1;
     }
     r->threads = threads;
+    for (int i = 0; i < NC_MAX_BODIES; i++)
+        r->fold_theta_bar_deg[i] = -1;
     return nc_rt_create(s, threads, &r->rt);
+}
+
+double nc_render_fold_theta_bar_deg(const struct nc_renderer *r, int nbodies)
+{
+    double d = -1;
+    for (int i = 0; i < nbodies; i++)
+        d = fmax(d, r->fold_theta_bar_deg[i]);
+    return d;
 }
 
 void nc_renderer_free(struct nc_renderer *r)
@@ -92,6 +102,7 @@ struct job {
     } *row;
     struct nc_mat3 body_R[NC_MAX_BODIES];      /* body -> scene */
     struct nc_vec3 body_rel[NC_MAX_BODIES];    /* body origin - camera, scene frame, m */
+    struct nc_material mat[NC_MAX_BODIES];     /* each body's, with its rocks not traced folded in */
     int tiles_x, tiles_y, n_strata;
     int tile_row_begin, tile_row_end; /* the rows of tiles to render */
     atomic_int next;
@@ -301,7 +312,7 @@ static void shade_tile(struct job *j, int tile)
                         }
                     }
                     ntodo = rest;
-                    nc_material_eval(&s->body[body].material, (size_t)nl, g, r);
+                    nc_material_eval(&j->mat[body], (size_t)nl, g, r);
                     for (int k = 0; k < nl; k++) {
                         int i = lane[k];
                         double rk = r[k] >= 0 && r[k] < INFINITY ? r[k] : 0.0; /* no NaN/Inf into a frame */
@@ -362,9 +373,15 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     if (rc < 0)
         return rc;
     struct job j = {.r = r, .s = s, .rt = r->rt, .f = f};
+    struct nc_rt_stats st;
+    nc_rt_get_stats(r->rt, &st);
     for (int b = 0; b < s->nbodies; b++) {
         j.body_R[b] = nc_quat_to_mat(s->body[b].attitude_q);
         j.body_rel[b] = nc_v3_sub(s->body[b].position_m, c->position_m);
+        j.mat[b] = s->body[b].material;
+        r->fold_theta_bar_deg[b] = -1;
+        if (s->render.boulder_fold && st.boulder_cut_cover[b] > 0)
+            r->fold_theta_bar_deg[b] = nc_material_fold_rocks(&s->body[b].material, st.boulder_cut_cover[b], &j.mat[b]);
     }
     j.row = malloc((size_t)c->height_px * sizeof *j.row);
     if (!j.row)

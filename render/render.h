@@ -39,6 +39,10 @@ struct nc_renderer {
      * (nc_rt_occluded16); the frames differ only where float tracing of
      * such a ray reports a spurious hit. */
     int no_shadow_cull;
+    /* Per body, at the last frame: the roughness theta_bar (deg) its
+     * material was rendered with after folding in the rocks not traced, or
+     * -1 where nothing was folded (scene.h, render.boulder_fold). */
+    double fold_theta_bar_deg[NC_MAX_BODIES];
 };
 
 int nc_frame_alloc(struct nc_frame *f, int width_px, int height_px);
@@ -46,6 +50,8 @@ void nc_frame_free(struct nc_frame *f);
 
 /* threads <= 0: use scene render.threads, then all online cores. */
 int nc_renderer_init(struct nc_renderer *r, const struct nc_scene *s, int threads);
+/* The largest of fold_theta_bar_deg over the first nbodies bodies (-1: none folded). */
+double nc_render_fold_theta_bar_deg(const struct nc_renderer *r, int nbodies);
 /* Render the scene's current poses into f (allocated to the camera size). */
 int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f);
 /* Only image rows [16 begin, 16 end): rows of 16-pixel tiles; other rows of f

@@ -41,6 +41,9 @@ struct nc_rt_stats {
      * traced, m (0: every rock), and how many rocks that leaves. */
     double boulder_min_m[NC_MAX_BODIES];
     size_t boulders_traced[NC_MAX_BODIES];
+    /* ... and the cover of the rocks left out (nc_boulders_cover), which
+     * the reflectance folds in (nc_material_fold_rocks). */
+    double boulder_cut_cover[NC_MAX_BODIES];
     /* Since creation, as the renderer reports them (nc_rt_count_shadow_rays):
      * shadow rays proven unoccluded (nc_rt_shadow_cull16), and traced. */
     unsigned long shadow_rays_culled, shadow_rays_traced;

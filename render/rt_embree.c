@@ -445,13 +445,14 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             /* Boulders: those spanning render.boulder_min_px pixels at the
              * nearest possible range (every one from inside the bounding
              * sphere), like the level of detail a function of the pose. */
-            nc__rt_rocks_cut(&b->rocks, s->render.boulder_min_px * px_m);
+            nc__rt_rocks_cut(&b->rocks, nc_scene_boulder_min_px(s, i) * px_m);
             nc__rt_rocks_commit(&b->rocks, b->rocks_fitted != b->anchor_gen);
             b->rocks_fitted = b->anchor_gen;
             rtcSetGeometryTransform(b->rock_inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
             rtcCommitGeometry(b->rock_inst);
             rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
             rt->stats.boulders_traced[i] = b->rocks.traced;
+            rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
         }
         if ((rc = update_grid(b, s)) < 0)
             return rc;

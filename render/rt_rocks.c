@@ -270,7 +270,10 @@ void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m)
     if (min_d_m == r->min_d_m)
         return;
     r->min_d_m = min_d_m;
-    r->traced = nc_boulders_at_least(r->field, min_d_m);
+    size_t traced = nc_boulders_at_least(r->field, min_d_m);
+    if (traced != r->traced)
+        r->cut_cover = nc_boulders_cover(r->field, traced);
+    r->traced = traced;
     for (int k = 0; k < r->noctaves; k++) {
         struct nc__rt_rock_octave *oc = &r->octave[k];
         int on = 2.0 * r->field->rock[oc->first].half_m >= min_d_m; /* its largest rock */

@@ -43,6 +43,7 @@ struct nc__rt_rocks {
     int noctaves;
     double min_d_m; /* the cut: the smallest diameter traced */
     size_t traced;  /* rocks at or above the cut: rock[0 .. traced) */
+    double cut_cover; /* nc_boulders_cover() of the rocks below the cut */
     int dirty;        /* the scene needs a commit */
 };
 

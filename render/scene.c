@@ -225,7 +225,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     r->seed = 0;
     r->threads = 0;
     r->lod_error_px = 0;
-    r->boulder_min_px = 0;
+    r->boulder_min_px = -1;
+    r->boulder_fold = 1;
     if (!map)
         return 0;
     if ((rc = nc_cfg_int(map, "samples_per_pixel", 1, 1024, &v)) < 0)
@@ -246,6 +247,9 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     if ((rc = nc_cfg_double(map, "lod_error_px", 0, 100, &r->lod_error_px)) < 0)
         return rc;
     if ((rc = nc_cfg_double(map, "boulder_min_px", 0, 1000, &r->boulder_min_px)) < 0)
+        return rc;
+    static const char *const bools[] = {"false", "true", NULL};
+    if ((rc = nc_cfg_enum(map, "boulder_fold", bools, &r->boulder_fold)) < 0)
         return rc;
     return 0;
 }
@@ -378,4 +382,11 @@ void nc_scene_propagate(const struct nc_scene *s, double dt, struct nc_scene *ou
         b->position_m = nc_v3_add(b->position_m, nc_v3_scale(b->velocity_m_s, dt));
         b->attitude_q = nc_quat_propagate(b->attitude_q, b->angular_velocity_rad_s, dt);
     }
+}
+
+double nc_scene_boulder_min_px(const struct nc_scene *s, int b)
+{
+    if (s->render.boulder_min_px >= 0)
+        return s->render.boulder_min_px;
+    return s->render.boulder_fold && nc_material_roughness_param(&s->body[b].material) >= 0 ? 1.0 : 0.0;
 }

@@ -55,9 +55,11 @@ struct nc_render_settings {
      * this many pixels at the body's nearest range; 0 = always the full mesh. */
     double lod_error_px;
     /* Boulders: only rocks whose longest dimension spans at least this many
-     * pixels at the body's nearest range are traced; 0 = every rock (the
-     * rocks left out are not yet folded into the reflectance). */
+     * pixels at the body's nearest range are traced; 0 = every rock; < 0
+     * (the default) = 1 for a body whose material folds the rest into its
+     * reflectance, 0 for others (nc_scene_boulder_min_px). */
     double boulder_min_px;
+    int boulder_fold; /* 1 (default): fold the rocks not traced into the reflectance */
 };
 
 struct nc_scene {
@@ -84,6 +86,9 @@ void nc_scene_free(struct nc_scene *s);
 /* A body's craters and boulders from its config item and shape node, after
  * its shape is built (scene_detail.c; internal to scene*.c). */
 int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b);
+
+/* The boulder cut of body b in pixels (render.boulder_min_px resolved). */
+double nc_scene_boulder_min_px(const struct nc_scene *s, int b);
 
 /* Poses dt seconds later: positions move with their velocities, attitudes
  * turn at their angular rates. out shares s's meshes and materials (a shallow

@@ -162,6 +162,11 @@ expect 0 "photon transfer" -- "$navcam" expose --help
 # The shading choice is recorded in the file.
 "$navcam" render "${small[@]}" --set bodies.0.shape.normals=smooth -o "$tmp/smooth.fits" >/dev/null 2>&1
 head -c 28800 "$tmp/smooth.fits" | grep -aq "NORMALS = 'asteroid=smooth'" && ok || bad "smooth.fits lacks NORMALS = 'asteroid=smooth'"
+# Boulders below the cut (8 px: 10 m here) are folded into the Hapke roughness:
+# said on stdout and recorded in the file.
+expect 0 "folded into the reflectance: theta_bar 16 ->" -- "$navcam" render "${small[@]}" \
+  --set "bodies.0.boulders={preset: bennu, min_diameter_m: 2}" --set render.boulder_min_px=8 -o "$tmp/fold.fits"
+head -c 28800 "$tmp/fold.fits" | grep -aq "ROCKFOLD= 'asteroid=" && ok || bad "fold.fits lacks ROCKFOLD"
 
 # Every example scene renders (the camera-only ones overlay a scene; the
 # shape models come from ../shared/data/shapes, next to the checkout).
