@@ -1,8 +1,8 @@
 /* rng.h - counter-based random numbers (Random123 Philox4x32-10): every
  * draw is a pure function of (seed, stream, frame, index, block), so results
  * never depend on thread count or order. */
-#ifndef NC_RNG_H
-#define NC_RNG_H
+#ifndef NC_CAMERA_RNG_H
+#define NC_CAMERA_RNG_H
 
 #include <math.h>
 #include <stdint.h>

@@ -258,12 +258,12 @@ static void shade_tile(struct job *j, int tile)
                     hits[k]++;
                     if (!(mu0[i] > 0 && mu > 0))
                         continue;
-                    double factor = 1.0;
+                    double factor = hit.albedo[i]; /* albedo variation */
                     const struct nc_albedo_map *am = s->body[hit.body[i]].material.albedo_map;
                     if (am) {
                         /* Body-fixed position of the hit, in double. */
                         int bi = hit.body[i];
-                        factor = nc_albedo_map_factor(am, nc_mat_tmul_v(&j->body_R[bi], nc_v3_sub(p, j->body_rel[bi])));
+                        factor *= nc_albedo_map_factor(am, nc_mat_tmul_v(&j->body_R[bi], nc_v3_sub(p, j->body_rel[bi])));
                     }
                     geo[i] = (struct nc_photometry){mu0[i], mu, -nc_v3_dot(sdir, d), factor};
                     /* Offset the origin off the surface by a few float ulps of the

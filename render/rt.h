@@ -28,6 +28,7 @@ struct nc_hit16 {
     float t[NC_PACKET];                    /* ray parameter of the hit (tfar) */
     float nx[NC_PACKET], ny[NC_PACKET], nz[NC_PACKET]; /* geometric normal, scene frame, unnormalised */
     int body[NC_PACKET];                   /* body index, -1 for a miss */
+    float albedo[NC_PACKET];               /* factor on the albedo there (albedo_var.h; 1: none) */
 };
 
 struct nc_rt_stats {

@@ -258,7 +258,7 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, const str
         rtcSetGeometryBoundsFunction(g, rock_bounds, NULL);
         rtcSetGeometryIntersectFunction(g, rock_intersect);
         rtcSetGeometryOccludedFunction(g, rock_occluded);
-        rtcAttachGeometry(r->scene, g);
+        rtcAttachGeometryByID(r->scene, g, (unsigned)k); /* geomID k: octave k (nc__rt_rock_index) */
     }
     r->traced = f->n;
     r->dirty = 1;

@@ -47,6 +47,12 @@ struct nc__rt_rocks {
     int dirty;        /* the scene needs a commit */
 };
 
+/* The list index of the rock a hit in the rocks' scene names. */
+static inline size_t nc__rt_rock_index(const struct nc__rt_rocks *r, unsigned geom_id, unsigned prim_id)
+{
+    return r->octave[geom_id].first + prim_id;
+}
+
 /* Lane i of an Embree ray packet of width N (RTCRayN: origin, tnear,
  * direction, time, tfar, ... by component), as a user geometry reads it.
  * Shared by the analytic ellipsoid (rt_embree.c) and the rocks. */

@@ -4,6 +4,7 @@
 #include <libgen.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
@@ -338,6 +339,8 @@ void nc_scene_free(struct nc_scene *s)
     for (int i = 0; i < s->nbodies; i++) {
         nc_mesh_free(&s->body[i].mesh);
         nc_boulders_free(&s->body[i].boulders);
+        free(s->body[i].albedo_vertex);
+        s->body[i].albedo_vertex = NULL;
         nc_material_free(&s->body[i].material);
     }
     s->nbodies = 0;

@@ -13,6 +13,7 @@
 
 #include "core/config.h"
 #include "core/pose.h"
+#include "render/albedo_var.h"
 #include "render/boulders.h"
 #include "render/camera.h"
 #include "render/material.h"
@@ -31,6 +32,10 @@ struct nc_body {
     struct nc_mesh mesh;    /* mesh and asteroid */
     int smooth_normals;     /* mesh and asteroid: shade with normals interpolated from the vertices' */
     struct nc_boulder_field boulders; /* none when boulders.n == 0 (meshes only) */
+    /* Procedural albedo variation (meshes only): its parameters, and the
+     * ground's factor per mesh vertex (NULL: none). */
+    struct nc_albedo_var_params albedo_var;
+    float *albedo_vertex;
     double bounding_radius_m;
     struct nc_material material;
     struct nc_vec3 position_m; /* scene frame */

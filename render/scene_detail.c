@@ -1,7 +1,8 @@
 /* scene_detail.c - a body's surface detail from its configuration
  * (docs/terrain.md): relief below its mesh's resolution (shape.relief),
  * craters carved into it (shape.craters), how the mesh is shaded
- * (shape.normals), and boulders on it (boulders). Reads config nodes and
+ * (shape.normals), boulders on it (boulders), and albedo variation
+ * over ground and rocks (albedo_variation). Reads config nodes and
  * builds render/ data; no rendering here. */
 #include "render/scene.h"
 
@@ -181,6 +182,37 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     return 0;
 }
 
+/* `albedo_variation:` of a body with a mesh (docs/terrain.md). */
+static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b)
+{
+    struct nc_cfg_node *map;
+    int rc;
+    if ((rc = nc_cfg_map(item, "albedo_variation", &map)) <= 0)
+        return rc;
+    if (!has_mesh(b))
+        return nc_cfg_error(nc_cfg_get(item, "albedo_variation"),
+                            "albedo_variation needs a mesh or asteroid shape (an albedo map serves the others)");
+    /* default largest wavelength: a tenth of the radius of the sphere of
+     * the same area */
+    struct nc_albedo_var_params p = {.rms = 0.1, .largest_m = 0.1 * sqrt(nc_mesh_area_m2(&b->mesh) / (4 * M_PI)),
+                                     .hurst = 0.5, .rocks_rms = -1, .seed = 1};
+    if ((rc = nc_cfg_double(map, "rms", 0, 2, &p.rms)) < 0 ||
+        (rc = nc_cfg_double(map, "largest_m", 1e-6, 1e9, &p.largest_m)) < 0 ||
+        (rc = nc_cfg_double(map, "hurst", 0, 1, &p.hurst)) < 0 ||
+        (rc = nc_cfg_double(map, "rocks_rms", 0, 2, &p.rocks_rms)) < 0 || (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
+        return rc;
+    if (p.rocks_rms < 0)
+        p.rocks_rms = p.rms;
+    double smallest_m = 0;
+    if (p.rms > 0 && (rc = nc_albedo_var_vertices(&b->mesh, &p, &b->albedo_vertex, &smallest_m)) < 0)
+        return error_at(map);
+    b->albedo_var = p;
+    nc_log_info("scene", "body '%s': albedo variation, RMS %g on the ground (wavelengths %.4g to %.4g m, Hurst %g), "
+                "%g per rock, seed %llu", b->name, p.rms, p.largest_m, smallest_m, p.hurst, p.rocks_rms,
+                (unsigned long long)p.seed);
+    return 0;
+}
+
 int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b)
 {
     static const char *const normals[] = {"flat", "smooth", NULL};
@@ -192,5 +224,7 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
     b->smooth_normals = smooth;
     if ((rc = relief_from_config(shape, b)) < 0 || (rc = craters_from_config(shape, b)) < 0)
         return rc;
-    return boulders_from_config(item, b);
+    if ((rc = boulders_from_config(item, b)) < 0)
+        return rc;
+    return albedo_var_from_config(item, b);
 }
