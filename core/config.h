@@ -65,6 +65,10 @@ int nc_cfg_vec3(struct nc_cfg_node *parent, const char *key, struct nc_vec3 *out
 /* A unit quaternion [w, x, y, z]; within 1e-3 of unit length it is normalised. */
 int nc_cfg_quat(struct nc_cfg_node *parent, const char *key, struct nc_quat *out);
 
+/* A file named by node n resolved against the directory of the config file
+ * n came from (absolute paths, and nodes from strings or --set, unchanged). */
+void nc_cfg_resolve_path(const struct nc_cfg_node *n, const char *file, char *out, size_t len);
+
 /* Error helpers that prefix "origin:line: path:" for a node (or the place a
  * missing key should have been). */
 int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -4,6 +4,7 @@
 #include "core/config.h"
 
 #include <errno.h>
+#include <libgen.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -215,4 +216,15 @@ void nc_cfg_mark_used(struct nc_cfg_node *n)
     n->used = 1;
     for (size_t i = 0; i < n->nchild; i++)
         nc_cfg_mark_used(n->child[i]);
+}
+
+void nc_cfg_resolve_path(const struct nc_cfg_node *n, const char *file, char *out, size_t len)
+{
+    if (file[0] == '/' || !n || !n->origin || n->line == 0 || n->origin[0] == '<') {
+        snprintf(out, len, "%s", file);
+        return;
+    }
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", n->origin);
+    snprintf(out, len, "%s/%s", dirname(dir), file);
 }

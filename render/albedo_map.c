@@ -3,7 +3,6 @@
 #include "render/albedo_map.h"
 
 #include <errno.h>
-#include <libgen.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,7 +11,9 @@
 #include "core/error.h"
 #include "render/image_io.h"
 
-int nc_albedo_map_load(const char *path, double lon_left_deg, int east, double scale, struct nc_albedo_map **out)
+/* signed_values: any finite value (elevation maps); else >= 0 (albedo). */
+static int load(const char *path, double lon_left_deg, int east, double scale, int signed_values,
+                struct nc_albedo_map **out)
 {
     struct nc_albedo_map *m = calloc(1, sizeof *m);
     if (!m)
@@ -24,11 +25,11 @@ int nc_albedo_map_load(const char *path, double lon_left_deg, int east, double s
     }
     size_t n = (size_t)m->width_px * (size_t)m->height_px;
     for (size_t i = 0; i < n; i++)
-        if (!(m->value[i] >= 0 && isfinite(m->value[i]))) {
+        if (!((signed_values || m->value[i] >= 0) && isfinite(m->value[i]))) {
             int x = (int)(i % (size_t)m->width_px), y = (int)(i / (size_t)m->width_px);
             nc_albedo_map_free(m);
-            return nc_error(NC_EIMAGE, "%s: pixel (%d, %d) is negative or not finite; albedo maps need values >= 0",
-                            path, x, y);
+            return nc_error(NC_EIMAGE, "%s: pixel (%d, %d) is %s", path, x, y,
+                            signed_values ? "not finite" : "negative or not finite; albedo maps need values >= 0");
         }
     m->lon_left_rad = lon_left_deg * (M_PI / 180.0);
     m->east = east;
@@ -37,7 +38,12 @@ int nc_albedo_map_load(const char *path, double lon_left_deg, int east, double s
     return 0;
 }
 
-int nc_albedo_map_from_config(struct nc_cfg_node *map, struct nc_albedo_map **out)
+int nc_albedo_map_load(const char *path, double lon_left_deg, int east, double scale, struct nc_albedo_map **out)
+{
+    return load(path, lon_left_deg, east, scale, 0, out);
+}
+
+static int from_config(struct nc_cfg_node *map, int signed_values, struct nc_albedo_map **out)
 {
     static const char *const dirs[] = {"east", "west", NULL};
     const char *file;
@@ -47,23 +53,27 @@ int nc_albedo_map_from_config(struct nc_cfg_node *map, struct nc_albedo_map **ou
         return rc ? rc : nc_cfg_missing(map, "file", "an equirectangular image readable by OpenImageIO");
     if ((rc = nc_cfg_double(map, "lon_left_deg", -360, 360, &lon_left)) < 0 ||
         (rc = nc_cfg_enum(map, "lon_direction", dirs, &dir)) < 0 ||
-        (rc = nc_cfg_double(map, "scale", 0, 1e6, &scale)) < 0)
+        (rc = nc_cfg_double(map, "scale", signed_values ? -1e9 : 0, 1e9, &scale)) < 0)
         return rc;
     const struct nc_cfg_node *fn = nc_cfg_get(map, "file");
     char path[4096];
-    if (file[0] != '/' && fn->line > 0 && fn->origin && fn->origin[0] != '<') {
-        char dir_buf[4096];
-        snprintf(dir_buf, sizeof dir_buf, "%s", fn->origin);
-        snprintf(path, sizeof path, "%s/%s", dirname(dir_buf), file);
-    } else {
-        snprintf(path, sizeof path, "%s", file);
-    }
-    if ((rc = nc_albedo_map_load(path, lon_left, dir == 0, scale, out)) < 0) {
+    nc_cfg_resolve_path(fn, file, path, sizeof path);
+    if ((rc = load(path, lon_left, dir == 0, scale, signed_values, out)) < 0) {
         char why[800];
         snprintf(why, sizeof why, "%s", nc_errmsg());
         return nc_cfg_error(fn, "%s", why);
     }
     return 0;
+}
+
+int nc_albedo_map_from_config(struct nc_cfg_node *map, struct nc_albedo_map **out)
+{
+    return from_config(map, 0, out);
+}
+
+int nc_elevation_map_from_config(struct nc_cfg_node *map, struct nc_albedo_map **out)
+{
+    return from_config(map, 1, out);
 }
 
 double nc_albedo_map_factor(const struct nc_albedo_map *m, struct nc_vec3 p)

@@ -58,6 +58,27 @@ int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t m
 
 int nc_mesh_asteroid(const struct nc_asteroid_params *p, struct nc_mesh *out);
 
+/* Elevation data (mesh_dem.c). A terrain tile from a w x rows height image
+ * (row 0 the northern edge, column 0 the western; a vertex per pixel
+ * centre, two triangles per cell of four finite corners: a non-finite pixel
+ * makes holes). Flat (radius_m 0): x east, y north, z up, the origin at the
+ * image's centre at height 0. On a sphere of radius_m: the tile's centre at
+ * planetocentric lat_deg, lon_deg (east), each pixel's east and north
+ * offsets projected gnomonically onto the sphere and raised by its height,
+ * in the sphere's body-fixed frame (+z the pole, +x longitude 0). Heights
+ * are height_offset_m + height_scale x pixel value, metres. */
+#define NC_DEM_MAX_PIXELS (4096 * 4096)
+struct nc_dem_tile_params {
+    double pixel_m[2]; /* ground sample distance along a row (east) and a column (north), m */
+    double height_scale, height_offset_m;
+    double radius_m, lat_deg, lon_deg;
+};
+int nc_mesh_dem_tile(const float *h, int w, int rows, const struct nc_dem_tile_params *p, struct nc_mesh *out);
+/* A sphere of radius_m (an icosphere of 20 x 4^subdivisions faces) with
+ * each vertex moved along its radius by the elevation map's value there, m. */
+struct nc_albedo_map;
+int nc_mesh_globe(double radius_m, int subdivisions, const struct nc_albedo_map *elevation, struct nc_mesh *out);
+
 /* Levels of detail (mesh_lod.c): level 0 is the mesh itself (its own
  * triangle list, not copied); each next level has about 4x fewer triangles,
  * made by collapsing edges onto existing vertices (no vertex moves or is

@@ -164,8 +164,12 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
 {
     const struct nc_mesh *m = &b->src->mesh;
     b->scene[k] = rtcNewScene(rt->dev);
-    /* LOW makes Embree honour the per-geometry quality (a two-level index). */
+    /* LOW makes Embree honour the per-geometry quality (a two-level index).
+     * ROBUST: watertight triangle tests, so that a ray through a shared
+     * edge or vertex (a pixel centre right over a DEM's grid line) meets
+     * one of the triangles instead of slipping between them. */
     rtcSetSceneBuildQuality(b->scene[k], RTC_BUILD_QUALITY_LOW);
+    rtcSetSceneFlags(b->scene[k], RTC_SCENE_FLAG_ROBUST);
     RTCGeometry g = b->geom[k] = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     /* Anchors move by pure translation: a refit keeps the tree exact. */
     rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);

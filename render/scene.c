@@ -1,7 +1,6 @@
 /* scene.c - building a scene from configuration, and the built-in default. */
 #include "render/scene.h"
 
-#include <libgen.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -66,25 +65,15 @@ const char nc_default_scene_yaml[] =
     "exposure:\n"
     "  time_s: 0.002\n";
 
-static const char *const shape_names[] = {"sphere", "ellipsoid", "mesh", "asteroid", NULL};
-
-/* Resolve a path given in the config relative to the file it came from. */
-static void resolve_path(const struct nc_cfg_node *n, const char *file, char *out, size_t len)
-{
-    if (file[0] == '/' || !n->origin || n->line == 0 || n->origin[0] == '<') {
-        snprintf(out, len, "%s", file);
-        return;
-    }
-    char dir[4096];
-    snprintf(dir, sizeof dir, "%s", n->origin);
-    snprintf(out, len, "%s/%s", dirname(dir), file);
-}
+static const char *const shape_names[] = {"sphere", "ellipsoid", "mesh", "asteroid", "dem", "globe", NULL};
 
 static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
 {
     int type = 0, rc;
     if ((rc = nc_cfg_enum(sh, "type", shape_names, &type)) <= 0)
-        return rc ? rc : nc_cfg_missing(sh, "type", "sphere, ellipsoid, mesh or asteroid");
+        return rc ? rc : nc_cfg_missing(sh, "type", "sphere, ellipsoid, mesh, asteroid, dem or globe");
+    if (type >= 4) /* dem, globe: meshes from elevation data */
+        return nc__scene_dem_from_config(sh, type == 5, b);
     b->shape = (enum nc_shape_type)type;
     switch (b->shape) {
     case NC_SHAPE_SPHERE: {
@@ -136,12 +125,9 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         if ((rc = nc_cfg_double(sh, "scale", 1e-9, 1e9, &scale)) < 0)
             return rc;
         char path[4096];
-        resolve_path(nc_cfg_get(sh, "file"), file, path, sizeof path);
-        if ((rc = nc_mesh_load(path, scale * (unit ? 1000.0 : 1.0), &b->mesh)) < 0) {
-            char why[800];
-            snprintf(why, sizeof why, "%s", nc_errmsg());
-            return nc_cfg_error(nc_cfg_get(sh, "file"), "%s", why);
-        }
+        nc_cfg_resolve_path(nc_cfg_get(sh, "file"), file, path, sizeof path);
+        if ((rc = nc_mesh_load(path, scale * (unit ? 1000.0 : 1.0), &b->mesh)) < 0)
+            return nc__scene_error_at(nc_cfg_get(sh, "file"));
         b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
         return 0;
     }

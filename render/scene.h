@@ -91,6 +91,11 @@ void nc_scene_free(struct nc_scene *s);
 /* A body's craters and boulders from its config item and shape node, after
  * its shape is built (scene_detail.c; internal to scene*.c). */
 int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b);
+/* The error just set (by a loader or generator) restated at config node n,
+ * with its file and line (scene_detail.c). */
+int nc__scene_error_at(const struct nc_cfg_node *n);
+/* Shapes `dem` and `globe` as meshes (scene_dem.c; internal to scene*.c). */
+int nc__scene_dem_from_config(struct nc_cfg_node *shape, int globe, struct nc_body *b);
 
 /* The boulder cut of body b in pixels (render.boulder_min_px resolved). */
 double nc_scene_boulder_min_px(const struct nc_scene *s, int b);

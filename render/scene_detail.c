@@ -16,11 +16,9 @@
 /* Detail needs a triangle mesh: a loaded one or the asteroid's. */
 static int has_mesh(const struct nc_body *b) { return b->shape == NC_SHAPE_MESH || b->shape == NC_SHAPE_ASTEROID; }
 
-/* The error just set (by a generator) restated at config node n, with its
- * file and line. */
-static int error_at(const struct nc_cfg_node *n)
+int nc__scene_error_at(const struct nc_cfg_node *n)
 {
-    char why[512];
+    char why[800];
     snprintf(why, sizeof why, "%s", nc_errmsg());
     return nc_cfg_error(n, "%s", why);
 }
@@ -85,7 +83,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         rc = nc_craters_apply(&f, &b->mesh);
     if (rc < 0) {
         nc_craters_free(&f);
-        return error_at(node ? node : sh);
+        return nc__scene_error_at(node ? node : sh);
     }
     if (f.n)
         nc_log_info("scene", "body '%s': %zu craters of %.3g to %.3g m (N(>1 m) = %.4g per km^2, slope %g, seed %llu), "
@@ -146,7 +144,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
     if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
         return rc;
     if ((rc = nc_boulders_generate(&b->mesh, &p, MAX_BOULDERS, &b->boulders)) < 0) {
-        return error_at(map);
+        return nc__scene_error_at(map);
     }
     /* rocks standing out past the mesh's farthest vertex widen the body */
     b->bounding_radius_m = fmax(b->bounding_radius_m, nc_boulders_bounding_radius(&b->boulders));
@@ -173,7 +171,7 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         return rc;
     struct nc_relief_info info;
     if ((rc = nc_mesh_relief(&b->mesh, &p, NC_RELIEF_MAX_TRIANGLES, &info)) < 0) {
-        return error_at(map);
+        return nc__scene_error_at(map);
     }
     nc_log_info("scene", "body '%s': relief from mean edges of %.4g m down to %.4g m (%d subdivisions, %zu triangles; "
                 "Hurst %g, s = %.4g m^%g measured on the mesh x %g)", b->name, info.model_edge_m, info.edge_m,
@@ -205,7 +203,7 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b)
         p.rocks_rms = p.rms;
     double smallest_m = 0;
     if (p.rms > 0 && (rc = nc_albedo_var_vertices(&b->mesh, &p, &b->albedo_vertex, &smallest_m)) < 0)
-        return error_at(map);
+        return nc__scene_error_at(map);
     b->albedo_var = p;
     nc_log_info("scene", "body '%s': albedo variation, RMS %g on the ground (wavelengths %.4g to %.4g m, Hurst %g), "
                 "%g per rock, seed %llu", b->name, p.rms, p.largest_m, smallest_m, p.hurst, p.rocks_rms,
