@@ -132,3 +132,12 @@ int nc_test_spawn(const char *dir, const char *const *argv)
     }
     return (int)pid;
 }
+
+const char nc_test_asteroid_yaml[] =
+    "bodies:\n"
+    "  - shape: {type: asteroid, radii_m: [280, 230, 200], subdivisions: 5, seed: 7, craters: 30}\n"
+    "    material: {model: lambert, A: 0.1}\n"
+    "sun: {direction: [0.643, -0.766, 0.3]}\n"
+    "camera: {width_px: 256, height_px: 256, focal_length_m: 0.025, pixel_pitch_m: 2.2e-5,\n"
+    "         position_m: [0, -3000, 0], look_at_m: [0, 0, 0], up: [0, 0, 1]}\n"
+    "render: {samples_per_pixel: 4}\n";

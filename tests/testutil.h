@@ -22,6 +22,11 @@ extern int nc_test_failed, nc_test_passed;
         }                                                                                                  \
     } while (0)
 
+/* A small cratered asteroid (Lambert, subdivisions 5: 20 480 triangles)
+ * seen whole from 3 km by a 256x256 camera at about 40 deg phase: the
+ * surface-detail tests' scene. */
+extern const char nc_test_asteroid_yaml[];
+
 /* Temporary directory of this test (created), and a path inside it. */
 const char *nc_test_tmp(void);
 const char *nc_test_path(const char *name);

@@ -94,24 +94,19 @@ static void check_ground(void)
     CHECK(nc_albedo_var_rock(&p, 17) == 1.0f, "no rock variation gave %g", nc_albedo_var_rock(&p, 17));
 }
 
-static const char *scene_yaml =
-    "bodies:\n"
-    "  - shape: {type: asteroid, radii_m: [280, 230, 200], subdivisions: 6, seed: 7, craters: 30}\n"
-    "    material: {model: lambert, A: 0.1}\n"
-    "sun: {direction: [0.643, -0.766, 0.3]}\n"
-    "camera: {width_px: 256, height_px: 256, focal_length_m: 0.025, pixel_pitch_m: 2.2e-5,\n"
-    "         position_m: [0, -3000, 0], look_at_m: [0, 0, 0], up: [0, 0, 1]}\n"
-    "render: {samples_per_pixel: 4}\n";
 
 static void check_render(void)
 {
-    const char *var[] = {"bodies[0].albedo_variation={rms: 0.2, largest_m: 40, seed: 2}",
+    /* the finer asteroid: 4.5 m vertex spacing under 2.6 m pixels */
+    const char *bare_sets[] = {"bodies[0].shape.subdivisions=6"};
+    const char *var[] = {"bodies[0].shape.subdivisions=6", "bodies[0].albedo_variation={rms: 0.2, largest_m: 40, seed: 2}",
                          "bodies[0].boulders={preset: bennu, min_diameter_m: 4, seed: 3}"};
+    const char *rock_sets[] = {var[0], var[2]};
     struct nc_scene bare, varied, rocks, rocks_var;
-    nc_test_scene(scene_yaml, NULL, 0, &bare);
-    nc_test_scene(scene_yaml, var, 1, &varied);
-    nc_test_scene(scene_yaml, var + 1, 1, &rocks);
-    nc_test_scene(scene_yaml, var, 2, &rocks_var);
+    nc_test_scene(nc_test_asteroid_yaml, bare_sets, 1, &bare);
+    nc_test_scene(nc_test_asteroid_yaml, var, 2, &varied);
+    nc_test_scene(nc_test_asteroid_yaml, rock_sets, 2, &rocks);
+    nc_test_scene(nc_test_asteroid_yaml, var, 3, &rocks_var);
     struct nc_frame f0, f1, f2, r0, r1;
     nc_test_render(&bare, 2, &f0);
     nc_test_render(&varied, 2, &f1);
@@ -149,10 +144,10 @@ static void check_render(void)
     /* configuration errors name the key */
     const char *sphere[] = {"bodies[0].shape={type: sphere, radius_m: 100}", "bodies[0].albedo_variation={rms: 0.1}"};
     struct nc_scene s;
-    CHECK(nc_test_scene_rc(scene_yaml, sphere, 2, &s) < 0 && nc_test_contains(nc_errmsg(), "albedo_variation needs a mesh"),
+    CHECK(nc_test_scene_rc(nc_test_asteroid_yaml, sphere, 2, &s) < 0 && nc_test_contains(nc_errmsg(), "albedo_variation needs a mesh"),
           "on a sphere: %s", nc_errmsg());
     const char *bad[] = {"bodies[0].albedo_variation={rms: -1}"};
-    CHECK(nc_test_scene_rc(scene_yaml, bad, 1, &s) < 0 && nc_test_contains(nc_errmsg(), "albedo_variation.rms"),
+    CHECK(nc_test_scene_rc(nc_test_asteroid_yaml, bad, 1, &s) < 0 && nc_test_contains(nc_errmsg(), "albedo_variation.rms"),
           "a negative RMS: %s", nc_errmsg());
 }
 

@@ -112,14 +112,6 @@ static void check_determinism(const struct nc_mesh *m)
     nc_boulders_free(&b);
 }
 
-static const char *scene_yaml =
-    "bodies:\n"
-    "  - shape: {type: asteroid, radii_m: [280, 230, 200], subdivisions: 5, seed: 7, craters: 30}\n"
-    "    material: {model: lambert, A: 0.1}\n"
-    "sun: {direction: [0.643, -0.766, 0.3]}\n"
-    "camera: {width_px: 256, height_px: 256, focal_length_m: 0.025, pixel_pitch_m: 2.2e-5,\n"
-    "         position_m: [0, -3000, 0], look_at_m: [0, 0, 0], up: [0, 0, 1]}\n"
-    "render: {samples_per_pixel: 4}\n";
 
 /* The frame with boulders: darker spots (shadows) and bright faces appear,
  * the same bytes on 1 and 2 threads; a ray down onto the largest rock
@@ -128,8 +120,8 @@ static void check_render(void)
 {
     const char *sets[] = {"bodies[0].boulders={preset: bennu, min_diameter_m: 2, seed: 3}"};
     struct nc_scene bare, rocky;
-    nc_test_scene(scene_yaml, NULL, 0, &bare);
-    nc_test_scene(scene_yaml, sets, 1, &rocky);
+    nc_test_scene(nc_test_asteroid_yaml, NULL, 0, &bare);
+    nc_test_scene(nc_test_asteroid_yaml, sets, 1, &rocky);
     const struct nc_boulder_field *f = &rocky.body[0].boulders;
     printf("render: %zu rocks of 2 m or more\n", f->n);
     CHECK(f->n > 1000, "only %zu rocks", f->n);
@@ -186,7 +178,7 @@ static void check_render(void)
     long r0 = nc_resident_kb();
     CHECK(nc_rt_create(&bare, 1, &rt_bare) == 0, "%s", nc_errmsg());
     long r1 = nc_resident_kb();
-    nc_test_scene(scene_yaml, many, 1, &rocky);
+    nc_test_scene(nc_test_asteroid_yaml, many, 1, &rocky);
     size_t nrock = rocky.body[0].boulders.n;
     CHECK(nc_rt_create(&rocky, 1, &rt_rock) == 0, "%s", nc_errmsg());
     long r2 = nc_resident_kb();
@@ -224,12 +216,12 @@ static void check_cut(void)
                              {"bodies[0].boulders={preset: bennu, min_diameter_m: 1, seed: 3}", "render.boulder_min_px=1000"}};
     struct nc_scene bare, s[3];
     struct nc_frame fb, f[3];
-    nc_test_scene(scene_yaml, NULL, 0, &bare);
+    nc_test_scene(nc_test_asteroid_yaml, NULL, 0, &bare);
     nc_test_render(&bare, 2, &fb);
     size_t traced[3];
     double cut[3];
     for (int k = 0; k < 3; k++) {
-        nc_test_scene(scene_yaml, sets[k], 2, &s[k]);
+        nc_test_scene(nc_test_asteroid_yaml, sets[k], 2, &s[k]);
         struct nc_rt *rt;
         CHECK(nc_rt_create(&s[k], 2, &rt) == 0, "%s", nc_errmsg());
         struct nc_rt_stats st;
@@ -331,9 +323,9 @@ static void check_fold(void)
         const char *unfolded[] = {cases[k].rocks, cases[k].material, cases[k].sun, "render.boulder_fold=false",
                                   "render.boulder_min_px=1"};
         struct nc_scene a, f, u;
-        nc_test_scene(scene_yaml, all, 4, &a);
-        nc_test_scene(scene_yaml, all, 3, &f); /* the default cut: 1 px, folded */
-        nc_test_scene(scene_yaml, unfolded, 5, &u);
+        nc_test_scene(nc_test_asteroid_yaml, all, 4, &a);
+        nc_test_scene(nc_test_asteroid_yaml, all, 3, &f); /* the default cut: 1 px, folded */
+        nc_test_scene(nc_test_asteroid_yaml, unfolded, 5, &u);
         double da, df, du;
         double ta = render_sum(&a, &da), tf = render_sum(&f, &df), tu = render_sum(&u, &du);
         struct nc_rt *rt;
