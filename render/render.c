@@ -39,6 +39,7 @@ void nc_frame_free(struct nc_frame *f)
     free(f->iof);
     free(f->range_m);
     free(f->coverage);
+    free(f->rock_id);
     memset(f, 0, sizeof *f);
 }
 
@@ -223,6 +224,11 @@ static void shade_tile(struct job *j, int tile)
                 if (j->r->ray_hook)
                     j->r->ray_hook(j->r->ray_hook_user, 0, &ray);
                 nc_rt_intersect16(j->rt, &ray, &hit, 1);
+                if (sidx == 0 && j->f->rock_id) /* the rock each pixel's first sample hit */
+                    for (int i = 0; i < NC_PACKET; i++)
+                        if (ray.valid[i])
+                            j->f->rock_id[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
+                                hit.body[i] >= 0 ? hit.rock[i] : -1;
 
                 /* Shadow rays from the visible points that face both Sun and camera. */
                 int any = 0; /* how many */

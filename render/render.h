@@ -21,6 +21,10 @@ struct nc_frame {
     float *iof;       /* I/F = pi r, dimensionless */
     float *range_m;   /* mean distance camera -> surface over samples that hit; 0 where none hit */
     float *coverage;  /* fraction of the pixel's samples that hit a body */
+    /* Optional (the caller allocates it; nc_frame_free frees it): the
+     * boulder the pixel's first sample hit, as its index in its body's
+     * list (boulders.h), -1 for ground, sky or no rock. */
+    int32_t *rock_id;
 };
 
 struct nc_renderer {

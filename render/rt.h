@@ -29,6 +29,7 @@ struct nc_hit16 {
     float nx[NC_PACKET], ny[NC_PACKET], nz[NC_PACKET]; /* geometric normal, scene frame, unnormalised */
     int body[NC_PACKET];                   /* body index, -1 for a miss */
     float albedo[NC_PACKET];               /* factor on the albedo there (albedo_var.h; 1: none) */
+    int32_t rock[NC_PACKET];               /* the boulder hit (its index in the body's list), -1: none */
 };
 
 struct nc_rt_stats {

@@ -527,15 +527,18 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
         /* Albedo variation: interpolated from the vertices on the ground,
          * one factor per rock. */
         float alb = 1.0f;
+        int32_t rock = -1;
         if (inst == b->inst_id && b->src->albedo_vertex) {
             const unsigned *t = b->tri[b->level] + 3 * (size_t)rh.hit.primID[i];
             const float *a = b->src->albedo_vertex, u = rh.hit.u[i], v = rh.hit.v[i];
             alb = (1 - u - v) * a[t[0]] + u * a[t[1]] + v * a[t[2]];
         } else if (inst == b->rock_inst_id && b->rock_inst) {
-            alb = nc_albedo_var_rock(&b->src->albedo_var,
-                                     nc__rt_rock_index(&b->rocks, rh.hit.geomID[i], rh.hit.primID[i]));
+            size_t k = nc__rt_rock_index(&b->rocks, rh.hit.geomID[i], rh.hit.primID[i]);
+            alb = nc_albedo_var_rock(&b->src->albedo_var, k);
+            rock = (int32_t)k;
         }
         hit->albedo[i] = alb;
+        hit->rock[i] = rock;
         hit->body[i] = (int)rt->geom_to_body[inst];
         hit->t[i] = rh.ray.tfar[i];
         hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;

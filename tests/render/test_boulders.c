@@ -350,6 +350,89 @@ static void check_fold(void)
     }
 }
 
+static int cmp_desc(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x < y) - (x > y);
+}
+
+/* The population in a rendered frame: a close view (2048x2048, 10 cm
+ * pixels, straight down from 600 m above the surface) and the rock each
+ * pixel shows (nc_frame.rock_id). Every rock of 1 m or more whose centre is
+ * in view and in sight (its top, seen along the pixel's ray, hits it) is in
+ * the frame, and the rocks' pixel areas A, which go as D^2, fall off as
+ * N(>A) ~ A^(-b/2): the slope fitted on the frame's areas recovers b. */
+static void check_frame_count(void)
+{
+    const char *sets[] = {"bodies[0].boulders={preset: bennu, min_diameter_m: 0.5, seed: 9}",
+                          "camera={width_px: 2048, height_px: 2048, fx_px: 6000, fy_px: 6000, "
+                          "position_m: [0, -830, 0], look_at_m: [0, 0, 0], up: [0, 0, 1]}",
+                          "render.samples_per_pixel=1", "render.boulder_min_px=0"};
+    struct nc_scene s;
+    nc_test_scene(nc_test_asteroid_yaml, sets, 4, &s);
+    struct nc_renderer r;
+    struct nc_frame f;
+    const int W = 2048;
+    CHECK(nc_renderer_init(&r, &s, 2) == 0 && nc_frame_alloc(&f, W, W) == 0 &&
+              (f.rock_id = malloc((size_t)W * W * sizeof *f.rock_id)) != NULL && nc_render_frame(&r, &s, &f) == 0,
+          "%s", nc_errmsg());
+    const struct nc_boulder_field *bf = &s.body[0].boulders;
+    unsigned *px = calloc(bf->n, sizeof *px);
+    size_t ground = 0;
+    double range = 0;
+    for (size_t i = 0; i < (size_t)W * W; i++) {
+        if (f.rock_id[i] >= 0)
+            px[f.rock_id[i]]++;
+        else if (f.coverage[i] > 0)
+            ground++;
+        range += f.range_m[(size_t)(W / 2) * W + W / 2] * (i == 0);
+    }
+    /* pixel areas of the rocks seen */
+    double *area = malloc(bf->n * sizeof *area);
+    size_t seen = 0;
+    for (size_t k = 0; k < bf->n; k++)
+        if (px[k] >= 100) /* about 1.1 m and up: a rock of D m covers some 80 D^2 px here */
+            area[seen++] = px[k];
+    qsort(area, seen, sizeof *area, cmp_desc);
+    double b_frame = 2 * nc_test_fit_slope(area, seen, 100, 1e12);
+    printf("frame: %zu rocks of 100 px or more (%.3g m pixels at the centre); the slope from their areas %.3f "
+           "(configured %.2f)\n", seen, range / 6000, b_frame, bf->params.slope);
+    CHECK(seen > 1500, "only %zu rocks resolved", seen);
+    CHECK(fabs(b_frame / bf->params.slope - 1) < 0.05, "slope %.3f from the frame, configured %.2f", b_frame,
+          bf->params.slope);
+    /* completeness: every rock of 1 m or more with its centre in view and
+     * its top in sight is in the frame */
+    struct nc_rt *rt = r.rt;
+    struct nc_mat3 Rc = nc_quat_to_mat(s.camera.attitude_q);
+    size_t expected = 0, found = 0;
+    for (size_t k = 0; k < bf->n && 2 * bf->rock[k].half_m >= 1; k++) {
+        const struct nc_boulder *b = &bf->rock[k];
+        struct nc_vec3 c = nc_v3(b->centre_m[0], b->centre_m[1], b->centre_m[2]);
+        struct nc_vec3 d = nc_v3_sub(c, s.camera.position_m), dc = nc_mat_tmul_v(&Rc, d);
+        double x, y;
+        if (nc_camera_project(&s.camera, dc, &x, &y) < 0 || x < 1 || y < 1 || x > W - 2 || y > W - 2)
+            continue;
+        struct nc_ray16 ray = {0};
+        struct nc_hit16 hit;
+        struct nc_vec3 u = nc_v3_unit(d);
+        ray.dx[0] = (float)u.x, ray.dy[0] = (float)u.y, ray.dz[0] = (float)u.z;
+        ray.tfar[0] = 1e5f;
+        ray.valid[0] = -1;
+        nc_rt_intersect16(rt, &ray, &hit, 0);
+        if (hit.body[0] != 0 || hit.rock[0] != (int32_t)k)
+            continue; /* hidden by another rock or the ground */
+        expected++;
+        found += px[k] > 0;
+    }
+    printf("frame: %zu rocks of 1 m or more in view and in sight, %zu of them in the rock-id plane\n", expected, found);
+    CHECK(expected > 1000 && found == expected, "%zu of %zu rocks in sight are in the frame", found, expected);
+    free(area);
+    free(px);
+    nc_frame_free(&f);
+    nc_renderer_free(&r);
+    nc_scene_free(&s);
+}
+
 int main(void)
 {
     struct nc_asteroid_params p = {.radii_m = {280, 230, 200}, .subdivisions = 5, .seed = 3, .craters = 40,
@@ -362,5 +445,6 @@ int main(void)
     check_render();
     check_cut();
     check_fold();
+    check_frame_count();
     return nc_test_end();
 }
