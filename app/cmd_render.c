@@ -34,6 +34,9 @@ static const char render_help[] =
     "  -q, --quantity Q       radiance   W m^-2 sr^-1 (default)\n"
     "                         iof        I/F = pi * radiance / solar irradiance\n"
     "                         range      distance camera-surface, m (0 = sky)\n"
+    "                         rock_id    the boulder each pixel shows: its index in\n"
+    "                                    its body's list (exact in float32 files up\n"
+    "                                    to 2^24), -1 for ground or sky\n"
     "                         electrons  noise-free photo-electrons through the optics\n"
     "                                    and PSF: the ground truth of a DN frame\n"
     "                         dn         the digitised frame: noise, full well, gain,\n"
@@ -200,9 +203,12 @@ int main(int argc, char **argv)
     /* Electrons and DN go through the camera model, whose PSF needs the
      * light from a margin around the field: render that larger image. */
     struct nc_scene drawn = scene;
-    if (q > NC_Q_RANGE)
+    if (q > NC_Q_ROCK_ID)
         nc_camsys_render_camera(&cs, &scene.camera, &drawn.camera);
     rc = nc_frame_alloc(&f, drawn.camera.width_px, drawn.camera.height_px);
+    if (rc >= 0 && q == NC_Q_ROCK_ID &&
+        !(f.rock_id = malloc((size_t)f.width_px * (size_t)f.height_px * sizeof *f.rock_id)))
+        rc = nc_error(-ENOMEM, "out of memory");
     /* Motion during the exposure (camera and body rates) and a rolling
      * shutter are integrated over the exposure window. */
     struct nc_exposure ex = {.exposure_s = exposure, .rolling = cs.sensor.shutter == NC_SHUTTER_ROLLING,
@@ -235,7 +241,7 @@ int main(int argc, char **argv)
         extra[nextra++] = (struct nc_image_attr){"navcam:rock_fold_theta_bar_deg", fold};
     if (rows)
         extra[nextra++] = row_attr;
-    if (rc >= 0 && q <= NC_Q_RANGE)
+    if (rc >= 0 && q <= NC_Q_ROCK_ID)
         rc = nc_frame_write(out, &f, q, &scene, extra, nextra, &scale);
     else if (rc >= 0)
         rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, extra, nextra, &scale);

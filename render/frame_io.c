@@ -1,18 +1,20 @@
 /* frame_io.c - frame + scene -> image file with metadata. */
 #include "render/frame_io.h"
 
+#include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "render/image_io.h"
 #include "core/version.h"
 
-const char *const nc_quantity_names[] = {"radiance", "iof", "range", "electrons", "dn", NULL};
+const char *const nc_quantity_names[] = {"radiance", "iof", "range", "rock_id", "electrons", "dn", NULL};
 
 const char *nc_quantity_units(enum nc_quantity q)
 {
-    static const char *const u[] = {"W m^-2 sr^-1", "1 (I/F)", "m", "e-", "DN"};
+    static const char *const u[] = {"W m^-2 sr^-1", "1 (I/F)", "m", "1 (index in the body's boulder list, -1: none)", "e-", "DN"};
     return u[q];
 }
 
@@ -23,7 +25,7 @@ int nc_quantity_parse(const char *name, enum nc_quantity *q)
             *q = (enum nc_quantity)i;
             return 0;
         }
-    return nc_error(NC_EUSAGE, "unknown quantity '%s' (expected radiance, iof, range, electrons or dn)", name);
+    return nc_error(NC_EUSAGE, "unknown quantity '%s' (expected radiance, iof, range, rock_id, electrons or dn)", name);
 }
 
 int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_attr *attrs, char (*v)[200], int max)
@@ -74,13 +76,26 @@ int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_
 int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
                    const struct nc_image_attr *extra, int nextra, double *preview_scale)
 {
-    if (q > NC_Q_RANGE)
+    if (q > NC_Q_ROCK_ID)
         return nc_error(NC_EUSAGE, "quantity %s needs the camera model", nc_quantity_names[q]);
+    if (q == NC_Q_ROCK_ID && !f->rock_id)
+        return nc_error(NC_EUSAGE, "quantity rock_id needs a frame with its rock-id plane");
     struct nc_image_attr attrs[32];
     char text[24][200];
     int n = nc_frame_meta(s, q, attrs, text, 24);
     for (int i = 0; i < nextra && n < 32; i++)
         attrs[n++] = extra[i];
     const float *px = q == NC_Q_RADIANCE ? f->radiance : q == NC_Q_IOF ? f->iof : f->range_m;
-    return nc_image_write(path, px, f->width_px, f->height_px, attrs, n, preview_scale);
+    float *ids = NULL;
+    if (q == NC_Q_ROCK_ID) {
+        size_t np = (size_t)f->width_px * (size_t)f->height_px;
+        if (!(ids = malloc(np * sizeof *ids)))
+            return nc_error(-ENOMEM, "out of memory");
+        for (size_t i = 0; i < np; i++)
+            ids[i] = (float)f->rock_id[i];
+        px = ids;
+    }
+    int rc = nc_image_write(path, px, f->width_px, f->height_px, attrs, n, preview_scale);
+    free(ids);
+    return rc;
 }

@@ -10,7 +10,9 @@
 
 /* radiance, iof and range come from the renderer; electrons (noise-free
  * photo-electrons) and dn (a digitised frame) need the camera model. */
-enum nc_quantity { NC_Q_RADIANCE, NC_Q_IOF, NC_Q_RANGE, NC_Q_ELECTRONS, NC_Q_DN };
+/* NC_Q_ROCK_ID: the boulder each pixel shows (nc_frame.rock_id, which the
+ * caller allocates), as float32 (exact to 2^24), -1 for none. */
+enum nc_quantity { NC_Q_RADIANCE, NC_Q_IOF, NC_Q_RANGE, NC_Q_ROCK_ID, NC_Q_ELECTRONS, NC_Q_DN };
 
 extern const char *const nc_quantity_names[]; /* NULL-terminated, enum order */
 const char *nc_quantity_units(enum nc_quantity q);

@@ -167,6 +167,9 @@ head -c 28800 "$tmp/smooth.fits" | grep -aq "NORMALS = 'asteroid=smooth'" && ok 
 expect 0 "folded into the reflectance: theta_bar 16 ->" -- "$navcam" render "${small[@]}" \
   --set "bodies.0.boulders={preset: bennu, min_diameter_m: 2}" --set render.boulder_min_px=8 -o "$tmp/fold.fits"
 head -c 28800 "$tmp/fold.fits" | grep -aq "ROCKFOLD= 'asteroid=" && ok || bad "fold.fits lacks ROCKFOLD"
+# Which rock each pixel shows.
+expect 0 "rock_id [1 (index in the body's boulder list" -- "$navcam" render "${small[@]}" \
+  --set "bodies.0.boulders={preset: bennu, min_diameter_m: 2}" -q rock_id -o "$tmp/rocks.fits"
 
 # Every example scene renders (the camera-only ones overlay a scene; the
 # shape models come from ../shared/data/shapes, next to the checkout).
