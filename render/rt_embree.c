@@ -37,11 +37,9 @@ struct rt_body {
     const unsigned *tri[NC_LOD_MAX_LEVELS]; /* each level's triangles (Embree's index buffer) */
     unsigned inst_id;
     RTCGeometry inst;
-    /* boulders (rt_rocks.h): a scene of their own, instanced with the
-     * body's transform, placed at the anchor generation rocks_fitted */
+    /* boulders (rt_rocks.h): tiles of their own, each instanced in the
+     * top-level scene with the body's rotation */
     struct nc__rt_rocks rocks;
-    RTCGeometry rock_inst;
-    unsigned rock_inst_id, rocks_fitted;
     int analytic;
     /* Shadow-ray culling (shadow_grid.h): which levels are closed outward
      * surfaces, and the grid of the level shown (body frame, body origin). */
@@ -68,8 +66,11 @@ struct nc_rt {
     RTCScene top;
     struct rt_body body[NC_MAX_BODIES];
     int nbodies;
-    unsigned geom_to_body[2 * NC_MAX_BODIES]; /* instance ID -> body (the body's, its rocks') */
-    unsigned ninst;
+    /* Instance ID -> body (the body's own, or a tile of its rocks) and the
+     * rock tile it is (NULL for the body's own). */
+    unsigned *geom_to_body;
+    const struct nc__rt_rock_tile **inst_tile;
+    unsigned ninst, inst_cap;
     struct nc_rt_stats stats;
     atomic_ulong shadow_culled, shadow_traced;
 };
@@ -82,6 +83,30 @@ static int rt_check(RTCDevice dev, const char *what)
     static const char *const names[] = {"none", "unknown", "invalid argument", "invalid operation",
                                         "out of memory", "unsupported CPU", "cancelled"};
     return nc_error(NC_ERENDER, "embree: %s: %s", what, (unsigned)e < 7 ? names[e] : "error");
+}
+
+/* Instance id of the top-level scene -> body index and rock tile. */
+static int register_inst(struct nc_rt *rt, unsigned id, int body, const struct nc__rt_rock_tile *tile)
+{
+    if (id >= rt->inst_cap) {
+        unsigned cap = rt->inst_cap ? rt->inst_cap : 16;
+        while (cap <= id)
+            cap *= 2;
+        unsigned *g = realloc(rt->geom_to_body, cap * sizeof *g);
+        if (g)
+            rt->geom_to_body = g;
+        const struct nc__rt_rock_tile **t = realloc(rt->inst_tile, cap * sizeof *t);
+        if (t)
+            rt->inst_tile = t;
+        if (!g || !t)
+            return nc_error(-ENOMEM, "out of memory for %u instances", cap);
+        memset(rt->inst_tile + rt->inst_cap, 0, (cap - rt->inst_cap) * sizeof *t);
+        rt->inst_cap = cap;
+    }
+    rt->geom_to_body[id] = (unsigned)body;
+    rt->inst_tile[id] = tile;
+    rt->ninst = id + 1 > rt->ninst ? id + 1 : rt->ninst;
+    return 0;
 }
 
 /* ---- analytic ellipsoid (user geometry) ---------------------------------- */
@@ -246,22 +271,22 @@ static int body_init(struct nc_rt *rt, unsigned index, const struct nc_body *src
         if (src->smooth_normals && (rc = vertex_normals(b, m)) < 0)
             return rc;
         if (src->boulders.n) { /* rocks shadow the body: no grid proves a point lit */
-            if ((rc = nc__rt_rocks_init(rt->dev, &src->boulders, &b->anchor_m, &b->rocks)) < 0)
+            if ((rc = nc__rt_rocks_init(rt->dev, &src->boulders, &b->rocks)) < 0 ||
+                (rc = nc__rt_rocks_attach(&b->rocks, rt->dev, rt->top)) < 0)
                 return rc;
             for (int k = 0; k < b->nlevels; k++)
                 b->closed[k] = 0;
-            b->rock_inst = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_INSTANCE);
-            rtcSetGeometryInstancedScene(b->rock_inst, b->rocks.scene);
-            b->rock_inst_id = rtcAttachGeometry(rt->top, b->rock_inst);
-            rt->geom_to_body[b->rock_inst_id] = index;
-            rt->ninst = b->rock_inst_id + 1 > rt->ninst ? b->rock_inst_id + 1 : rt->ninst;
+            for (size_t t = 0; t < b->rocks.ntiles && rc == 0; t++)
+                rc = register_inst(rt, b->rocks.tile[t].inst_id, index, &b->rocks.tile[t]);
+            if (rc < 0)
+                return rc;
         }
     }
     b->inst = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(b->inst, b->scene[0]);
     b->inst_id = rtcAttachGeometry(rt->top, b->inst);
-    rt->geom_to_body[b->inst_id] = index;
-    rt->ninst = b->inst_id + 1 > rt->ninst ? b->inst_id + 1 : rt->ninst;
+    if ((rc = register_inst(rt, b->inst_id, index, NULL)) < 0)
+        return rc;
     return rt_check(rt->dev, "creating geometry");
 }
 
@@ -445,15 +470,12 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
         b->cull_radius_m = src->bounding_radius_m * (1 + 1e-5) + 1e-5 * nc_v3_norm(b->origin_rel);
         rtcSetGeometryTransform(b->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(b->inst);
-        if (b->rock_inst) {
+        if (b->rocks.ntiles) {
             /* Boulders: those spanning render.boulder_min_px pixels at the
              * nearest possible range (every one from inside the bounding
              * sphere), like the level of detail a function of the pose. */
             nc__rt_rocks_cut(&b->rocks, nc_scene_boulder_min_px(s, i) * px_m);
-            nc__rt_rocks_commit(&b->rocks, b->rocks_fitted != b->anchor_gen);
-            b->rocks_fitted = b->anchor_gen;
-            rtcSetGeometryTransform(b->rock_inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
-            rtcCommitGeometry(b->rock_inst);
+            nc__rt_rocks_place(&b->rocks, &R, b->origin_rel);
             rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
             rt->stats.boulders_traced[i] = b->rocks.traced;
             rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
@@ -532,8 +554,8 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
             const unsigned *t = b->tri[b->level] + 3 * (size_t)rh.hit.primID[i];
             const float *a = b->src->albedo_vertex, u = rh.hit.u[i], v = rh.hit.v[i];
             alb = (1 - u - v) * a[t[0]] + u * a[t[1]] + v * a[t[2]];
-        } else if (inst == b->rock_inst_id && b->rock_inst) {
-            size_t k = nc__rt_rock_index(&b->rocks, rh.hit.geomID[i], rh.hit.primID[i]);
+        } else if (rt->inst_tile[inst]) {
+            size_t k = rt->inst_tile[inst]->index[rh.hit.primID[i]];
             alb = nc_albedo_var_rock(&b->src->albedo_var, k);
             rock = (int32_t)k;
         }
@@ -809,8 +831,6 @@ void nc_rt_destroy(struct nc_rt *rt)
         struct rt_body *b = &rt->body[i];
         if (b->inst)
             rtcReleaseGeometry(b->inst);
-        if (b->rock_inst)
-            rtcReleaseGeometry(b->rock_inst);
         nc__rt_rocks_free(&b->rocks);
         for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
             if (b->geom[k])
@@ -828,5 +848,7 @@ void nc_rt_destroy(struct nc_rt *rt)
         free(rt->body[i].vnormal);
         nc_shadow_grid_free(&rt->body[i].grid);
     }
+    free(rt->geom_to_body);
+    free(rt->inst_tile);
     free(rt);
 }

@@ -1,12 +1,20 @@
-/* rt_rocks.h - boulders (boulders.h) for the Embree back-end: a scene per
- * body of its own, instanced with the body's transform, holding one user
- * geometry per octave of diameter. Each rock is a primitive that refers to
- * its shared shape: 48 bytes in the list, 64 here, plus the tree's share,
- * where an Embree instance costs about 390 bytes (measured with Embree
- * 3.13: a million instances take 368 MiB). Rocks smaller than a
- * cut are not traced: octaves wholly below it are disabled, and the rest of
- * the boulders below it are refused in the intersection test. Internal to
- * the Embree back-end (rt_embree.c). */
+/* rt_rocks.h - boulders (boulders.h) for the Embree back-end. Each octave
+ * of diameter is split into tiles, cubes of the body frame 1024 times the
+ * octave's largest diameter on a side; a tile is an Embree scene of its own
+ * (one user geometry whose primitives are its rocks, each referring to its
+ * shared shape: 48 bytes in the list, 64 here and 4 of index, plus the
+ * tree's share) with its rocks stored relative to the tile's own origin,
+ * and an instance in the top-level scene. The tiles' trees are built once:
+ * a pose only moves their instances (the float translation from the camera
+ * to a tile's origin costs 6e-8 of that distance, a record 6e-8 of its
+ * distance from the origin: under 1e-4 of the rock's own size), so nothing
+ * is rebuilt when the camera moves. Rocks smaller than a cut are not traced: tiles of
+ * octaves wholly below it are disabled, and the rest of the rocks below it
+ * are refused in the intersection test by their rank in the list (the list
+ * is sorted by size). An Embree instance per rock would cost about 390
+ * bytes (measured with Embree 3.13: a million instances take 368 MiB); per
+ * tile, it is a few per thousand rocks. Internal to the Embree back-end
+ * (rt_embree.c). */
 #ifndef NC_RT_ROCKS_H
 #define NC_RT_ROCKS_H
 
@@ -17,16 +25,21 @@
 
 struct nc__rt_rocks;
 
-struct nc__rt_rock_octave {
+struct nc__rt_rock_tile {
     struct nc__rt_rocks *rocks;
-    size_t first; /* its first rock in the list */
-    RTCGeometry geom;
+    double origin_m[3];    /* body frame: its rocks' records are relative to it */
+    const uint32_t *index; /* list index of each primitive, ascending (largest rock first) */
+    unsigned n;
+    int octave; /* in the field's octave table */
+    RTCScene scene;
+    RTCGeometry geom, inst;
+    unsigned inst_id; /* in the top-level scene */
     int enabled;
 };
 
 /* What the intersection test reads of a rock: one cache line. */
 struct nc__rt_rock {
-    float c[3];   /* centre relative to the anchor, body frame, m */
+    float c[3];   /* centre relative to its tile's origin, body frame, m */
     float M[9];   /* body frame -> rock frame over half_m: R^T / half_m, row-major */
     float ext[3]; /* the rock's extent from c along each body axis, m */
     uint32_t shape;
@@ -36,22 +49,14 @@ _Static_assert(sizeof(struct nc__rt_rock) == 64, "a rock record is one cache lin
 
 struct nc__rt_rocks {
     const struct nc_boulder_field *field;
-    const struct nc_vec3 *anchor_m; /* the body's anchor (body frame): geometry is relative to it */
-    struct nc__rt_rock *rock;       /* field->rock[i] as traced */
-    RTCScene scene;
-    struct nc__rt_rock_octave octave[NC_BOULDER_OCTAVES];
-    int noctaves;
-    double min_d_m; /* the cut: the smallest diameter traced */
-    size_t traced;  /* rocks at or above the cut: rock[0 .. traced) */
+    struct nc__rt_rock *rock; /* field->rock[i] as traced */
+    uint32_t *index;          /* the tiles' index arrays, end to end */
+    struct nc__rt_rock_tile *tile;
+    size_t ntiles;
+    double min_d_m;   /* the cut: the smallest diameter traced */
+    size_t traced;    /* rocks at or above the cut: rock[0 .. traced) */
     double cut_cover; /* nc_boulders_cover() of the rocks below the cut */
-    int dirty;        /* the scene needs a commit */
 };
-
-/* The list index of the rock a hit in the rocks' scene names. */
-static inline size_t nc__rt_rock_index(const struct nc__rt_rocks *r, unsigned geom_id, unsigned prim_id)
-{
-    return r->octave[geom_id].first + prim_id;
-}
 
 /* Lane i of an Embree ray packet of width N (RTCRayN: origin, tnear,
  * direction, time, tfar, ... by component), as a user geometry reads it.
@@ -86,15 +91,15 @@ static inline void nc__rt_user_hit(const struct RTCIntersectFunctionNArguments *
     ((unsigned *)hit)[7 * N + i] = a->context->instID[0];
 }
 
-/* The rock scene of field f, rocks relative to *anchor_m, every rock traced
- * until the first nc__rt_rocks_cut. Not committed: nc__rt_rocks_commit. */
-int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, const struct nc_vec3 *anchor_m,
-                      struct nc__rt_rocks *r);
-/* Trace rocks of diameter min_d_m or more only (0: all). */
+/* The tiles of field f, every rock traced until the first cut. */
+int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc__rt_rocks *r);
+/* Each tile's instance, attached to top (tile[k].inst_id). */
+int nc__rt_rocks_attach(struct nc__rt_rocks *r, RTCDevice dev, RTCScene top);
+/* Trace only rocks of diameter min_d_m or more (0: all). */
 void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m);
-/* Move the rocks to the anchor (moved: after a re-anchor) and, if that or a
- * cut changed the scene, commit it (a rebuild of its tree). */
-void nc__rt_rocks_commit(struct nc__rt_rocks *r, int moved);
+/* The enabled tiles' instances for the body's pose: R body -> scene,
+ * origin_rel the body origin relative to the camera (scene frame). */
+void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct nc_vec3 origin_rel);
 void nc__rt_rocks_free(struct nc__rt_rocks *r);
 
 #endif

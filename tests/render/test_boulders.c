@@ -133,6 +133,23 @@ static void check_render(void)
     for (size_t i = 0; i < n; i++)
         differ += a.radiance[i] != b.radiance[i];
     CHECK(!memcmp(b.radiance, c.radiance, n * sizeof *b.radiance), "1 and 2 threads differ with boulders");
+    /* A function of the pose alone: a renderer that comes from elsewhere
+     * (the camera 400 m closer first: a new anchor for the mesh, the rock
+     * tiles moved) gives the same frame as a fresh one. */
+    {
+        struct nc_renderer rr;
+        struct nc_frame g;
+        struct nc_vec3 at = rocky.camera.position_m;
+        CHECK(nc_renderer_init(&rr, &rocky, 2) == 0 && nc_frame_alloc(&g, b.width_px, b.height_px) == 0, "%s",
+              nc_errmsg());
+        rocky.camera.position_m = nc_v3_scale(at, 0.85);
+        CHECK(nc_render_frame(&rr, &rocky, &g) == 0, "%s", nc_errmsg());
+        rocky.camera.position_m = at;
+        CHECK(nc_render_frame(&rr, &rocky, &g) == 0, "%s", nc_errmsg());
+        CHECK(!memcmp(b.radiance, g.radiance, n * sizeof *b.radiance), "the frame depends on the pose before");
+        nc_frame_free(&g);
+        nc_renderer_free(&rr);
+    }
     CHECK(differ > n / 20, "only %zu of %zu pixels changed by the rocks", differ, n);
     int finite = 1;
     for (size_t i = 0; i < n; i++)
