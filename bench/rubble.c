@@ -11,7 +11,7 @@
  * frame's brightness moves with them folded into the roughness (cut_flux:
  * total radiance / that with every rock - 1; theta_bar the roughness used)
  * and without the fold (unfolded_flux); and the time of a pose update that moves the
- * anchor (the rocks' tree rebuilt). Memory: resident memory the rubble
+ * anchor (the mesh re-anchored; the rock tiles only move). Memory: resident memory the rubble
  * scene and its renderer take beyond the bare ones.
  * Usage: bench_rubble [--frames N] [--threads N]
  * One line per range:
