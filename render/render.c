@@ -110,6 +110,8 @@ struct job {
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
     struct nc_vec3 sun_dir;
     double sun_irr;
+    double sun_tan_radius; /* soft shadows: tan of the Sun's angular radius (0: hard) */
+    uint64_t disk_seed;
     int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
 };
 
@@ -278,13 +280,27 @@ static void shade_tile(struct job *j, int tile)
                     shadow.ox[i] = (float)(p.x + eps * nrm.x);
                     shadow.oy[i] = (float)(p.y + eps * nrm.y);
                     shadow.oz[i] = (float)(p.z + eps * nrm.z);
-                    shadow.dx[i] = (float)sdir.x;
-                    shadow.dy[i] = (float)sdir.y;
-                    shadow.dz[i] = (float)sdir.z;
+                    struct nc_vec3 sray = sdir;
+                    if (j->sun_tan_radius > 0) {
+                        /* Soft shadows: toward a point of the solar disk, uniform
+                         * over it, from a stream of its own (pixel, sample). */
+                        uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                        double rr = j->sun_tan_radius * sqrt(hash01(j->disk_seed, pid, 2 * (uint64_t)sidx)),
+                               th = 2.0 * M_PI * hash01(j->disk_seed, pid, 2 * (uint64_t)sidx + 1);
+                        struct nc_vec3 e1 = nc_v3_unit(fabs(sdir.x) < 0.9 ? nc_v3_cross(sdir, nc_v3(1, 0, 0))
+                                                                          : nc_v3_cross(sdir, nc_v3(0, 1, 0)));
+                        struct nc_vec3 e2 = nc_v3_cross(sdir, e1);
+                        sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)),
+                                                                    nc_v3_scale(e2, rr * sin(th)))));
+                    }
+                    shadow.dx[i] = (float)sray.x;
+                    shadow.dy[i] = (float)sray.y;
+                    shadow.dz[i] = (float)sray.z;
                     shadow.tnear[i] = 0.0f;
                     shadow.tfar[i] = INFINITY;
                     shadow.valid[i] = -1;
-                    from[i] = outside ? hit.body[i] : -1;
+                    /* the grid's proof needs a ray leaving the outer side */
+                    from[i] = outside && nc_v3_dot(nrm, sray) > 0 ? hit.body[i] : -1;
                     lit[i] = 1;
                     any++;
                 }
@@ -416,6 +432,8 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     atomic_init(&j.next, 0);
     j.cull = !c->distorted && !r->no_cull; /* the lens model's rays are not linear in the pixel */
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
+    j.sun_tan_radius = s->render.soft_shadows ? tan(nc_scene_sun_radius_rad(s)) : 0.0;
+    j.disk_seed = mix64(s->render.seed ^ 0x736f6674ull); /* "soft": not the pixel jitter's stream */
 
     /* Threads kept between frames (and between a rolling shutter's bands);
      * fewer threads only cost time, never change pixels. */

@@ -365,10 +365,10 @@ static void reanchor(struct rt_body *b, struct nc_vec3 a)
  * the pose, never of the path to it. */
 #define GRID_TOL_RAD 2.5e-4
 
-static int build_grid(struct rt_body *b, int k, struct nc_vec3 sun, double margin_m)
+static int build_grid(struct rt_body *b, int k, struct nc_vec3 sun, double tol_rad, double margin_m)
 {
     const unsigned *tri = rtcGetGeometryBufferData(b->geom[k], RTC_BUFFER_TYPE_INDEX, 0);
-    int rc = nc_shadow_grid_build(&b->grid, b->src->mesh.v, tri, b->nt[k], sun, GRID_TOL_RAD, nc_v3(0, 0, 0),
+    int rc = nc_shadow_grid_build(&b->grid, b->src->mesh.v, tri, b->nt[k], sun, tol_rad, nc_v3(0, 0, 0),
                                   b->src->bounding_radius_m, margin_m);
     b->grid_level = rc < 0 ? -1 : k;
     return rc;
@@ -395,10 +395,15 @@ static int update_grid(struct rt_body *b, const struct nc_scene *s)
      * the double mesh; the margin is 1e-6 of it rounded up to a power of
      * two, so that re-anchoring rarely changes it. */
     const double margin = exp2(ceil(log2(1e-6 * (nc_v3_norm(b->anchor_m) + b->src->bounding_radius_m))));
+    /* Soft shadows aim anywhere on the solar disk: the grid serves rays
+     * within its angular radius more (rounded up to 1e-4 rad, so that a
+     * slowly changing distance rarely rebuilds it). */
+    const double tol = GRID_TOL_RAD + (s->render.soft_shadows ? 1e-4 * ceil(nc_scene_sun_radius_rad(s) / 1e-4) : 0);
     const struct nc_vec3 gs = b->grid.sun;
     int rc = 0;
-    if (b->grid_level != k || b->grid.margin_m != margin || gs.x != sun.x || gs.y != sun.y || gs.z != sun.z)
-        rc = build_grid(b, k, sun, margin);
+    if (b->grid_level != k || b->grid.margin_m != margin || b->grid.tol_rad != tol || gs.x != sun.x ||
+        gs.y != sun.y || gs.z != sun.z)
+        rc = build_grid(b, k, sun, tol, margin);
     /* body coordinates: R^T (x - origin_rel) */
     const struct nc_vec3 ax[3] = {b->grid.u, b->grid.v, b->grid.sun};
     for (int c = 0; c < 3; c++) {

@@ -199,6 +199,7 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun)
             return nc_cfg_error(nc_cfg_get(map, "position_m"), "the Sun is closer than 1 km to the body");
         sun->has_position = 1;
     }
+    sun->distance_m = d_m;
     if (!sun->irradiance_override)
         sun->irradiance_w_m2 = NC_SOLAR_CONSTANT_W_M2 * (NC_AU_M / d_m) * (NC_AU_M / d_m);
     return 0;
@@ -214,6 +215,7 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     r->lod_error_px = 0;
     r->boulder_min_px = -1;
     r->boulder_fold = 1;
+    r->soft_shadows = 0;
     if (!map)
         return 0;
     if ((rc = nc_cfg_int(map, "samples_per_pixel", 1, 1024, &v)) < 0)
@@ -236,7 +238,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     if ((rc = nc_cfg_double(map, "boulder_min_px", 0, 1000, &r->boulder_min_px)) < 0)
         return rc;
     static const char *const bools[] = {"false", "true", NULL};
-    if ((rc = nc_cfg_enum(map, "boulder_fold", bools, &r->boulder_fold)) < 0)
+    if ((rc = nc_cfg_enum(map, "boulder_fold", bools, &r->boulder_fold)) < 0 ||
+        (rc = nc_cfg_enum(map, "soft_shadows", bools, &r->soft_shadows)) < 0)
         return rc;
     return 0;
 }
@@ -378,4 +381,10 @@ double nc_scene_boulder_min_px(const struct nc_scene *s, int b)
     if (s->render.boulder_min_px >= 0)
         return s->render.boulder_min_px;
     return s->render.boulder_fold && nc_material_roughness_param(&s->body[b].material) >= 0 ? 1.0 : 0.0;
+}
+
+double nc_scene_sun_radius_rad(const struct nc_scene *s)
+{
+    double d = s->sun.has_position ? nc_v3_norm(s->sun.position_m) : s->sun.distance_m;
+    return d > NC_SUN_RADIUS_M ? asin(NC_SUN_RADIUS_M / d) : M_PI / 2;
 }

@@ -21,6 +21,7 @@
 
 #define NC_AU_M 149597870700.0     /* IAU 2012, exact */
 #define NC_SOLAR_CONSTANT_W_M2 1361.0 /* total solar irradiance at 1 au */
+#define NC_SUN_RADIUS_M 6.957e8       /* IAU 2015 nominal solar radius */
 #define NC_MAX_BODIES 16
 
 enum nc_shape_type { NC_SHAPE_SPHERE, NC_SHAPE_ELLIPSOID, NC_SHAPE_MESH, NC_SHAPE_ASTEROID };
@@ -50,6 +51,7 @@ struct nc_sun {
     struct nc_vec3 position_m;  /* bodies[0] frame (when has_position) */
     double irradiance_w_m2;     /* at bodies[0] (direction) or at 1 au scaled by 1/d^2 (position) */
     int irradiance_override;
+    double distance_m;          /* from bodies[0] (direction: sun.distance_au; position: |position_m|) */
 };
 
 struct nc_render_settings {
@@ -65,6 +67,7 @@ struct nc_render_settings {
      * reflectance, 0 for others (nc_scene_boulder_min_px). */
     double boulder_min_px;
     int boulder_fold; /* 1 (default): fold the rocks not traced into the reflectance */
+    int soft_shadows; /* 1: shadow rays toward points of the solar disk (penumbrae); 0: its centre */
 };
 
 struct nc_scene {
@@ -96,6 +99,9 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
 int nc__scene_error_at(const struct nc_cfg_node *n);
 /* Shapes `dem` and `globe` as meshes (scene_dem.c; internal to scene*.c). */
 int nc__scene_dem_from_config(struct nc_cfg_node *shape, int globe, struct nc_body *b);
+
+/* The Sun's angular radius seen from bodies[0], radians. */
+double nc_scene_sun_radius_rad(const struct nc_scene *s);
 
 /* The boulder cut of body b in pixels (render.boulder_min_px resolved). */
 double nc_scene_boulder_min_px(const struct nc_scene *s, int b);
