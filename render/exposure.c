@@ -60,6 +60,8 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
     struct acc a = {calloc(n, sizeof(double)), calloc(n, sizeof(double)), calloc(n, sizeof(double)),
                     calloc(n, sizeof(double))};
     int rc = nc_frame_alloc(&sub, W, H);
+    if (rc >= 0 && f->rock_id && !(sub.rock_id = malloc(n * sizeof *sub.rock_id)))
+        rc = nc_error(-ENOMEM, "out of memory");
     if (rc < 0 || !a.L || !a.iof || !a.range || !a.cov) {
         rc = rc < 0 ? rc : nc_error(-ENOMEM, "out of memory");
         goto out;
@@ -84,6 +86,9 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
             nc_scene_propagate(s, tc + T * ((k + 0.5) / K - 0.5), &at);
             if ((rc = nc_render_rows_timed(r, &at, &sub, r0, r1, row_dt)) >= 0)
                 accumulate(&a, &sub, (size_t)y0 * W, (size_t)y1 * W);
+            if (rc >= 0 && f->rock_id && k == K / 2) /* the rocks seen at the middle time sample */
+                memcpy(f->rock_id + (size_t)y0 * W, sub.rock_id + (size_t)y0 * W,
+                       (size_t)(y1 - y0) * (size_t)W * sizeof *f->rock_id);
         }
     }
     free(row_dt);

@@ -23,7 +23,8 @@ struct nc_frame {
     float *coverage;  /* fraction of the pixel's samples that hit a body */
     /* Optional (the caller allocates it; nc_frame_free frees it): the
      * boulder the pixel's first sample hit, as its index in its body's
-     * list (boulders.h), -1 for ground, sky or no rock. */
+     * list (boulders.h), -1 for ground, sky or no rock (an exposure with
+     * time samples: at the middle one). */
     int32_t *rock_id;
 };
 
