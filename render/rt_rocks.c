@@ -69,12 +69,23 @@ static int rock_hit(const struct nc__rt_rocks *r, size_t i, const float o[3], co
     const struct nc__rt_rock *k = &r->rock[i];
     const float *M = k->M;
     const float rel[3] = {o[0] - k->c[0], o[1] - k->c[1], o[2] - k->c[2]};
+    const struct nc_rock_shape *sh = &r->field->shape[k->shape];
+    /* The sphere through the box's corners first (|half| rock units, each
+     * 1/|row of M| metres): a ray the tree's box let through that passes
+     * outside it costs no transform. */
+    const float dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], tc = -(rel[0] * d[0] + rel[1] * d[1] + rel[2] * d[2]) / dd;
+    /* the ray's point nearest the centre, relative to it (no cancellation
+     * of two large squares: the origin may be kilometres away) */
+    const float q[3] = {rel[0] + tc * d[0], rel[1] + tc * d[1], rel[2] + tc * d[2]};
+    const float m2 = M[0] * M[0] + M[1] * M[1] + M[2] * M[2];
+    const float h2 = sh->half[0] * sh->half[0] + sh->half[1] * sh->half[1] + sh->half[2] * sh->half[2];
+    if ((q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) * m2 > 1.01f * h2)
+        return 0;
     float ol[3], dl[3];
     for (int j = 0; j < 3; j++) { /* t is unchanged by the scale */
         ol[j] = M[3 * j] * rel[0] + M[3 * j + 1] * rel[1] + M[3 * j + 2] * rel[2];
         dl[j] = M[3 * j] * d[0] + M[3 * j + 1] * d[1] + M[3 * j + 2] * d[2];
     }
-    const struct nc_rock_shape *sh = &r->field->shape[k->shape];
     const v4f ninf = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, pinf = -ninf;
     v4f t0 = {tnear, tnear, tnear, tnear}, t1 = {tfar, tfar, tfar, tfar};
     v4f tk[NC_ROCK_PLANES / 4];
