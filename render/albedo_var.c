@@ -11,13 +11,7 @@ int nc_albedo_var_vertices(const struct nc_mesh *m, const struct nc_albedo_var_p
                            double *smallest_m)
 {
     *out = NULL;
-    double len = 0;
-    for (size_t t = 0; t < m->nt; t++)
-        for (int e = 0; e < 3; e++) {
-            const double *a = m->v + 3 * m->tri[3 * t + e], *b = m->v + 3 * m->tri[3 * t + (e + 1) % 3];
-            len += sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]));
-        }
-    double wl_min = m->nt ? 2 * len / (3.0 * (double)m->nt) : 0;
+    double wl_min = 2 * nc_mesh_mean_edge_m(m);
     *smallest_m = wl_min;
     float *f = malloc((m->nv ? m->nv : 1) * sizeof *f);
     if (!f)

@@ -110,6 +110,8 @@ double nc_mesh_bounding_radius(const struct nc_mesh *m);
  * winding (zero for a degenerate face; unit_normal may be NULL). */
 double nc_mesh_face(const struct nc_mesh *m, size_t t, struct nc_vec3 *unit_normal);
 double nc_mesh_area_m2(const struct nc_mesh *m);
+/* The mean length of the triangles' edges (each counted once per triangle), m. */
+double nc_mesh_mean_edge_m(const struct nc_mesh *m);
 /* Unit normals at the vertices (3 per vertex, into n), the area-weighted
  * mean of the faces around each; zero for a vertex no face uses. */
 void nc_mesh_vertex_normals(const struct nc_mesh *m, double *n);

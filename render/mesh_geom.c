@@ -20,6 +20,20 @@ double nc_mesh_face(const struct nc_mesh *m, size_t t, struct nc_vec3 *unit_norm
     return 0.5 * len;
 }
 
+double nc_mesh_mean_edge_m(const struct nc_mesh *m)
+{
+    double len = 0;
+    for (size_t t = 0; t < m->nt; t++)
+        for (int e = 0; e < 3; e++) {
+            const double *a = m->v + 3 * m->tri[3 * t + e], *b = m->v + 3 * m->tri[3 * t + (e + 1) % 3];
+            double d2 = 0;
+            for (int k = 0; k < 3; k++)
+                d2 += (b[k] - a[k]) * (b[k] - a[k]);
+            len += sqrt(d2);
+        }
+    return m->nt ? len / (3.0 * (double)m->nt) : 0;
+}
+
 double nc_mesh_area_m2(const struct nc_mesh *m)
 {
     double a = 0;

@@ -32,18 +32,13 @@ static int measure(const struct nc_mesh *m, const double *nrm, double hurst, dou
         free(cnt);
         return nc_error(-ENOMEM, "out of memory for %zu vertices", m->nv);
     }
-    double len = 0;
     for (size_t t = 0; t < m->nt; t++)
         for (int e = 0; e < 3; e++) {
             uint32_t a = m->tri[3 * t + e], b = m->tri[3 * t + (e + 1) % 3];
-            double d2 = 0;
             for (int k = 0; k < 3; k++) {
-                double d = m->v[3 * b + k] - m->v[3 * a + k];
-                d2 += d * d;
                 sum[3 * a + k] += m->v[3 * b + k];
                 sum[3 * b + k] += m->v[3 * a + k];
             }
-            len += sqrt(d2);
             cnt[a]++, cnt[b]++;
         }
     double m1 = 0, m2 = 0;
@@ -60,7 +55,7 @@ static int measure(const struct nc_mesh *m, const double *nrm, double hurst, dou
     }
     free(sum);
     free(cnt);
-    *edge_m = m->nt ? len / (3.0 * (double)m->nt) : 0;
+    *edge_m = nc_mesh_mean_edge_m(m);
     double var = n ? m2 / (double)n - (m1 / (double)n) * (m1 / (double)n) : 0;
     *s = *edge_m > 0 ? sqrt(fmax(var, 0)) / (pow(2 * *edge_m, hurst) * midpoint_factor(hurst)) : 0;
     return 0;

@@ -111,9 +111,17 @@ struct job {
     struct nc_vec3 sun_dir;
     double sun_irr;
     double sun_tan_radius; /* soft shadows: tan of the Sun's angular radius (0: hard) */
+    struct nc_vec3 sun_e1, sun_e2; /* axes across sun_dir, for points of the disk */
     uint64_t disk_seed;
     int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
 };
+
+/* Two unit axes across the unit direction d (soft shadows' disk of the Sun). */
+static void disk_axes(struct nc_vec3 d, struct nc_vec3 *e1, struct nc_vec3 *e2)
+{
+    *e1 = nc_v3_unit(fabs(d.x) < 0.9 ? nc_v3_cross(d, nc_v3(1, 0, 0)) : nc_v3_cross(d, nc_v3(0, 1, 0)));
+    *e2 = nc_v3_cross(d, *e1);
+}
 
 /* Whether any ray of the 4x4 pixel block at (px0, py0) can reach a body's
  * bounding sphere. Conservative: every sample of pixel (x, y) lies in
@@ -287,9 +295,9 @@ static void shade_tile(struct job *j, int tile)
                         uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
                         double rr = j->sun_tan_radius * sqrt(hash01(j->disk_seed, pid, 2 * (uint64_t)sidx)),
                                th = 2.0 * M_PI * hash01(j->disk_seed, pid, 2 * (uint64_t)sidx + 1);
-                        struct nc_vec3 e1 = nc_v3_unit(fabs(sdir.x) < 0.9 ? nc_v3_cross(sdir, nc_v3(1, 0, 0))
-                                                                          : nc_v3_cross(sdir, nc_v3(0, 1, 0)));
-                        struct nc_vec3 e2 = nc_v3_cross(sdir, e1);
+                        struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
+                        if (s->sun.has_position) /* the direction differs from point to point */
+                            disk_axes(sdir, &e1, &e2);
                         sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)),
                                                                     nc_v3_scale(e2, rr * sin(th)))));
                     }
@@ -433,6 +441,7 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     j.cull = !c->distorted && !r->no_cull; /* the lens model's rays are not linear in the pixel */
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
     j.sun_tan_radius = s->render.soft_shadows ? tan(nc_scene_sun_radius_rad(s)) : 0.0;
+    disk_axes(j.sun_dir, &j.sun_e1, &j.sun_e2);
     j.disk_seed = mix64(s->render.seed ^ 0x736f6674ull); /* "soft": not the pixel jitter's stream */
 
     /* Threads kept between frames (and between a rolling shutter's bands);
