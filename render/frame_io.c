@@ -34,7 +34,7 @@ int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_
     const struct nc_body *b0 = &s->body[0];
     struct nc_vec3 sun_dir;
     double sun_irr;
-    if (max < 15)
+    if (max < 16)
         return 0;
     nc_scene_sun_at(s, b0->position_m, &sun_dir, &sun_irr);
     snprintf(v[0], 200, "NavCam %s", NC_VERSION_STRING);
@@ -51,6 +51,8 @@ int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_
     snprintf(v[10], 200, "[%.17g, %.17g, %.17g, %.17g]", b0->attitude_q.w, b0->attitude_q.x, b0->attitude_q.y,
              b0->attitude_q.z);
     snprintf(v[11], 200, "[%.17g, %.17g, %.17g, %.17g, %.17g]", c->k1, c->k2, c->k3, c->p1, c->p2);
+    snprintf(v[12], 200, "shadows=%s bounces=%d roulette_after=%d", s->render.soft_shadows ? "soft" : "hard",
+             s->render.bounces, s->render.roulette_after);
     const struct nc_image_attr a[] = {
         {"Software", v[0]},
         {"navcam:version", NC_VERSION_STRING},
@@ -65,6 +67,7 @@ int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_
         {"navcam:intrinsics_fx_fy_cx_cy_px", v[7]},
         {"navcam:distortion_k1_k2_k3_p1_p2", v[11]},
         {"navcam:samples_per_pixel", v[8]},
+        {"navcam:light", v[12]},
         {"navcam:body0_position_m", v[9]},
         {"navcam:body0_attitude_q", v[10]},
     };

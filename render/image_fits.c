@@ -38,6 +38,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:sun_irradiance_w_m2", "SUNIRR"},
     {"navcam:intrinsics_fx_fy_cx_cy_px", "INTRINS"},
     {"navcam:samples_per_pixel", "SPP"},
+    {"navcam:light", "LIGHT"},
     {"navcam:body0_position_m", "BODYPOS"},
     {"navcam:body0_attitude_q", "BODYQUAT"},
     {"navcam:preview_scale", "PRVSCALE"},

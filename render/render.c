@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "render/albedo_map.h"
+#include "render/bounce.h"
 #include "core/error.h"
 #include "core/pool.h"
 
@@ -113,6 +114,8 @@ struct job {
     double sun_tan_radius; /* soft shadows: tan of the Sun's angular radius (0: hard) */
     struct nc_vec3 sun_e1, sun_e2; /* axes across sun_dir, for points of the disk */
     uint64_t disk_seed;
+    int bounces, roulette_after; /* indirect light (render.bounces, render.roulette_after) */
+    uint64_t path_seed;          /* the bounce directions' stream */
     int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
 };
 
@@ -169,6 +172,262 @@ static int block_can_hit(const struct job *j, int px0, int py0)
     return 0;
 }
 
+/* The surface points a packet's rays reached: per lane, where and how. */
+struct surf {
+    int body[NC_PACKET];      /* -1: none (a miss, or a float hit the exact shape refutes) */
+    int outside[NC_PACKET];   /* the ray came from the outer side of the surface */
+    double t[NC_PACKET];      /* ray parameter, m */
+    struct nc_vec3 p[NC_PACKET];    /* position relative to the camera, scene frame, m */
+    struct nc_vec3 n[NC_PACKET];    /* unit normal, turned to face the ray's origin */
+    struct nc_vec3 d[NC_PACKET];    /* the ray's unit direction */
+    struct nc_vec3 sdir[NC_PACKET]; /* unit direction to the Sun's centre */
+    double irr[NC_PACKET];    /* solar irradiance there, W m^-2 */
+    double factor[NC_PACKET]; /* on the albedo: variation and map */
+};
+
+/* Fill s from a packet's hits, for rays from orig along the unit dir. */
+static void surface16(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
+                      const struct nc_vec3 *dir, struct surf *s)
+{
+    const struct nc_scene *sc = j->s;
+    for (int i = 0; i < NC_PACKET; i++) {
+        s->body[i] = hit->body[i];
+        if (hit->body[i] < 0)
+            continue;
+        struct nc_vec3 d = dir[i], nrm;
+        double t = hit->t[i];
+        int exact = nc_rt_refine(j->rt, hit->body[i], orig[i], d, &t, &nrm);
+        if (exact < 0) { /* the float trace grazed a limb the exact shape misses */
+            s->body[i] = -1;
+            continue;
+        }
+        if (exact == 0)
+            nrm = nc_v3_unit(nc_v3(hit->nx[i], hit->ny[i], hit->nz[i]));
+        s->outside[i] = nc_v3_dot(nrm, d) <= 0;
+        if (!s->outside[i]) /* back face: inconsistent winding, or the ray from inside */
+            nrm = nc_v3_scale(nrm, -1.0);
+        struct nc_vec3 p = nc_v3_add(orig[i], nc_v3_scale(d, t));
+        s->t[i] = t;
+        s->p[i] = p;
+        s->n[i] = nrm;
+        s->d[i] = d;
+        s->sdir[i] = j->sun_dir;
+        s->irr[i] = j->sun_irr;
+        if (sc->sun.has_position)
+            nc_scene_sun_at(sc, nc_v3_add(p, sc->camera.position_m), &s->sdir[i], &s->irr[i]);
+        double factor = hit->albedo[i]; /* albedo variation */
+        const struct nc_albedo_map *am = sc->body[hit->body[i]].material.albedo_map;
+        if (am) { /* at the body-fixed position of the hit, in double */
+            int bi = hit->body[i];
+            factor *= nc_albedo_map_factor(am, nc_mat_tmul_v(&j->body_R[bi], nc_v3_sub(p, j->body_rel[bi])));
+        }
+        s->factor[i] = factor;
+    }
+}
+
+/* r (1/sr) for the lanes listed, each with its own body's material, in one
+ * batch per body (usually one); r is 0 where a model gives NaN or Inf. */
+static void eval_lanes(const struct job *j, const int *body, const struct nc_photometry *geo, const int *lanes,
+                       int nlanes, double *r)
+{
+    int todo[NC_PACKET];
+    memcpy(todo, lanes, (size_t)nlanes * sizeof *todo);
+    while (nlanes > 0) {
+        int b = body[todo[0]], lane[NC_PACKET], nl = 0, rest = 0;
+        struct nc_photometry g[NC_PACKET];
+        double rb[NC_PACKET];
+        for (int k = 0; k < nlanes; k++) {
+            if (body[todo[k]] == b) {
+                lane[nl] = todo[k];
+                g[nl++] = geo[todo[k]];
+            } else {
+                todo[rest++] = todo[k];
+            }
+        }
+        nlanes = rest;
+        nc_material_eval(&j->mat[b], (size_t)nl, g, rb);
+        for (int k = 0; k < nl; k++)
+            r[lane[k]] = rb[k] >= 0 && rb[k] < INFINITY ? rb[k] : 0.0; /* no NaN/Inf into a frame */
+    }
+}
+
+/* Counters a tile adds up before it reports them (nc_rt_count_shadow_rays). */
+struct tile_counts {
+    unsigned long shadow_culled, shadow_traced;
+};
+
+/* Direct sunlight at the surface points of s seen along their rays: r[i]
+ * (1/sr; radiance = r irr), 0 where the point is unlit, shadowed or missing.
+ * (px0, py0) is the packet's pixel block, sidx the pixel sample and depth the
+ * path vertex (0: the camera ray's), which key the solar disk's points. */
+static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, int sidx, int depth, double *r,
+                       struct tile_counts *cnt)
+{
+    const int W = j->s->camera.width_px;
+    struct nc_ray16 shadow;
+    struct nc_photometry geo[NC_PACKET];
+    int occluded[NC_PACKET], from[NC_PACKET], lit[NC_PACKET], any = 0; /* how many lit */
+    const uint64_t disk_seed = depth ? mix64(j->disk_seed + (uint64_t)depth) : j->disk_seed;
+    for (int i = 0; i < NC_PACKET; i++) {
+        shadow.valid[i] = lit[i] = 0;
+        from[i] = -1;
+        r[i] = 0;
+        if (s->body[i] < 0)
+            continue;
+        struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i];
+        double mu = -nc_v3_dot(nrm, s->d[i]), mu0 = nc_v3_dot(nrm, sdir);
+        if (!(mu0 > 0 && mu > 0))
+            continue;
+        geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, s->d[i]), s->factor[i]};
+        /* Offset the origin off the surface by a few float ulps of the
+         * camera-relative coordinates; tnear stays 0. */
+        double eps = 4e-6 * s->t[i];
+        struct nc_vec3 p = s->p[i];
+        shadow.ox[i] = (float)(p.x + eps * nrm.x);
+        shadow.oy[i] = (float)(p.y + eps * nrm.y);
+        shadow.oz[i] = (float)(p.z + eps * nrm.z);
+        struct nc_vec3 sray = sdir;
+        if (j->sun_tan_radius > 0) {
+            /* Soft shadows: toward a point of the solar disk, uniform
+             * over it, from a stream of its own (pixel, sample, depth). */
+            int px = px0 + (i & 3), py = py0 + (i >> 2);
+            uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+            double rr = j->sun_tan_radius * sqrt(hash01(disk_seed, pid, 2 * (uint64_t)sidx)),
+                   th = 2.0 * M_PI * hash01(disk_seed, pid, 2 * (uint64_t)sidx + 1);
+            struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
+            if (j->s->sun.has_position) /* the direction differs from point to point */
+                disk_axes(sdir, &e1, &e2);
+            sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)), nc_v3_scale(e2, rr * sin(th)))));
+        }
+        shadow.dx[i] = (float)sray.x;
+        shadow.dy[i] = (float)sray.y;
+        shadow.dz[i] = (float)sray.z;
+        shadow.tnear[i] = 0.0f;
+        shadow.tfar[i] = INFINITY;
+        shadow.valid[i] = -1;
+        /* the grid's proof needs a ray leaving the outer side */
+        from[i] = s->outside[i] && nc_v3_dot(nrm, sray) > 0 ? s->body[i] : -1;
+        lit[i] = 1;
+        any++;
+    }
+    if (!any)
+        return;
+    int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, &shadow, from);
+    cnt->shadow_culled += (unsigned long)culled;
+    cnt->shadow_traced += (unsigned long)(any - culled);
+    if (culled == any) {
+        memset(occluded, 0, sizeof occluded); /* every ray proven: nothing to trace */
+    } else {
+        if (j->r->ray_hook)
+            j->r->ray_hook(j->r->ray_hook_user, 1, &shadow);
+        nc_rt_occluded16(j->rt, &shadow, occluded);
+    }
+    int todo[NC_PACKET], ntodo = 0;
+    for (int i = 0; i < NC_PACKET; i++)
+        if (lit[i] && !occluded[i])
+            todo[ntodo++] = i;
+    eval_lanes(j, s->body, geo, todo, ntodo, r);
+}
+
+/* Indirect light: from the camera ray's surface points s (changed: on return
+ * the paths' last vertices), paths of up to render.bounces further vertices,
+ * each lit by the Sun (sunlight16). The next direction comes from the
+ * mixture of bounce.h and the path's throughput beta (dimensionless) is
+ * multiplied by r / pdf; after render.roulette_after bounces a path goes on
+ * with probability min(1, beta), its beta divided by that (Russian roulette:
+ * unbiased). Adds the radiance to L[i] and I/F (relative to the irradiance
+ * at the camera ray's point) to iof[i]. */
+static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx, double *L, double *iof,
+                       struct tile_counts *cnt)
+{
+    const struct nc_scene *sc = j->s;
+    const int W = sc->camera.width_px, B = j->bounces;
+    double beta[NC_PACKET], irr0[NC_PACKET], pdf[NC_PACKET], r[NC_PACKET], radius[NC_MAX_BODIES];
+    struct nc_vec3 w[NC_PACKET], orig[NC_PACKET], centre[NC_MAX_BODIES];
+    struct nc_photometry geo[NC_PACKET];
+    struct nc_ray16 ray;
+    struct nc_hit16 hit;
+    for (int b = 0; b < sc->nbodies; b++)
+        radius[b] = sc->body[b].bounding_radius_m;
+    for (int i = 0; i < NC_PACKET; i++) {
+        beta[i] = 1.0;
+        irr0[i] = s->irr[i];
+    }
+    for (int k = 1; k <= B; k++) {
+        int lanes[NC_PACKET], nl = 0;
+        for (int i = 0; i < NC_PACKET; i++) {
+            if (s->body[i] < 0)
+                continue;
+            int px = px0 + (i & 3), py = py0 + (i >> 2);
+            uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px, key = 4 * ((uint64_t)sidx * (uint64_t)B + (uint64_t)(k - 1));
+            for (int b = 0; b < sc->nbodies; b++)
+                centre[b] = nc_v3_sub(j->body_rel[b], s->p[i]);
+            struct nc_bounce_mix mix;
+            nc_bounce_init(&mix, s->n[i], centre, radius, sc->nbodies, s->body[i]);
+            w[i] = nc_bounce_sample(&mix, hash01(j->path_seed, pid, key), hash01(j->path_seed, pid, key + 1),
+                                    hash01(j->path_seed, pid, key + 2));
+            pdf[i] = nc_bounce_pdf(&mix, w[i]);
+            double mu0 = nc_v3_dot(s->n[i], w[i]), mu = -nc_v3_dot(s->n[i], s->d[i]);
+            if (!(mu0 > 0 && mu > 0 && pdf[i] > 0)) { /* below the horizon: a cone's edge */
+                s->body[i] = -1;
+                continue;
+            }
+            geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(w[i], s->d[i]), s->factor[i]};
+            lanes[nl++] = i;
+        }
+        eval_lanes(j, s->body, geo, lanes, nl, r);
+        int live = 0;
+        for (int n = 0; n < nl; n++) {
+            int i = lanes[n], px = px0 + (i & 3), py = py0 + (i >> 2);
+            beta[i] *= r[i] / pdf[i];
+            if (k > j->roulette_after && beta[i] < 1) {
+                uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                double u = hash01(j->path_seed, pid, 4 * ((uint64_t)sidx * (uint64_t)B + (uint64_t)(k - 1)) + 3);
+                if (u < beta[i])
+                    beta[i] = 1.0; /* beta / q with q = beta */
+                else
+                    beta[i] = 0;
+            }
+            if (!(beta[i] > 0 && beta[i] < INFINITY)) {
+                s->body[i] = -1;
+                continue;
+            }
+            double eps = 4e-6 * nc_v3_norm(s->p[i]) + 1e-9;
+            orig[i] = nc_v3_add(s->p[i], nc_v3_scale(s->n[i], eps));
+            live++;
+        }
+        if (!live)
+            return;
+        for (int i = 0; i < NC_PACKET; i++) {
+            ray.valid[i] = s->body[i] >= 0 ? -1 : 0;
+            if (!ray.valid[i])
+                continue;
+            ray.ox[i] = (float)orig[i].x;
+            ray.oy[i] = (float)orig[i].y;
+            ray.oz[i] = (float)orig[i].z;
+            ray.dx[i] = (float)w[i].x;
+            ray.dy[i] = (float)w[i].y;
+            ray.dz[i] = (float)w[i].z;
+            ray.tnear[i] = 0.0f;
+            ray.tfar[i] = INFINITY;
+        }
+        if (j->r->ray_hook)
+            j->r->ray_hook(j->r->ray_hook_user, 2, &ray);
+        nc_rt_intersect16(j->rt, &ray, &hit, 0);
+        for (int i = 0; i < NC_PACKET; i++)
+            if (!ray.valid[i])
+                hit.body[i] = -1;
+        surface16(j, &hit, orig, w, s);
+        sunlight16(j, s, px0, py0, sidx, k, r, cnt);
+        for (int i = 0; i < NC_PACKET; i++) {
+            if (s->body[i] < 0 || r[i] == 0)
+                continue;
+            L[i] += beta[i] * r[i] * s->irr[i];
+            iof[i] += beta[i] * M_PI * r[i] * s->irr[i] / irr0[i];
+        }
+    }
+}
+
 static void shade_tile(struct job *j, int tile)
 {
     const struct nc_scene *s = j->s;
@@ -186,13 +445,12 @@ static void shade_tile(struct job *j, int tile)
         for (int bx = 0; bx < TILE; bx += 4)
             live[by / 4][bx / 4] = y0 + by < H && x0 + bx < W && (!j->cull || block_can_hit(j, x0 + bx, y0 + by));
 
-    struct nc_ray16 ray, shadow;
+    struct nc_ray16 ray;
     struct nc_vec3 dir[NC_PACKET], orig[NC_PACKET]; /* the camera rays in double precision */
     struct nc_hit16 hit;
-    int occluded[NC_PACKET], from[NC_PACKET], lit[NC_PACKET];
-    unsigned long shadow_culled = 0, shadow_traced = 0;
-    double mu0[NC_PACKET], irr[NC_PACKET];
-    struct nc_photometry geo[NC_PACKET];
+    struct surf sf;
+    struct tile_counts cnt = {0, 0};
+    double r[NC_PACKET];
 
     for (int sidx = 0; sidx < spp; sidx++) {
         const int sx = sidx % n, sy = sidx / n;
@@ -239,121 +497,35 @@ static void shade_tile(struct job *j, int tile)
                         if (ray.valid[i])
                             j->f->rock_id[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
                                 hit.body[i] >= 0 ? hit.rock[i] : -1;
-
-                /* Shadow rays from the visible points that face both Sun and camera. */
-                int any = 0; /* how many */
+                surface16(j, &hit, orig, dir, &sf);
+                int any = 0;
                 for (int i = 0; i < NC_PACKET; i++) {
-                    shadow.valid[i] = lit[i] = 0;
-                    from[i] = -1;
-                    if (hit.body[i] < 0)
+                    if (sf.body[i] < 0)
                         continue;
-                    struct nc_vec3 d = dir[i], nrm;
-                    double t = hit.t[i];
-                    int exact = nc_rt_refine(j->rt, hit.body[i], orig[i], d, &t, &nrm);
-                    if (exact < 0) { /* the float trace grazed a limb the exact shape misses */
-                        hit.body[i] = -1;
-                        continue;
-                    }
-                    if (exact == 0)
-                        nrm = nc_v3_unit(nc_v3(hit.nx[i], hit.ny[i], hit.nz[i]));
-                    double mu = -nc_v3_dot(nrm, d);
-                    int outside = mu >= 0; /* the camera ray came from outside the surface */
-                    if (mu < 0) { /* back face: inconsistent winding, or the camera inside */
-                        nrm = nc_v3_scale(nrm, -1.0);
-                        mu = -mu;
-                    }
-                    struct nc_vec3 p = nc_v3_add(orig[i], nc_v3_scale(d, t));
-                    struct nc_vec3 sdir = j->sun_dir;
-                    irr[i] = j->sun_irr;
-                    if (s->sun.has_position)
-                        nc_scene_sun_at(s, nc_v3_add(p, c->position_m), &sdir, &irr[i]);
-                    mu0[i] = nc_v3_dot(nrm, sdir);
-                    int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
-                    int k = (py - y0) * TILE + (px - x0);
-                    acc_range[k] += t;
+                    int k = (by + (i >> 2)) * TILE + bx + (i & 3);
+                    acc_range[k] += sf.t[i];
                     hits[k]++;
-                    if (!(mu0[i] > 0 && mu > 0))
-                        continue;
-                    double factor = hit.albedo[i]; /* albedo variation */
-                    const struct nc_albedo_map *am = s->body[hit.body[i]].material.albedo_map;
-                    if (am) {
-                        /* Body-fixed position of the hit, in double. */
-                        int bi = hit.body[i];
-                        factor *= nc_albedo_map_factor(am, nc_mat_tmul_v(&j->body_R[bi], nc_v3_sub(p, j->body_rel[bi])));
-                    }
-                    geo[i] = (struct nc_photometry){mu0[i], mu, -nc_v3_dot(sdir, d), factor};
-                    /* Offset the origin off the surface by a few float ulps of the
-                     * camera-relative coordinates; tnear stays 0. */
-                    double eps = 4e-6 * t;
-                    shadow.ox[i] = (float)(p.x + eps * nrm.x);
-                    shadow.oy[i] = (float)(p.y + eps * nrm.y);
-                    shadow.oz[i] = (float)(p.z + eps * nrm.z);
-                    struct nc_vec3 sray = sdir;
-                    if (j->sun_tan_radius > 0) {
-                        /* Soft shadows: toward a point of the solar disk, uniform
-                         * over it, from a stream of its own (pixel, sample). */
-                        uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                        double rr = j->sun_tan_radius * sqrt(hash01(j->disk_seed, pid, 2 * (uint64_t)sidx)),
-                               th = 2.0 * M_PI * hash01(j->disk_seed, pid, 2 * (uint64_t)sidx + 1);
-                        struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
-                        if (s->sun.has_position) /* the direction differs from point to point */
-                            disk_axes(sdir, &e1, &e2);
-                        sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)),
-                                                                    nc_v3_scale(e2, rr * sin(th)))));
-                    }
-                    shadow.dx[i] = (float)sray.x;
-                    shadow.dy[i] = (float)sray.y;
-                    shadow.dz[i] = (float)sray.z;
-                    shadow.tnear[i] = 0.0f;
-                    shadow.tfar[i] = INFINITY;
-                    shadow.valid[i] = -1;
-                    /* the grid's proof needs a ray leaving the outer side */
-                    from[i] = outside && nc_v3_dot(nrm, sray) > 0 ? hit.body[i] : -1;
-                    lit[i] = 1;
                     any++;
                 }
                 if (!any)
                     continue;
-                int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, &shadow, from);
-                shadow_culled += (unsigned long)culled;
-                shadow_traced += (unsigned long)(any - culled);
-                if (culled == any) {
-                    memset(occluded, 0, sizeof occluded); /* every ray proven: nothing to trace */
-                } else {
-                    if (j->r->ray_hook)
-                        j->r->ray_hook(j->r->ray_hook_user, 1, &shadow);
-                    nc_rt_occluded16(j->rt, &shadow, occluded);
+                /* Direct sunlight, then what reaches these points from other surfaces. */
+                double L[NC_PACKET], iof[NC_PACKET];
+                sunlight16(j, &sf, x0 + bx, y0 + by, sidx, 0, r, &cnt);
+                for (int i = 0; i < NC_PACKET; i++) {
+                    L[i] = sf.body[i] >= 0 ? r[i] * sf.irr[i] : 0.0;
+                    iof[i] = M_PI * r[i];
                 }
-                /* Sunlit lanes, evaluated in one batch per body (usually one). */
-                int todo[NC_PACKET], ntodo = 0;
-                for (int i = 0; i < NC_PACKET; i++)
-                    if (lit[i] && !occluded[i])
-                        todo[ntodo++] = i;
-                while (ntodo > 0) {
-                    int body = hit.body[todo[0]], lane[NC_PACKET], nl = 0, rest = 0;
-                    struct nc_photometry g[NC_PACKET];
-                    double r[NC_PACKET];
-                    for (int k = 0; k < ntodo; k++) {
-                        if (hit.body[todo[k]] == body) {
-                            lane[nl] = todo[k];
-                            g[nl++] = geo[todo[k]];
-                        } else {
-                            todo[rest++] = todo[k];
-                        }
-                    }
-                    ntodo = rest;
-                    nc_material_eval(&j->mat[body], (size_t)nl, g, r);
-                    for (int k = 0; k < nl; k++) {
-                        int i = lane[k];
-                        double rk = r[k] >= 0 && r[k] < INFINITY ? r[k] : 0.0; /* no NaN/Inf into a frame */
-                        int o = (by + (i >> 2)) * TILE + bx + (i & 3);
-                        acc_L[o] += rk * irr[i];
-                        acc_iof[o] += M_PI * rk;
-                    }
+                if (j->bounces > 0)
+                    indirect16(j, &sf, x0 + bx, y0 + by, sidx, L, iof, &cnt);
+                for (int i = 0; i < NC_PACKET; i++) {
+                    int o = (by + (i >> 2)) * TILE + bx + (i & 3);
+                    acc_L[o] += L[i];
+                    acc_iof[o] += iof[i];
                 }
             }
     }
-    nc_rt_count_shadow_rays(j->rt, shadow_culled, shadow_traced);
+    nc_rt_count_shadow_rays(j->rt, cnt.shadow_culled, cnt.shadow_traced);
     const double inv = 1.0 / spp;
     for (int y = y0; y < y0 + TILE && y < H; y++)
         for (int x = x0; x < x0 + TILE && x < W; x++) {
@@ -443,6 +615,9 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     j.sun_tan_radius = s->render.soft_shadows ? tan(nc_scene_sun_radius_rad(s)) : 0.0;
     disk_axes(j.sun_dir, &j.sun_e1, &j.sun_e2);
     j.disk_seed = mix64(s->render.seed ^ 0x736f6674ull); /* "soft": not the pixel jitter's stream */
+    j.bounces = s->render.bounces;
+    j.roulette_after = s->render.roulette_after;
+    j.path_seed = mix64(s->render.seed ^ 0x70617468ull); /* "path" */
 
     /* Threads kept between frames (and between a rolling shutter's bands);
      * fewer threads only cost time, never change pixels. */

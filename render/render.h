@@ -1,5 +1,7 @@
-/* render.h - the integrator: camera rays, hard shadows toward the Sun, the
- * material's reflectance, and the per-pixel image in physical units.
+/* render.h - the integrator: camera rays, shadows toward the Sun (hard, or
+ * over its disk), the material's reflectance, indirect light along paths of
+ * render.bounces vertices (bounce.h), and the per-pixel image in physical
+ * units.
  *
  * Work is split into fixed tiles handed out to threads; every pixel's value
  * depends only on the scene and its own coordinates, so frames are

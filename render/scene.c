@@ -216,6 +216,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     r->boulder_min_px = -1;
     r->boulder_fold = 1;
     r->soft_shadows = 0;
+    r->bounces = 0;
+    r->roulette_after = 2;
     if (!map)
         return 0;
     if ((rc = nc_cfg_int(map, "samples_per_pixel", 1, 1024, &v)) < 0)
@@ -241,6 +243,14 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     if ((rc = nc_cfg_enum(map, "boulder_fold", bools, &r->boulder_fold)) < 0 ||
         (rc = nc_cfg_enum(map, "soft_shadows", bools, &r->soft_shadows)) < 0)
         return rc;
+    if ((rc = nc_cfg_int(map, "bounces", 0, 64, &v)) < 0)
+        return rc;
+    if (rc)
+        r->bounces = (int)v;
+    if ((rc = nc_cfg_int(map, "roulette_after", 0, 64, &v)) < 0)
+        return rc;
+    if (rc)
+        r->roulette_after = (int)v;
     return 0;
 }
 

@@ -68,6 +68,10 @@ struct nc_render_settings {
     double boulder_min_px;
     int boulder_fold; /* 1 (default): fold the rocks not traced into the reflectance */
     int soft_shadows; /* 1: shadow rays toward points of the solar disk (penumbrae); 0: its centre */
+    /* Indirect light: path vertices after the camera ray's (0: direct
+     * sunlight only), and how many are traced before Russian roulette. */
+    int bounces;
+    int roulette_after;
 };
 
 struct nc_scene {
