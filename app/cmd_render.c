@@ -15,6 +15,7 @@
 #include "app/cli.h"
 #include "camera/camsys.h"
 #include "camera/load.h"
+#include "camera/quality.h"
 #include "core/error.h"
 #include "render/frame_io.h"
 #include "render/image_io.h"
@@ -214,6 +215,19 @@ int main(int argc, char **argv)
     struct nc_exposure ex = {.exposure_s = exposure, .rolling = cs.sensor.shutter == NC_SHUTTER_ROLLING,
                              .line_time_s = cs.sensor.line_time_s};
     int tsamples = 1;
+    /* render.quality: auto picks the settings from the camera's noise, for
+     * the sensor's own render camera whatever the quantity */
+    char chosen[300] = "";
+    if (rc >= 0 && scene.render.quality_auto) {
+        struct nc_scene sensor = drawn;
+        struct nc_quality_choice qc;
+        nc_camsys_render_camera(&cs, &scene.camera, &sensor.camera);
+        if ((rc = nc_quality_auto(&r, &sensor, &cs, exposure, &qc)) >= 0) {
+            drawn.render = sensor.render;
+            scene.render = sensor.render; /* recorded in the file */
+            nc_quality_describe(&qc, chosen, sizeof chosen);
+        }
+    }
     if (rc >= 0)
         rc = nc_render_exposure(&r, &drawn, &ex, &f, &tsamples);
     double t2 = now_ms(), scale = 0;
@@ -250,6 +264,8 @@ int main(int argc, char **argv)
                "render %.1f ms\n",
                out, scene.camera.width_px, scene.camera.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
                tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
+        if (chosen[0])
+            printf("  render.quality auto: %s\n", chosen);
         if (scene.render.lod_error_px > 0)
             printf("  levels of detail: surface error bound %.3g m (render.lod_error_px %g)\n", nc_rt_lod_error_m(r.rt),
                    scene.render.lod_error_px);

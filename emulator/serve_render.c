@@ -11,6 +11,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "camera/quality.h"
 #include "emulator/serve_internal.h"
 
 /* The next job, or 0 when the thread is to end (what is still queued then
@@ -127,6 +128,7 @@ struct staged {
     int64_t gap, t0, t1; /* render start and end, CLOCK_MONOTONIC */
     int rc, ts, buf;
     double lod_error_m, boulder_min_m, rock_fold_theta_bar_deg;
+    struct nc_render_settings used; /* render.quality: auto's choice, or the scene's */
 };
 
 /* The camera-model stage: in free-run and trigger modes (unless
@@ -188,7 +190,9 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = x->pose,
         .pose_quality = x->q, .pose_gap_ns = x->gap, .exposure_s = j->exposure_s, .gain_db = j->gain_db,
         .time_samples = x->ts, .lod_error_m = x->lod_error_m, .boulder_min_m = x->boulder_min_m,
-        .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .render_ms = (x->t1 - x->t0) * 1e-6,
+        .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .samples_per_pixel = x->used.samples_per_pixel,
+        .bounces = x->used.bounces, .soft_shadows = x->used.soft_shadows, .quality_auto = x->used.quality_auto,
+        .render_ms = (x->t1 - x->t0) * 1e-6,
         .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
         .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
     fill_slot(e);
@@ -273,7 +277,11 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         x.t0 = nc_mono_ns(); /* from here on the frame is being read out */
         double est_ms = nc__serve_render_estimate_ms(e); /* 0 before the first frame: no tick waits for it */
         atomic_store(&e->readout_end_ns, est_ms > 0 ? x.t0 + llround(est_ms * 1e6) : INT64_MAX);
-        x.rc = nc_render_exposure(&e->renderer, &at, &ex, f, &x.ts);
+        struct nc_quality_choice qc; /* render.quality: auto, per frame (its pilots count as render time) */
+        x.rc = at.render.quality_auto ? nc_quality_auto(&e->renderer, &at, &e->cs, j.exposure_s, &qc) : 0;
+        x.used = at.render;
+        if (x.rc >= 0)
+            x.rc = nc_render_exposure(&e->renderer, &at, &ex, f, &x.ts);
         x.t1 = nc_mono_ns();
         x.lod_error_m = nc_rt_lod_error_m(e->renderer.rt);
         x.boulder_min_m = nc_rt_boulder_min_m(e->renderer.rt);

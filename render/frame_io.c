@@ -51,8 +51,8 @@ int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_
     snprintf(v[10], 200, "[%.17g, %.17g, %.17g, %.17g]", b0->attitude_q.w, b0->attitude_q.x, b0->attitude_q.y,
              b0->attitude_q.z);
     snprintf(v[11], 200, "[%.17g, %.17g, %.17g, %.17g, %.17g]", c->k1, c->k2, c->k3, c->p1, c->p2);
-    snprintf(v[12], 200, "shadows=%s bounces=%d roulette_after=%d", s->render.soft_shadows ? "soft" : "hard",
-             s->render.bounces, s->render.roulette_after);
+    snprintf(v[12], 200, "shadows=%s bounces=%d roulette_after=%d quality=%s", s->render.soft_shadows ? "soft" : "hard",
+             s->render.bounces, s->render.roulette_after, s->render.quality_auto ? "auto" : "manual");
     const struct nc_image_attr a[] = {
         {"Software", v[0]},
         {"navcam:version", NC_VERSION_STRING},

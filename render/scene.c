@@ -218,6 +218,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     r->soft_shadows = 0;
     r->bounces = 0;
     r->roulette_after = 2;
+    r->quality_auto = 0;
+    r->auto_noise_fraction = 0.25;
     if (!map)
         return 0;
     if ((rc = nc_cfg_int(map, "samples_per_pixel", 1, 1024, &v)) < 0)
@@ -251,6 +253,10 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
         return rc;
     if (rc)
         r->roulette_after = (int)v;
+    static const char *const qualities[] = {"manual", "auto", NULL};
+    if ((rc = nc_cfg_enum(map, "quality", qualities, &r->quality_auto)) < 0 ||
+        (rc = nc_cfg_double(map, "auto_noise_fraction", 0.01, 10, &r->auto_noise_fraction)) < 0)
+        return rc;
     return 0;
 }
 

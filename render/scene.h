@@ -72,6 +72,10 @@ struct nc_render_settings {
      * sunlight only), and how many are traced before Russian roulette. */
     int bounces;
     int roulette_after;
+    /* 1: camera/quality.h picks samples_per_pixel, bounces and soft_shadows
+     * per frame from the camera's noise (render.quality: auto); 0: as set. */
+    int quality_auto;
+    double auto_noise_fraction; /* auto: the RMS render error allowed, in units of the camera's noise */
 };
 
 struct nc_scene {

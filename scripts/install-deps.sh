@@ -8,7 +8,8 @@
 set -euo pipefail
 
 pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev libcfitsio-dev libfftw3-dev librandom123-dev zlib1g-dev
-      libmeshoptimizer-dev python3 libaravis-dev libusb-1.0-0-dev libgpiod-dev)
+      libmeshoptimizer-dev python3 libaravis-dev libusb-1.0-0-dev libgpiod-dev
+      gnuplot-nox)
 case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
 if [ "${1:-}" = --test ]; then
   pkgs+=(clang libclang-rt-14-dev aravis-tools-cli gpiod v4l-utils)

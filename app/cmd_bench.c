@@ -1,0 +1,257 @@
+/* cmd_bench.c - `navcam bench accuracy`: error against time for the methods
+ * NavCam offers, on reference scenes, as CSV and a chart (docs/accuracy.md). */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "app/bench_accuracy.h"
+#include "app/cli.h"
+#include "core/error.h"
+#include "core/log.h"
+
+static const char bench_help[] =
+    "Usage: navcam bench accuracy [-o DIR] [options]\n"
+    "\n"
+    "Renders each reference scene converged (the reference), then with each method\n"
+    "(samples per pixel, indirect bounces, soft shadows, levels of detail, boulder\n"
+    "cut, render.quality: auto), and records per method the render time per frame\n"
+    "and the error against the reference: relative radiance over the body's pixels\n"
+    "and DN after the scene's camera model (noise-free, exposed so that the\n"
+    "reference's 99th percentile sits at 70 % of the full well), RMS and 95th\n"
+    "percentile. Writes DIR/accuracy.csv, DIR/accuracy.gp and, through gnuplot,\n"
+    "DIR/accuracy.png: error against time per scene with its Pareto front.\n"
+    "\n"
+    "Scenes: sphere (analytic Hapke sphere), bennu (a real shape model), rubble\n"
+    "(procedural asteroid with boulders), crater (a bowl crater at low Sun),\n"
+    "icy (a bright body), comet (67P's neck). docs/accuracy.md shows the charts.\n"
+    "\n"
+    "  -o, --output DIR     output directory (default: accuracy; made if missing)\n"
+    "      --scene NAME     only this scene; repeatable\n"
+    "      --size N         frames of N x N pixels with the default camera's field\n"
+    "                       (default 256)\n"
+    "      --ref-spp N      the reference's samples per pixel, a square (default 1024)\n"
+    "      --ref-bounces N  the reference's bounces (default 6)\n"
+    "      --shapes DIR     the shape models (default ../shared/data/shapes); a scene\n"
+    "                       whose model is missing is skipped with a note\n"
+    "      --quick          fewer methods (what the tests run)\n"
+    "  -j, --threads N      render threads (default: all cores)\n"
+    "  -h, --help           this help\n"
+    "\n"
+    "CSV columns: scene, method, spp, bounces, soft_shadows, lod_error_px,\n"
+    "boulder_min_px (-1: the scene's default), time_ms, rel_rms, rel_p95, dn_rms,\n"
+    "dn_p95, noise_dn (the camera's shot and read noise at the median lit pixel),\n"
+    "pareto (1: no other method is both faster and closer in rel_rms), chosen\n"
+    "(what auto picked).\n";
+
+static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (*end || v < lo || v > hi) {
+        fprintf(stderr, "navcam bench: --%s expects %d..%d, got '%s'\n", opt, lo, hi, s);
+        return -1;
+    }
+    *out = (int)v;
+    return 0;
+}
+
+/* Pareto flags over the scene's methods (auto excluded from the front). */
+static void pareto(const struct nc_bench_method *m, struct nc_bench_result *r, int n)
+{
+    for (int i = 0; i < n; i++) {
+        r[i].pareto = !m[i].auto_quality;
+        for (int k = 0; k < n && r[i].pareto; k++)
+            if (k != i && !m[k].auto_quality && r[k].time_ms <= r[i].time_ms && r[k].rel_rms <= r[i].rel_rms &&
+                (r[k].time_ms < r[i].time_ms || r[k].rel_rms < r[i].rel_rms))
+                r[i].pareto = 0;
+    }
+}
+
+/* auto's time over the front's at auto's error: the front (sorted by time,
+ * errors falling) interpolated in log time against log error between the
+ * two methods that bracket it, or its cheapest method where that is already
+ * closer; -1 where auto is closer than every method of the front. */
+static double auto_ratio(const struct nc_bench_method *m, const struct nc_bench_result *r, int n, const int *front,
+                         int nf)
+{
+    int a = -1;
+    for (int i = 0; i < n; i++)
+        if (m[i].auto_quality)
+            a = i;
+    if (a < 0 || nf == 0)
+        return -1;
+    const double e = r[a].rel_rms;
+    if (r[front[0]].rel_rms <= e)
+        return r[a].time_ms / r[front[0]].time_ms;
+    for (int k = 1; k < nf; k++) {
+        const struct nc_bench_result *p = &r[front[k - 1]], *q = &r[front[k]];
+        if (q->rel_rms <= e) {
+            double u = log(e / p->rel_rms) / log(q->rel_rms / p->rel_rms);
+            return r[a].time_ms / exp(log(p->time_ms) + u * log(q->time_ms / p->time_ms));
+        }
+    }
+    return -1;
+}
+
+static void gp_scene(FILE *gp, const char *name, const char *what)
+{
+    fprintf(gp,
+            "set title \"%s: %s\" noenhanced\n"
+            "plot 'accuracy.csv' using (strcol(1) eq \"%s\" && strcol(2) ne \"auto\" ? $8 : 1/0):9 with points pt 7 ps 1 "
+            "lc rgb '#3070b0' title 'methods', \\\n"
+            "  'accuracy_front.csv' using (strcol(1) eq \"%s\" ? $2 : 1/0):3 with linespoints lw 2 pt 6 ps 1.5 lc rgb '#d04020' "
+            "title 'Pareto front', \\\n"
+            "  'accuracy.csv' using (strcol(1) eq \"%s\" && strcol(2) eq \"auto\" ? $8 : 1/0):9 with points pt 5 ps 2 "
+            "lc rgb '#20a040' title 'auto', \\\n"
+            "  'accuracy.csv' using (strcol(1) eq \"%s\" ? $8 : 1/0):9:2 with labels left offset 0.6,0.3 font ',7' "
+            "noenhanced notitle\n",
+            name, what, name, name, name, name);
+}
+
+int main(int argc, char **argv)
+{
+    nc_cli_init("bench");
+    static const struct option opts[] = {
+        {"output", required_argument, NULL, 'o'}, {"scene", required_argument, NULL, 'S'},
+        {"size", required_argument, NULL, 'z'},   {"ref-spp", required_argument, NULL, 'r'},
+        {"ref-bounces", required_argument, NULL, 'b'}, {"shapes", required_argument, NULL, 'd'},
+        {"quick", no_argument, NULL, 'Q'},        {"threads", required_argument, NULL, 'j'},
+        {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+    };
+    struct nc_bench_opts o = {.size_px = 256, .ref_spp = 1024, .ref_bounces = 6, .shapes_dir = "../shared/data/shapes"};
+    const char *dir = "accuracy", *only[16];
+    int nonly = 0, c;
+    if (argc < 2 || strcmp(argv[1], "accuracy")) {
+        if (argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))) {
+            fputs(bench_help, stdout);
+            return 0;
+        }
+        fprintf(stderr, "navcam bench: expected a benchmark name: accuracy\nTry 'navcam bench --help'.\n");
+        return 2;
+    }
+    optind = 2;
+    while ((c = getopt_long(argc, argv, "o:j:h", opts, NULL)) != -1) {
+        int bad = 0;
+        switch (c) {
+        case 'o': dir = optarg; break;
+        case 'S':
+            if (nonly < 16)
+                only[nonly++] = optarg;
+            break;
+        case 'z': bad = parse_int("size", optarg, 16, 4096, &o.size_px); break;
+        case 'r': bad = parse_int("ref-spp", optarg, 1, 4096, &o.ref_spp); break;
+        case 'b': bad = parse_int("ref-bounces", optarg, 0, 64, &o.ref_bounces); break;
+        case 'd': o.shapes_dir = optarg; break;
+        case 'Q': o.quick = 1; break;
+        case 'j': bad = parse_int("threads", optarg, 1, 1024, &o.threads); break;
+        case 'h': fputs(bench_help, stdout); return 0;
+        default: fputs("Try 'navcam bench --help'.\n", stderr); return 2;
+        }
+        if (bad)
+            return 2;
+    }
+    if (optind < argc) {
+        fprintf(stderr, "navcam bench: unexpected argument '%s'\n", argv[optind]);
+        return 2;
+    }
+    for (int i = 0; i < nonly; i++) {
+        int known = 0;
+        for (int k = 0; k < nc_bench_nscenes; k++)
+            known |= !strcmp(only[i], nc_bench_scenes[k].name);
+        if (!known) {
+            fprintf(stderr, "navcam bench: unknown scene '%s' (sphere, bennu, rubble, crater, icy, comet)\n", only[i]);
+            return 2;
+        }
+    }
+    if (mkdir(dir, 0777) < 0 && errno != EEXIST) {
+        fprintf(stderr, "navcam bench: %s: %s\n", dir, strerror(errno));
+        return 1;
+    }
+    o.work_dir = dir;
+    nc_log_set_level(NC_LOG_WARN); /* not the scene's notes at every load */
+    char path[4096];
+    snprintf(path, sizeof path, "%s/accuracy.csv", dir);
+    FILE *csv = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/accuracy_front.csv", dir);
+    FILE *front = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/accuracy.gp", dir);
+    FILE *gp = fopen(path, "w");
+    if (!csv || !front || !gp) {
+        fprintf(stderr, "navcam bench: cannot write into %s: %s\n", dir, strerror(errno));
+        return 1;
+    }
+    fprintf(csv, "scene,method,spp,bounces,soft_shadows,lod_error_px,boulder_min_px,time_ms,rel_rms,rel_p95,dn_rms,"
+                 "dn_p95,noise_dn,pareto,chosen\n");
+    fprintf(front, "scene,time_ms,rel_rms\n");
+    fprintf(gp, "# gnuplot script written by navcam bench accuracy\nset datafile separator ','\n"
+                "set terminal pngcairo size 1500,1000 font ',9'\nset output 'accuracy.png'\n"
+                "set multiplot layout 2,3 title 'NavCam: error against render time per frame (%dx%d; reference %d "
+                "samples, %d bounces, soft shadows, full detail)'\n"
+                "set logscale xy\nset xlabel 'render time per frame, ms'\nset ylabel 'relative radiance error, RMS'\n"
+                "set key bottom left font ',8'\nset grid\n",
+            o.size_px, o.size_px, o.ref_spp, o.ref_bounces);
+    int rc = 0, nplots = 0;
+    for (int si = 0; si < nc_bench_nscenes && rc >= 0; si++) {
+        const struct nc_bench_scene *sc = &nc_bench_scenes[si];
+        int wanted = nonly == 0;
+        for (int i = 0; i < nonly; i++)
+            wanted |= !strcmp(only[i], sc->name);
+        if (!wanted)
+            continue;
+        if (sc->shape_file) {
+            snprintf(path, sizeof path, "%s/%s", o.shapes_dir, sc->shape_file);
+            struct stat stt;
+            if (stat(path, &stt) < 0) {
+                printf("%s: skipped: %s: %s (--shapes DIR)\n", sc->name, path, strerror(errno));
+                continue;
+            }
+        }
+        struct nc_bench_method m[40];
+        struct nc_bench_result res[40];
+        int n = nc_bench_methods(sc, &o, m, 40);
+        if ((rc = nc_bench_run_scene(sc, &o, m, n, res, stdout)) < 0)
+            break;
+        pareto(m, res, n);
+        for (int i = 0; i < n; i++)
+            fprintf(csv, "%s,%s,%d,%d,%d,%g,%g,%.4f,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%s\n", sc->name, m[i].name, m[i].spp,
+                    m[i].bounces, m[i].soft, m[i].lod_error_px, m[i].boulder_min_px, res[i].time_ms, res[i].rel_rms,
+                    res[i].rel_p95, res[i].dn_rms, res[i].dn_p95, res[i].noise_dn, res[i].pareto, res[i].chosen);
+        /* the front, by time */
+        int idx[40], nf = 0;
+        for (int i = 0; i < n; i++)
+            if (res[i].pareto) {
+                int k = nf++;
+                for (; k > 0 && res[idx[k - 1]].time_ms > res[i].time_ms; k--)
+                    idx[k] = idx[k - 1];
+                idx[k] = i;
+            }
+        for (int k = 0; k < nf; k++)
+            fprintf(front, "%s,%.4f,%.6g\n", sc->name, res[idx[k]].time_ms, res[idx[k]].rel_rms);
+        double ratio = auto_ratio(m, res, n, idx, nf);
+        if (ratio > 0)
+            printf("%s: auto (%s) takes %.2f x the front's time at its error (rel RMS %.4g)\n", sc->name,
+                   res[n - 1].chosen, ratio, res[n - 1].rel_rms);
+        else
+            printf("%s: auto (%s) is closer than every method of the front (rel RMS %.4g)\n", sc->name,
+                   res[n - 1].chosen, res[n - 1].rel_rms);
+        gp_scene(gp, sc->name, sc->what);
+        nplots++;
+    }
+    fprintf(gp, "unset multiplot\n");
+    fclose(csv);
+    fclose(front);
+    fclose(gp);
+    if (rc < 0)
+        return nc_cli_fail();
+    char cmd[4200];
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot accuracy.gp", dir);
+    if (nplots && system(cmd) != 0)
+        printf("no chart: gnuplot failed or is missing (Debian: gnuplot-nox); %s/accuracy.gp draws it\n", dir);
+    else if (nplots)
+        printf("wrote %s/accuracy.csv, %s/accuracy.png\n", dir, dir);
+    return 0;
+}

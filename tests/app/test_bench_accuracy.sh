@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# test_bench_accuracy.sh - `navcam bench accuracy` end to end on two of its
+# scenes at a small size: the CSV is complete and finite, every scene has a
+# Pareto front, the DN error falls with samples, render.quality: auto picks
+# indirect light for the crater at low Sun and none for the convex sphere,
+# and gnuplot draws the chart.
+# Usage: test_bench_accuracy.sh NAVCAM TMPDIR
+set -u
+navcam=$1
+tmp=$2
+rm -rf "$tmp" && mkdir -p "$tmp"
+if ! "$navcam" bench accuracy --quick --size 48 --ref-spp 64 --scene sphere --scene crater -o "$tmp/out" \
+    > "$tmp/log" 2>&1; then
+  cat "$tmp/log" >&2
+  echo "FAIL: navcam bench accuracy exited non-zero" >&2
+  exit 1
+fi
+cat "$tmp/log"
+python3 - "$tmp/out" <<'PY'
+import csv, math, sys
+d = sys.argv[1]
+rows = list(csv.DictReader(open(d + "/accuracy.csv")))
+fail = []
+def check(cond, msg):
+    if not cond:
+        fail.append(msg)
+scenes = {}
+for r in rows:
+    scenes.setdefault(r["scene"], {})[r["method"]] = r
+    for k in ("time_ms", "rel_rms", "rel_p95", "dn_rms", "dn_p95", "noise_dn"):
+        v = float(r[k])
+        check(math.isfinite(v) and v >= 0, "%s %s: %s = %s" % (r["scene"], r["method"], k, r[k]))
+    check(float(r["time_ms"]) > 0, "%s %s: time 0" % (r["scene"], r["method"]))
+check(sorted(scenes) == ["crater", "sphere"], "scenes %s" % sorted(scenes))
+for name, m in scenes.items():
+    check(len(m) == 7, "%s: %d methods" % (name, len(m)))
+    check(any(r["pareto"] == "1" for r in m.values()), "%s: no Pareto front" % name)
+    check(float(m["4spp"]["dn_rms"]) < float(m["1spp"]["dn_rms"]), "%s: DN error does not fall with samples" % name)
+    check(m["auto"]["chosen"].startswith("spp="), "%s: auto chose '%s'" % (name, m["auto"]["chosen"]))
+check("bounces=0" in scenes["sphere"]["auto"]["chosen"], "sphere: auto chose %s" % scenes["sphere"]["auto"]["chosen"])
+check("bounces=0" not in scenes["crater"]["auto"]["chosen"], "crater: auto chose %s" % scenes["crater"]["auto"]["chosen"])
+png = open(d + "/accuracy.png", "rb").read(8)
+check(png == b"\x89PNG\r\n\x1a\n", "accuracy.png is not a PNG")
+for f in fail:
+    print("FAIL:", f, file=sys.stderr)
+print("%d rows checked, %d failures" % (len(rows), len(fail)))
+sys.exit(1 if fail else 0)
+PY
