@@ -280,8 +280,9 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
             continue;
         geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, s->d[i]), s->factor[i]};
         /* Offset the origin off the surface by a few float ulps of the
-         * camera-relative coordinates; tnear stays 0. */
-        double eps = 4e-6 * s->t[i];
+         * camera-relative coordinates (a bounce's t can be far shorter than
+         * the point's distance from the camera); tnear stays 0. */
+        double eps = 4e-6 * (depth ? fmax(s->t[i], nc_v3_norm(s->p[i])) : s->t[i]);
         struct nc_vec3 p = s->p[i];
         shadow.ox[i] = (float)(p.x + eps * nrm.x);
         shadow.oy[i] = (float)(p.y + eps * nrm.y);
