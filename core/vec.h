@@ -31,6 +31,12 @@ static inline struct nc_vec3 nc_v3_unit(struct nc_vec3 a)
     return n > 0 ? nc_v3_scale(a, 1.0 / n) : a;
 }
 static inline int nc_v3_isfinite(struct nc_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+/* Two unit axes across the unit vector a: (e1, e2, a) is right-handed. */
+static inline void nc_v3_basis(struct nc_vec3 a, struct nc_vec3 *e1, struct nc_vec3 *e2)
+{
+    *e1 = nc_v3_unit(fabs(a.x) < 0.9 ? nc_v3_cross(a, nc_v3(1, 0, 0)) : nc_v3_cross(a, nc_v3(0, 1, 0)));
+    *e2 = nc_v3_cross(a, *e1);
+}
 
 static inline double nc_quat_norm(struct nc_quat q) { return sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z); }
 

@@ -19,6 +19,7 @@
 static int next_job(struct nc__emu *e, struct nc__job *j)
 {
     pthread_mutex_lock(&e->jlock);
+    atomic_store(&e->readout_end_ns, 0); /* nothing in hand (the last job rendered or dropped) */
     while (e->jcount == 0 && atomic_load(&e->stop) < 2)
         pthread_cond_wait(&e->jcond, &e->jlock);
     if (e->jcount == 0 || atomic_load(&e->stop) >= 2) {
@@ -28,6 +29,14 @@ static int next_job(struct nc__emu *e, struct nc__job *j)
     *j = e->jobs[e->jhead];
     e->jhead = (e->jhead + 1) % e->queue_frames;
     e->jcount--;
+    if (e->mode != NC__MODE_LOCKSTEP) {
+        /* The camera is busy from now on: the job waits for its exposure's
+         * end and then renders. Until the render starts (and refines it),
+         * a trigger must already see that, or it would queue an exposure
+         * behind this one and wait a whole render (too_late). */
+        double est_ms = nc__serve_render_estimate_ms(e);
+        atomic_store(&e->readout_end_ns, est_ms > 0 ? j->ready_mono_ns + llround(est_ms * 1e6) : INT64_MAX);
+    }
     pthread_mutex_unlock(&e->jlock);
     return 1;
 }

@@ -3,18 +3,11 @@
 
 #include <math.h>
 
-/* Two unit axes across the unit vector a. */
-static void axes(struct nc_vec3 a, struct nc_vec3 *e1, struct nc_vec3 *e2)
-{
-    *e1 = nc_v3_unit(fabs(a.x) < 0.9 ? nc_v3_cross(a, nc_v3(1, 0, 0)) : nc_v3_cross(a, nc_v3(0, 1, 0)));
-    *e2 = nc_v3_cross(a, *e1);
-}
-
 void nc_bounce_init(struct nc_bounce_mix *m, struct nc_vec3 n, const struct nc_vec3 *centre_rel,
                     const double *radius_m, int nbodies, int self)
 {
     m->n = n;
-    axes(n, &m->e1, &m->e2);
+    nc_v3_basis(n, &m->e1, &m->e2);
     m->ncone = 0;
     for (int b = 0; b < nbodies; b++) {
         if (b == self)
@@ -27,7 +20,7 @@ void nc_bounce_init(struct nc_bounce_mix *m, struct nc_vec3 n, const struct nc_v
             continue;
         int k = m->ncone++;
         m->cone_axis[k] = a;
-        axes(a, &m->cone_e1[k], &m->cone_e2[k]);
+        nc_v3_basis(a, &m->cone_e1[k], &m->cone_e2[k]);
         double c = sqrt((1 - s) * (1 + s));
         m->cone_cos[k] = c;
         m->cone_omc[k] = s * s / (1 + c);

@@ -119,13 +119,6 @@ struct job {
     int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
 };
 
-/* Two unit axes across the unit direction d (soft shadows' disk of the Sun). */
-static void disk_axes(struct nc_vec3 d, struct nc_vec3 *e1, struct nc_vec3 *e2)
-{
-    *e1 = nc_v3_unit(fabs(d.x) < 0.9 ? nc_v3_cross(d, nc_v3(1, 0, 0)) : nc_v3_cross(d, nc_v3(0, 1, 0)));
-    *e2 = nc_v3_cross(d, *e1);
-}
-
 /* Whether any ray of the 4x4 pixel block at (px0, py0) can reach a body's
  * bounding sphere. Conservative: every sample of pixel (x, y) lies in
  * [x - 0.5, x + 0.5] x [y - 0.5, y + 0.5] and uses its row's camera, so the
@@ -297,7 +290,7 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
                    th = 2.0 * M_PI * hash01(disk_seed, pid, 2 * (uint64_t)sidx + 1);
             struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
             if (j->s->sun.has_position) /* the direction differs from point to point */
-                disk_axes(sdir, &e1, &e2);
+                nc_v3_basis(sdir, &e1, &e2);
             sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)), nc_v3_scale(e2, rr * sin(th)))));
         }
         shadow.dx[i] = (float)sray.x;
@@ -344,6 +337,7 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
     const struct nc_scene *sc = j->s;
     const int W = sc->camera.width_px, B = j->bounces;
     double beta[NC_PACKET], irr0[NC_PACKET], pdf[NC_PACKET], r[NC_PACKET], radius[NC_MAX_BODIES];
+    uint64_t pid[NC_PACKET]; /* each lane's pixel, keying its random numbers */
     struct nc_vec3 w[NC_PACKET], orig[NC_PACKET], centre[NC_MAX_BODIES];
     struct nc_photometry geo[NC_PACKET];
     struct nc_ray16 ray;
@@ -359,14 +353,14 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
         for (int i = 0; i < NC_PACKET; i++) {
             if (s->body[i] < 0)
                 continue;
-            int px = px0 + (i & 3), py = py0 + (i >> 2);
-            uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px, key = 4 * ((uint64_t)sidx * (uint64_t)B + (uint64_t)(k - 1));
+            const uint64_t key = 4 * ((uint64_t)sidx * (uint64_t)B + (uint64_t)(k - 1));
+            pid[i] = (uint64_t)(py0 + (i >> 2)) * (uint64_t)W + (uint64_t)(px0 + (i & 3));
             for (int b = 0; b < sc->nbodies; b++)
                 centre[b] = nc_v3_sub(j->body_rel[b], s->p[i]);
             struct nc_bounce_mix mix;
             nc_bounce_init(&mix, s->n[i], centre, radius, sc->nbodies, s->body[i]);
-            w[i] = nc_bounce_sample(&mix, hash01(j->path_seed, pid, key), hash01(j->path_seed, pid, key + 1),
-                                    hash01(j->path_seed, pid, key + 2));
+            w[i] = nc_bounce_sample(&mix, hash01(j->path_seed, pid[i], key), hash01(j->path_seed, pid[i], key + 1),
+                                    hash01(j->path_seed, pid[i], key + 2));
             pdf[i] = nc_bounce_pdf(&mix, w[i]);
             double mu0 = nc_v3_dot(s->n[i], w[i]), mu = -nc_v3_dot(s->n[i], s->d[i]);
             if (!(mu0 > 0 && mu > 0 && pdf[i] > 0)) { /* below the horizon: a cone's edge */
@@ -379,11 +373,10 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
         eval_lanes(j, s->body, geo, lanes, nl, r);
         int live = 0;
         for (int n = 0; n < nl; n++) {
-            int i = lanes[n], px = px0 + (i & 3), py = py0 + (i >> 2);
+            int i = lanes[n];
             beta[i] *= r[i] / pdf[i];
             if (k > j->roulette_after && beta[i] < 1) {
-                uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                double u = hash01(j->path_seed, pid, 4 * ((uint64_t)sidx * (uint64_t)B + (uint64_t)(k - 1)) + 3);
+                double u = hash01(j->path_seed, pid[i], 4 * ((uint64_t)sidx * (uint64_t)B + (uint64_t)(k - 1)) + 3);
                 if (u < beta[i])
                     beta[i] = 1.0; /* beta / q with q = beta */
                 else
@@ -614,7 +607,7 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     j.cull = !c->distorted && !r->no_cull; /* the lens model's rays are not linear in the pixel */
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
     j.sun_tan_radius = s->render.soft_shadows ? tan(nc_scene_sun_radius_rad(s)) : 0.0;
-    disk_axes(j.sun_dir, &j.sun_e1, &j.sun_e2);
+    nc_v3_basis(j.sun_dir, &j.sun_e1, &j.sun_e2);
     j.disk_seed = mix64(s->render.seed ^ 0x736f6674ull); /* "soft": not the pixel jitter's stream */
     j.bounces = s->render.bounces;
     j.roulette_after = s->render.roulette_after;
