@@ -154,11 +154,15 @@ int main(int argc, char **argv)
     double cam_ms = median(rc_ms, frames), shadow_ms = median(rs_ms, frames);
     double single_cam_ms = median(sc_ms, frames), single_shadow_ms = median(ss_ms, frames);
 
-    /* Cost of moving the camera out of its geometry cell: re-anchoring the
-     * mesh (vertex rewrite + BVH refit). */
-    struct nc_rt_stats st0, st1;
+    /* Pose updates that move the camera 600 m sideways and back: far out
+     * (more than one bounding radius from the body's bounding sphere, the
+     * mesh stays anchored at the body's origin), then at half a radius from
+     * the sphere, where every step leaves the camera's geometry cell and the
+     * mesh is re-anchored (vertex rewrite + BVH refit). */
+    struct nc_rt_stats st0, st1, st2;
+    double *upd = calloc((size_t)frames, sizeof *upd), *near = calloc((size_t)frames, sizeof *near);
+    const struct nc_vec3 cam0 = s.camera.position_m;
     nc_rt_get_stats(r.rt, &st0);
-    double* upd = calloc((size_t)frames, sizeof *upd);
     for (int i = 0; i < frames; i++) {
         s.camera.position_m.x += 600.0 * (i % 2 ? -1 : 1);
         double a = now_ms();
@@ -166,8 +170,26 @@ int main(int argc, char **argv)
         upd[i] = now_ms() - a;
     }
     nc_rt_get_stats(r.rt, &st1);
-    printf("re-anchor (camera moved to a new geometry cell): %.2f ms median over %lu re-anchors\n",
-           median(upd, frames), st1.reanchors - st0.reanchors);
+    const unsigned long far_reanchors = st1.reanchors - st0.reanchors;
+    const double R = s.body[0].bounding_radius_m;
+    s.camera.position_m = nc_v3_scale(nc_v3_unit(nc_v3_sub(cam0, s.body[0].position_m)), 1.5 * R);
+    s.camera.position_m = nc_v3_add(s.camera.position_m, s.body[0].position_m);
+    nc_rt_update(r.rt, &s);
+    nc_rt_get_stats(r.rt, &st1);
+    for (int i = 0; i < frames; i++) {
+        s.camera.position_m.x += 0.25 * R * (i % 2 ? -1 : 1);
+        double a = now_ms();
+        nc_rt_update(r.rt, &s);
+        near[i] = now_ms() - a;
+    }
+    nc_rt_get_stats(r.rt, &st2);
+    printf("pose update, camera %.0f m from the body, moved 600 m: %.2f ms median (%lu re-anchors in %d)\n",
+           nc_v3_norm(nc_v3_sub(cam0, s.body[0].position_m)), median(upd, frames), far_reanchors, frames);
+    printf("pose update at half a radius from the bounding sphere, moved %.0f m into a new geometry cell: %.2f ms "
+           "median (%lu re-anchors in %d)\n",
+           0.25 * R, median(near, frames), st2.reanchors - st1.reanchors, frames);
+    free(near);
+    s.camera.position_m = cam0;
     printf("Embree alone, 16-wide packets: camera rays %.2f ms, shadow rays %.2f ms (medians of %d)\n", cam_ms,
            shadow_ms, frames);
     printf("Embree alone, single rays:     camera rays %.2f ms, shadow rays %.2f ms (packets %.2fx faster)\n",

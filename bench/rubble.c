@@ -91,7 +91,9 @@ static double frame_ms(struct setup *u, int frames)
 }
 
 /* A pose update that moves the anchor: the camera steps a quarter of its
- * range sideways and back (each step leaves the anchor's cell). */
+ * range sideways and back (each step leaves the anchor's cell, unless the
+ * camera is more than one bounding radius from the body's bounding sphere:
+ * there the mesh stays anchored at the body's origin). */
 static double reanchor_ms(struct setup *u, double range_m)
 {
     struct nc_vec3 p = u->s.camera.position_m;

@@ -55,6 +55,7 @@ struct nc__job {
     int64_t trigger_sim_ns, mid_sim_ns, trigger_mono_ns;
     int64_t ready_mono_ns; /* the earliest a camera could read the frame out: the
                             * request's arrival (lock-step) or the exposure's end */
+    int64_t period_ns;     /* free-run and trigger: the time since the trigger before (0: none) */
     uint32_t sequence;
     int client; /* TCP client slot to answer, or -1 */
     unsigned client_gen;

@@ -85,11 +85,12 @@ void nc__serve_drop(struct nc__emu *e, const struct nc__job *j, enum nc__drop_re
  * trigger before it (one frame period) is an overrun, so every frame leaves
  * at most one period plus one render after its exposure, and the camera runs
  * at the rate its render allows (jlock held). */
-static int too_late(struct nc__emu *e, const struct nc__job *j)
+static int too_late(struct nc__emu *e, struct nc__job *j)
 {
-    int64_t busy = atomic_load(&e->readout_end_ns), period = j->trigger_mono_ns - e->last_trigger_mono_ns;
+    int64_t busy = atomic_load(&e->readout_end_ns);
+    j->period_ns = e->last_trigger_mono_ns ? j->trigger_mono_ns - e->last_trigger_mono_ns : 0;
     e->last_trigger_mono_ns = j->trigger_mono_ns;
-    return busy && busy - j->ready_mono_ns > period;
+    return busy && j->period_ns && busy - j->ready_mono_ns > j->period_ns;
 }
 
 /* Queue a frame job without ever waiting. Free-run and trigger: a trigger
@@ -98,7 +99,7 @@ static int too_late(struct nc__emu *e, const struct nc__job *j)
  * an overrun too: the new one is ignored (drop_newest, as a camera does)
  * or replaces the waiting one (drop_oldest). Lock-step over UDP: queue_full.
  * Returns 1 when this job was queued. */
-static int push_job(struct nc__emu *e, const struct nc__job *j)
+static int push_job(struct nc__emu *e, struct nc__job *j)
 {
     pthread_mutex_lock(&e->jlock);
     if (e->mode != NC__MODE_LOCKSTEP && too_late(e, j)) {

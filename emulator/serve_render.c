@@ -284,6 +284,12 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         x.ts = 1;
         x.buf = buf;
         x.t0 = nc_mono_ns(); /* from here on the frame is being read out */
+        if (j.period_ns && x.t0 - j.ready_mono_ns > j.period_ns + e->pose_wait_ns) {
+            /* The frame before ran longer than its estimate: this one would
+             * leave more than a period late, so it is an overrun after all. */
+            nc__serve_drop(e, &j, NC__DROP_OVERRUN);
+            continue;
+        }
         double est_ms = nc__serve_render_estimate_ms(e); /* 0 before the first frame: no tick waits for it */
         atomic_store(&e->readout_end_ns, est_ms > 0 ? x.t0 + llround(est_ms * 1e6) : INT64_MAX);
         struct nc_quality_choice qc; /* render.quality: auto, per frame (its pilots count as render time) */

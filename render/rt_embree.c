@@ -431,11 +431,18 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
          * stays below 1e-8 of every range (1e-3 px for an IFOV down to 1e-5
          * rad), re-anchors happen only when the camera leaves its cell, and a
          * (hence every pixel) is a function of the pose alone, never of the
-         * path taken. Inside the bounding sphere a is the camera itself. */
+         * path taken. Inside the bounding sphere a is the camera itself.
+         * Farther than one bounding radius from the sphere, a is the body's
+         * origin and never moves: vertices then carry 6e-8 * R <= 6e-8 of
+         * every range, T 6e-8 * (dmin + R) <= 1.2e-7 of it (1e-3 px at an
+         * IFOV of 1e-4 rad), and the tree is never refitted on approach
+         * (a refit costs 40 ms at 327 680 triangles: a latency spike). */
         struct nc_vec3 a = cam_body;
         double dmin = nc_v3_norm(cam_body) - src->bounding_radius_m;
         if (!b->analytic) {
-            if (dmin > 0) {
+            if (dmin >= src->bounding_radius_m) {
+                a = nc_v3(0, 0, 0);
+            } else if (dmin > 0) {
                 double cell = exp2(floor(log2(dmin / 8)));
                 a = nc_v3(cell * floor(cam_body.x / cell + 0.5), cell * floor(cam_body.y / cell + 0.5),
                           cell * floor(cam_body.z / cell + 0.5));

@@ -52,6 +52,31 @@ static void shifts(uint32_t pf, int bits, int *left, int *right)
     *right = bits > keep ? bits - keep : 0;
 }
 
+/* One row: DNs below 2^adc_bits shifted into the pixel format, in 16-bit
+ * lanes (left and right are never both set, so nothing is lost). */
+__attribute__((target_clones("avx2", "default")))
+static void row16(const uint16_t *restrict src, int n, int left, int right, uint8_t *restrict o)
+{
+    for (int x = 0; x < n; x++) {
+        uint16_t v = (uint16_t)(src[x] << left);
+        v = (uint16_t)(v >> right);
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        memcpy(o + 2 * x, &v, 2); /* one vectorised store */
+#else
+        put_u16(o + 2 * x, v);
+#endif
+    }
+}
+
+__attribute__((target_clones("avx2", "default")))
+static void row8(const uint16_t *restrict src, int n, int left, int right, uint8_t *restrict o)
+{
+    for (int x = 0; x < n; x++) {
+        uint16_t v = (uint16_t)(src[x] << left);
+        o[x] = (uint8_t)(v >> right);
+    }
+}
+
 void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct nc_frame_record *meta, uint32_t pf,
                     uint32_t w, uint32_t h, int ox, int oy, uint8_t *out, atomic_size_t *done)
 {
@@ -75,19 +100,10 @@ void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct
         }
         const uint16_t *src = dn + (size_t)sy * W + ox;
         int n = ox + (int)w <= W ? (int)w : W - ox; /* >= 0: ox <= W */
-        if (bpp == 1) {
-            for (int x = 0; x < n; x++)
-                o[x] = (uint8_t)((src[x] << left) >> right);
-        } else {
-            for (int x = 0; x < n; x++) {
-#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-                uint16_t v = (uint16_t)((src[x] << left) >> right);
-                memcpy(o + 2 * x, &v, 2); /* one vectorised store */
-#else
-                put_u16(o + 2 * x, (uint16_t)((src[x] << left) >> right));
-#endif
-            }
-        }
+        if (bpp == 1)
+            row8(src, n, left, right, o);
+        else
+            row16(src, n, left, right, o);
         if (n < (int)w)
             memset(o + (size_t)n * bpp, 0, (size_t)((int)w - n) * bpp);
         if (done && y % 16 == 15)

@@ -4,7 +4,10 @@
  * quantised to 0.125 m, which would put 10% errors on a 1 m range; here range
  * and radiance must match the exact double-precision answer to 1e-3.
  *  A: exact analytic sphere of the Moon's radius.
- *  B: a triangle mesh patch (given in km) lying on z = -R_moon. */
+ *  B: a triangle mesh patch (given in km) lying on z = -R_moon.
+ *  C: the same patch seen from about one Moon radius beyond the body's
+ *     bounding sphere, on either side of the point where the mesh's anchor
+ *     becomes the body's origin (render/rt_embree.c): range within 2e-7. */
 #include <math.h>
 #include <string.h>
 #include <stdio.h>
@@ -121,5 +124,33 @@ int main(void)
     report("mesh patch at the Moon's radius, camera 1 m up", &st);
     nc_frame_free(&f);
     nc_scene_free(&s);
+
+    /* C: far out. 2 km patch, 258 px across; float vertices about the
+     * body's origin are quantised to 0.125 m, 1/60 of a pixel's footprint. */
+    for (int side = 0; side < 2; side++) {
+        const double z = -(side ? 1.99 : 2.01) * R_MOON;
+        char pos[200], look[200];
+        snprintf(pos, sizeof pos, "camera.position_m=[0.25, -0.5, %.17g]", z);
+        snprintf(look, sizeof look, "camera.look_at_m=[3.25, -0.5, %.17g]", -R_MOON);
+        const char *far[] = {shape, pos, look, "camera.up=[0, 1, 0]", "camera.fx_px=400000", "camera.fy_px=400000"};
+        nc_test_scene(yaml_sphere, far, 6, &s);
+        nc_test_render(&s, 2, &f);
+        memset(&st, 0, sizeof st);
+        for (int y = 0; y < c->height_px; y++)
+            for (int x = 0; x < c->width_px; x++) {
+                struct nc_vec3 d = nc_v3_unit(nc_quat_rotate(c->attitude_q, nc_camera_dir(c, x, y)));
+                double t = (-R_MOON - c->position_m.z) / d.z;
+                struct nc_vec3 p = nc_v3_add(c->position_m, nc_v3_scale(d, t));
+                if (fabs(p.x) > 990 || fabs(p.y) > 990)
+                    continue;
+                check_pixel(&st, &f, x, y, t, 0.12 / M_PI * -s.sun.direction.z * s.sun.irradiance_w_m2);
+            }
+        report(side ? "mesh patch, camera 0.99 R beyond its bounding sphere (anchor near the camera)"
+                    : "mesh patch, camera 1.01 R beyond its bounding sphere (anchor at the body's origin)",
+               &st);
+        CHECK(st.worst_range < 2e-7, "far mesh: range error %.3g", st.worst_range);
+        nc_frame_free(&f);
+        nc_scene_free(&s);
+    }
     return nc_test_end();
 }
