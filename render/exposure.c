@@ -1,6 +1,8 @@
 /* exposure.c - rendering over an exposure window: time samples for motion
  * smear, and rows at their own times for a rolling shutter. Every sample is
- * a full render at propagated poses; nothing here approximates the image. */
+ * a full render at propagated poses; nothing here approximates the image.
+ * Time and anti-aliasing samples share one budget (struct nc_sample_pass):
+ * K time samples over S strata cost max(S, K) samples a pixel. */
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -41,15 +43,31 @@ static void accumulate(struct acc *a, const struct nc_frame *f, size_t o0, size_
     }
 }
 
+/* Time samples for at least k0 of them over S strata: a divisor of S, or
+ * a multiple of S, so that the N = max(S, K) samples of a pixel fall evenly
+ * on strata and time samples. */
+static int fold_time_samples(int k0, int S)
+{
+    if (k0 <= 1)
+        return 1;
+    if (k0 <= S) {
+        int K = k0;
+        while (S % K)
+            K++;
+        return K;
+    }
+    return S * ((k0 + S - 1) / S);
+}
+
 int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex,
                        struct nc_frame *f, int *time_samples)
 {
     const double T = ex->exposure_s;
     const int maxk = ex->max_time_samples > 0 ? ex->max_time_samples : 256;
     double motion = nc_render_motion_px(s, T);
-    int K = motion > 0 ? (int)fmin(maxk, ceil(motion / 0.5)) : 1;
-    if (K < 1)
-        K = 1;
+    int strata = (int)lround(sqrt((double)s->render.samples_per_pixel)), S = strata > 1 ? strata * strata : 1;
+    /* at most 0.5 px of motion between time samples */
+    int K = fold_time_samples(motion > 0 ? (int)fmin(maxk, ceil(motion / 0.5)) : 1, S);
     if (time_samples)
         *time_samples = K;
     if (K == 1 && !ex->rolling)
@@ -84,7 +102,8 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
         for (int k = 0; k < K && rc >= 0; k++) {
             struct nc_scene at;
             nc_scene_propagate(s, tc + T * ((k + 0.5) / K - 0.5), &at);
-            if ((rc = nc_render_rows_timed(r, &at, &sub, r0, r1, row_dt)) >= 0)
+            const struct nc_sample_pass pass = {k, K, K > S ? K : S};
+            if ((rc = nc_render_rows_timed(r, &at, &sub, r0, r1, row_dt, &pass)) >= 0)
                 accumulate(&a, &sub, (size_t)y0 * W, (size_t)y1 * W);
             if (rc >= 0 && f->rock_id && k == K / 2) /* the rocks seen at the middle time sample */
                 memcpy(f->rock_id + (size_t)y0 * W, sub.rock_id + (size_t)y0 * W,

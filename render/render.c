@@ -90,6 +90,30 @@ static inline double hash01(uint64_t seed, uint64_t a, uint64_t b)
     return (double)(z >> 11) * 0x1.0p-53;
 }
 
+static uint64_t gcd64(uint64_t u, uint64_t v)
+{
+    while (v) {
+        uint64_t t = u % v;
+        u = v;
+        v = t;
+    }
+    return u;
+}
+
+/* Pixel pid's sample for slot x (0 <= x < N) of the exposure: an affine
+ * permutation x -> (a x + b) mod N, a coprime to N, drawn per pixel, so
+ * each sample is dealt to a uniformly random time sample. */
+static int sample_of(uint64_t seed, uint64_t pid, int x, int N)
+{
+    if (N <= 1)
+        return 0;
+    const uint64_t h = mix64(seed ^ mix64(pid + 0x7065726dull)), n = (uint64_t)N; /* "perm" */
+    uint64_t a = 1 + (h >> 32) % (n - 1), b = (h & 0xffffffffu) % n;
+    while (gcd64(a, n) != 1) /* a = 1 ends it */
+        a = a % (n - 1) + 1;
+    return (int)((a * (uint64_t)x + b) % n);
+}
+
 struct job {
     const struct nc_renderer *r;
     const struct nc_scene *s;
@@ -106,6 +130,7 @@ struct job {
     struct nc_vec3 body_rel[NC_MAX_BODIES];    /* body origin - camera, scene frame, m */
     struct nc_material mat[NC_MAX_BODIES];     /* each body's, with its rocks not traced folded in */
     int tiles_x, tiles_y, n_strata;
+    struct nc_sample_pass pass; /* this time sample's share of each pixel's samples ({0, 1, S}: all) */
     int tile_row_begin, tile_row_end; /* the rows of tiles to render */
     atomic_int next;
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
@@ -426,7 +451,9 @@ static void shade_tile(struct job *j, int tile)
 {
     const struct nc_scene *s = j->s;
     const struct nc_camera *c = &s->camera;
-    const int W = c->width_px, H = c->height_px, n = j->n_strata, spp = n * n;
+    const int W = c->width_px, H = c->height_px, n = j->n_strata, S = n * n;
+    const struct nc_sample_pass *ps = &j->pass;
+    const int slots = ps->N / ps->K; /* samples each pixel takes in this pass */
     const int x0 = (tile % j->tiles_x) * TILE, y0 = (tile / j->tiles_x) * TILE;
     double acc_L[TILE * TILE], acc_iof[TILE * TILE], acc_range[TILE * TILE];
     int hits[TILE * TILE];
@@ -446,8 +473,10 @@ static void shade_tile(struct job *j, int tile)
     struct tile_counts cnt = {0, 0};
     double r[NC_PACKET];
 
-    for (int sidx = 0; sidx < spp; sidx++) {
-        const int sx = sidx % n, sy = sidx / n;
+    for (int slot = 0; slot < slots; slot++) {
+        /* This sample's number in the pixel's exposure (the soft-shadow and
+         * path streams'); the same in all lanes, unique per pixel. */
+        const int sidx = ps->k * slots + slot;
         for (int by = 0; by < TILE; by += 4)
             for (int bx = 0; bx < TILE; bx += 4) {
                 if (!live[by / 4][bx / 4])
@@ -457,10 +486,12 @@ static void shade_tile(struct job *j, int tile)
                     int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
                     ray.valid[i] = (px < W && py < H) ? -1 : 0;
                     double ox = 0, oy = 0;
-                    if (spp > 1) {
+                    if (S > 1) { /* sample g, in stratum g mod S, jittered within it */
                         uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                        ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)sidx)) / n - 0.5;
-                        oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)sidx + 1)) / n - 0.5;
+                        int g = ps->K > 1 ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N) : slot;
+                        const int sx = g % S % n, sy = g % S / n;
+                        ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)g)) / n - 0.5;
+                        oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)g + 1)) / n - 0.5;
                     }
                     double fx = px + ox, fy = py + oy;
                     const struct row_cam *rc = &j->row[py < H ? py : H - 1];
@@ -486,7 +517,7 @@ static void shade_tile(struct job *j, int tile)
                 if (j->r->ray_hook)
                     j->r->ray_hook(j->r->ray_hook_user, 0, &ray);
                 nc_rt_intersect16(j->rt, &ray, &hit, 1);
-                if (sidx == 0 && j->f->rock_id) /* the rock each pixel's first sample hit */
+                if (slot == 0 && j->f->rock_id) /* the rock each pixel's first sample (here) hit */
                     for (int i = 0; i < NC_PACKET; i++)
                         if (ray.valid[i])
                             j->f->rock_id[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
@@ -520,7 +551,7 @@ static void shade_tile(struct job *j, int tile)
             }
     }
     nc_rt_count_shadow_rays(j->rt, cnt.shadow_culled, cnt.shadow_traced);
-    const double inv = 1.0 / spp;
+    const double inv = 1.0 / slots;
     for (int y = y0; y < y0 + TILE && y < H; y++)
         for (int x = x0; x < x0 + TILE && x < W; x++) {
             int k = (y - y0) * TILE + (x - x0);
@@ -555,11 +586,11 @@ int nc_render_tile_rows(const struct nc_scene *s) { return (s->camera.height_px 
 int nc_render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
                    int tile_row_end)
 {
-    return nc_render_rows_timed(r, s, f, tile_row_begin, tile_row_end, NULL);
+    return nc_render_rows_timed(r, s, f, tile_row_begin, tile_row_end, NULL, NULL);
 }
 
 int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
-                         int tile_row_end, const double *row_dt)
+                         int tile_row_end, const double *row_dt, const struct nc_sample_pass *pass)
 {
     const struct nc_camera *c = &s->camera;
     if (f->width_px != c->width_px || f->height_px != c->height_px)
@@ -603,6 +634,14 @@ int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct
     j.n_strata = (int)lround(sqrt((double)s->render.samples_per_pixel));
     if (j.n_strata < 1)
         j.n_strata = 1;
+    const int S = j.n_strata * j.n_strata;
+    j.pass = pass ? *pass : (struct nc_sample_pass){0, 1, S};
+    if (j.pass.K < 1 || j.pass.k < 0 || j.pass.k >= j.pass.K || j.pass.N < S || j.pass.N % j.pass.K ||
+        j.pass.N % S) {
+        free(j.row);
+        return nc_error(NC_ERANGE, "render: sample pass %d of %d with %d samples a pixel (%d strata)", j.pass.k,
+                        j.pass.K, j.pass.N, S);
+    }
     atomic_init(&j.next, 0);
     j.cull = !c->distorted && !r->no_cull; /* the lens model's rays are not linear in the pixel */
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);

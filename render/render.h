@@ -66,10 +66,22 @@ int nc_render_frame(struct nc_renderer *r, const struct nc_scene *s, struct nc_f
 int nc_render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
                    int tile_row_end);
 int nc_render_tile_rows(const struct nc_scene *s);
+/* Time and anti-aliasing samples in one budget (render/exposure.c): each
+ * pixel takes N = max(S, K) samples over an exposure of K time samples (S =
+ * the render.samples_per_pixel strata; one of S, K divides the other).
+ * Sample g (0 <= g < N) lies in stratum g mod S; a random permutation per
+ * pixel deals the N samples to the K time samples, N / K each, so every
+ * time sample sees every part of the pixel on average (unbiased), and the
+ * exposure costs N samples a pixel, not K * S. Pass k of K renders its
+ * share; each frame it makes is the mean of that share. */
+struct nc_sample_pass {
+    int k, K, N;
+};
 /* The same with each image row's camera row_dt[y] seconds after the scene's
- * pose (camera rates; bodies stay at the scene's time). row_dt may be NULL. */
+ * pose (camera rates; bodies stay at the scene's time). row_dt may be NULL;
+ * pass NULL renders every stratum (S samples). */
 int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
-                         int tile_row_end, const double *row_dt);
+                         int tile_row_end, const double *row_dt, const struct nc_sample_pass *pass);
 
 /* An exposure: pose motion integrated over the exposure window. The scene's
  * poses are those at mid-exposure (of the middle row, for a rolling shutter);
