@@ -187,7 +187,11 @@ int main(int argc, char **argv)
     }
     struct nc_scene scene;
     struct nc_camsys cs;
+    struct nc_sky sky;
     int rc = nc_setup_load(scene_path, sets, nsets, &scene, &cs);
+    if (rc >= 0 && (rc = nc_sky_load(scene_path, sets, nsets, &sky)) >= 0 &&
+        (rc = nc_sky_prepare(&sky, &cs, &scene.camera)) < 0)
+        nc_sky_free(&sky);
     free(sets);
     if (rc < 0)
         return nc_cli_fail();
@@ -198,6 +202,7 @@ int main(int argc, char **argv)
     double t0 = now_ms();
     if ((rc = nc_renderer_init(&r, &scene, threads)) < 0) {
         nc_scene_free(&scene);
+        nc_sky_free(&sky);
         return nc_cli_fail();
     }
     double t1 = now_ms();
@@ -230,6 +235,13 @@ int main(int argc, char **argv)
     }
     if (rc >= 0)
         rc = nc_render_exposure(&r, &drawn, &ex, &f, &tsamples);
+    /* Stars (the `stars` section), drawn before the camera model's PSF. */
+    struct nc_sky_stats sst = {0};
+    char starinfo[120] = "";
+    double ts0 = now_ms();
+    if (rc >= 0 && sky.on && (rc = nc_sky_draw(&sky, &r, &cs, &drawn, 0, exposure, &f, &sst)) >= 0)
+        snprintf(starinfo, sizeof starinfo, "limit_mag=%.2f drawn=%ld hidden=%ld", sst.limit_mag, sst.drawn,
+                 sst.hidden);
     double t2 = now_ms(), scale = 0;
     /* Levels of detail and the smallest boulder traced (0: every rock). */
     char lod[40], rocks[40];
@@ -247,8 +259,10 @@ int main(int argc, char **argv)
         if (r.fold_theta_bar_deg[i] >= 0)
             o += snprintf(fold + o, sizeof fold - (size_t)o, "%s%s=%.6g", o ? "," : "", scene.body[i].name,
                           r.fold_theta_bar_deg[i]);
-    struct nc_image_attr extra[5] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}, {0}};
+    struct nc_image_attr extra[6] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}, {0}, {0}};
     int nextra = 2;
+    if (starinfo[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:stars", starinfo};
     if (normals[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:normals", normals};
     if (fold[0])
@@ -266,6 +280,9 @@ int main(int argc, char **argv)
                tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
         if (chosen[0])
             printf("  render.quality auto: %s\n", chosen);
+        if (sky.on)
+            printf("  stars: to V %.2f, %ld in the frame, %ld hidden by bodies (%.1f ms)\n", sst.limit_mag, sst.drawn,
+                   sst.hidden, t2 - ts0);
         if (scene.render.lod_error_px > 0)
             printf("  levels of detail: surface error bound %.3g m (render.lod_error_px %g)\n", nc_rt_lod_error_m(r.rt),
                    scene.render.lod_error_px);
@@ -293,5 +310,6 @@ int main(int argc, char **argv)
     nc_renderer_free(&r);
     nc_scene_free(&scene);
     nc_camsys_free(&cs);
+    nc_sky_free(&sky);
     return rc < 0 ? nc_cli_fail() : 0;
 }

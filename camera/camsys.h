@@ -22,6 +22,9 @@
 
 #define NC_PLANCK_J_S 6.62607015e-34 /* exact (SI 2019) */
 #define NC_LIGHT_M_S 299792458.0     /* exact */
+#define NC_STAR_TEMPS 64
+#define NC_STAR_T_MIN 2000.0
+#define NC_STAR_T_MAX 50000.0
 
 enum nc_vignetting { NC_VIGNETTING_NONE, NC_VIGNETTING_COS4, NC_VIGNETTING_TABLE };
 enum nc_shutter { NC_SHUTTER_GLOBAL, NC_SHUTTER_ROLLING };
@@ -32,6 +35,13 @@ struct nc_optics {
     double transmission;     /* optical throughput, 0..1 */
     double band_fraction;    /* in-band fraction of the solar irradiance */
     double wavelength_m;     /* effective wavelength of the passband */
+    /* Stars (camera/sky.h): for black bodies of NC_STAR_TEMPS temperatures
+     * (log-spaced, NC_STAR_T_MIN..NC_STAR_T_MAX K) the photon flux through
+     * the passband, int T(lambda) n(lambda) dlambda, per unit photon spectral
+     * flux at 545 nm (m); star_band is 0 when only band_fraction and
+     * wavelength_m were given (the band's shape is not known). */
+    double star_g_m[64];
+    int star_band;
     enum nc_vignetting vignetting;
     double *vig_angle_rad, *vig_factor; /* table: field angle -> factor */
     int nvig;

@@ -45,6 +45,21 @@ static void passband_integrate(const double (*row)[2], size_t n, struct nc_optic
     }
     o->band_fraction = num / den;
     o->wavelength_m = num > 0 ? wsum / num : 0;
+    /* Stars: photons through the band of a black body at each temperature,
+     * per photon spectral flux at 545 nm (photons ~ B lambda). */
+    for (int k = 0; k < NC_STAR_TEMPS; k++) {
+        const double tk = NC_STAR_T_MIN * pow(NC_STAR_T_MAX / NC_STAR_T_MIN, k / (NC_STAR_TEMPS - 1.0));
+        const double ref = planck_lambda(545e-9, tk) * 545e-9;
+        double g = 0;
+        for (size_t i = 0; i + 1 < n; i++)
+            for (int s = 0; s < 64; s++) {
+                double a = (s + 0.5) / 64, l = row[i][0] + a * (row[i + 1][0] - row[i][0]);
+                double t = row[i][1] + a * (row[i + 1][1] - row[i][1]), dl = (row[i + 1][0] - row[i][0]) / 64;
+                g += t * planck_lambda(l, tk) * l * dl;
+            }
+        o->star_g_m[k] = g / ref;
+    }
+    o->star_band = 1;
 }
 
 static int passband_table(struct nc_cfg_node *tab, struct nc_optics *o)

@@ -11,9 +11,9 @@ int nc_setup_load(const char *path, const char *const *sets, int nsets, struct n
     nc_cfg_init(&cfg);
     int rc = nc_cfg_load_scene(&cfg, path, sets, nsets);
     if (rc >= 0 && (rc = nc_scene_read(&cfg, s)) >= 0) {
-        /* The emulator's sections: not used by a single render. */
-        static const char *const serve_sections[] = {"serve", "outputs"};
-        for (int i = 0; i < 2; i++) {
+        /* The emulator's sections, and the stars (nc_sky_load reads them). */
+        static const char *const serve_sections[] = {"serve", "outputs", "stars"};
+        for (int i = 0; i < 3; i++) {
             struct nc_cfg_node *n = nc_cfg_get(cfg.root, serve_sections[i]);
             if (n)
                 nc_cfg_mark_used(n);
@@ -24,6 +24,17 @@ int nc_setup_load(const char *path, const char *const *sets, int nsets, struct n
         if (rc < 0)
             nc_scene_free(s);
     }
+    nc_cfg_free(&cfg);
+    return rc;
+}
+
+int nc_sky_load(const char *path, const char *const *sets, int nsets, struct nc_sky *sky)
+{
+    struct nc_cfg cfg;
+    nc_cfg_init(&cfg);
+    int rc = nc_cfg_load_scene(&cfg, path, sets, nsets);
+    if (rc >= 0)
+        rc = nc_sky_from_config(cfg.root, sky);
     nc_cfg_free(&cfg);
     return rc;
 }
@@ -42,9 +53,9 @@ int nc_camsys_load(const char *path, const char *const *sets, int nsets, struct 
         rc = nc_camera_intrinsics_from_config(cam, geom);
     if (rc >= 0) {
         /* Parts of a scene file that a camera alone does not use. */
-        static const char *const ignore_top[] = {"bodies", "sun", "render", "serve", "outputs"};
+        static const char *const ignore_top[] = {"bodies", "sun", "render", "serve", "outputs", "stars"};
         static const char *const ignore_cam[] = {"position_m", "attitude_q", "look_at_m", "up"};
-        for (int i = 0; i < 5; i++) {
+        for (int i = 0; i < 6; i++) {
             struct nc_cfg_node *n = nc_cfg_get(cfg.root, ignore_top[i]);
             if (n)
                 nc_cfg_mark_used(n);

@@ -8,12 +8,15 @@
 #include <stdint.h>
 
 #include "camera/camsys.h"
+#include "camera/sky.h"
 #include "render/frame_io.h"
 #include "render/scene.h"
 
 /* A scene and its camera model from one configuration (path NULL: the
  * built-in default scene), with --set overrides; unknown keys are errors. */
 int nc_setup_load(const char *path, const char *const *sets, int nsets, struct nc_scene *s, struct nc_camsys *cs);
+/* The same configuration's `stars` section (sky->on = 0 without one). */
+int nc_sky_load(const char *path, const char *const *sets, int nsets, struct nc_sky *sky);
 /* A camera alone (intrinsics, optics, sensor, exposure), for `navcam expose`.
  * A whole scene file is accepted: its pose, bodies, Sun and render settings
  * are ignored. */

@@ -58,6 +58,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:boulder_min_m", "ROCKMIN"},
     {"navcam:normals", "NORMALS"},
     {"navcam:rock_fold_theta_bar_deg", "ROCKFOLD"},
+    {"navcam:stars", "STARS"},
 };
 
 /* 1 when attrs ask for the archive row order (row 1 at the bottom). */

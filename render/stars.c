@@ -1,0 +1,331 @@
+/* stars.c - the star catalogue, its index file, and point sources drawn
+ * into the frame (stars.h). */
+#include "render/stars.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/rt.h"
+#include "render/scene.h"
+
+#define MAS_RAD (M_PI / 180.0 / 3600.0 / 1000.0)
+#define LIGHT_M_S 299792458.0
+
+/* ---- KStars stars.dat ------------------------------------------------------ */
+
+/* The number in columns [a, b) of line (0-based); 0 when it is not one. */
+static int field(const char *line, size_t len, int a, int b, double *v)
+{
+    char buf[32], *end;
+    if ((size_t)b > len || b - a >= (int)sizeof buf)
+        return 0;
+    memcpy(buf, line + a, (size_t)(b - a));
+    buf[b - a] = 0;
+    *v = strtod(buf, &end);
+    while (*end == ' ')
+        end++;
+    return end != buf && !*end && isfinite(*v);
+}
+
+static int by_mag(const void *a, const void *b)
+{
+    const struct nc_star *x = a, *y = b;
+    return (x->v_mag > y->v_mag) - (x->v_mag < y->v_mag);
+}
+
+int nc_star_cat_read_kstars(const char *path, struct nc_star_cat *c)
+{
+    memset(c, 0, sizeof *c);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    size_t cap = 0;
+    char line[512];
+    int rc = 0;
+    for (long no = 1; rc == 0 && fgets(line, sizeof line, f); no++) {
+        size_t len = strlen(line);
+        if (line[0] == '#' || len < 8)
+            continue;
+        double hh, mm, ss, dd, dm, ds, pa, pd, v, bv;
+        /* RA hhmmss.ss (cols 1-9), Dec sddmmss.s (11-19), pmRA cos(dec)
+         * (21-29) and pmDec (30-38) in mas/yr, V (46-51), B-V (52-56) */
+        if (!field(line, len, 0, 2, &hh) || !field(line, len, 2, 4, &mm) || !field(line, len, 4, 9, &ss) ||
+            !field(line, len, 11, 13, &dd) || !field(line, len, 13, 15, &dm) || !field(line, len, 15, 19, &ds) ||
+            !field(line, len, 20, 29, &pa) || !field(line, len, 29, 38, &pd) || !field(line, len, 45, 51, &v) ||
+            !field(line, len, 51, 56, &bv) || (line[10] != '+' && line[10] != '-') || hh >= 24 || dd > 90) {
+            rc = nc_error(NC_ECONFIG, "%s:%ld: not a stars.dat row (RA hhmmss.ss, Dec sddmmss.s, pmRA, pmDec, "
+                                     "parallax, V, B-V in fixed columns)",
+                          path, no);
+            break;
+        }
+        if (c->n == cap) {
+            cap = cap ? 2 * cap : 1 << 17;
+            struct nc_star *s = realloc(c->star, cap * sizeof *s);
+            if (!s) {
+                rc = nc_error(-ENOMEM, "out of memory");
+                break;
+            }
+            c->star = s;
+        }
+        /* Seconds written as 60.00 (rounding) are converted, not refused. */
+        double dec = (dd + dm / 60 + ds / 3600) * (line[10] == '-' ? -1 : 1);
+        c->star[c->n++] = (struct nc_star){.ra_rad = (hh + mm / 60 + ss / 3600) * 15 * M_PI / 180,
+                                           .dec_rad = dec * M_PI / 180, .pm_ra_mas_yr = (float)pa,
+                                           .pm_dec_mas_yr = (float)pd, .v_mag = (float)v, .b_v = (float)bv};
+    }
+    fclose(f);
+    if (rc == 0 && c->n == 0)
+        rc = nc_error(NC_ECONFIG, "%s: no stars", path);
+    if (rc < 0) {
+        nc_star_cat_free(c);
+        return rc;
+    }
+    qsort(c->star, c->n, sizeof *c->star, by_mag);
+    c->epoch_jyear = 2000.0;
+    return 0;
+}
+
+/* ---- NavCam's index: "NCSTARS1", u64 count, f64 epoch (Julian year), then
+ * per star f64 ra, f64 dec (rad), f32 pm_ra cos(dec), f32 pm_dec (mas/yr),
+ * f32 V, f32 B-V; little-endian, brightest first. ------------------------------ */
+
+#define MAGIC "NCSTARS1"
+#define RECORD 32
+
+static void put64(uint8_t *p, uint64_t v)
+{
+    for (int i = 0; i < 8; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+static uint64_t get64(const uint8_t *p)
+{
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; i--)
+        v = v << 8 | p[i];
+    return v;
+}
+static void putd(uint8_t *p, double d)
+{
+    uint64_t u;
+    memcpy(&u, &d, 8);
+    put64(p, u);
+}
+static double getd(const uint8_t *p)
+{
+    uint64_t u = get64(p);
+    double d;
+    memcpy(&d, &u, 8);
+    return d;
+}
+static void putf(uint8_t *p, float x)
+{
+    uint32_t u;
+    memcpy(&u, &x, 4);
+    for (int i = 0; i < 4; i++)
+        p[i] = (uint8_t)(u >> (8 * i));
+}
+static float getf(const uint8_t *p)
+{
+    uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+    float x;
+    memcpy(&x, &u, 4);
+    return x;
+}
+
+int nc_star_cat_write(const struct nc_star_cat *c, const char *path)
+{
+    size_t size = 24 + c->n * RECORD;
+    uint8_t *b = malloc(size);
+    if (!b)
+        return nc_error(-ENOMEM, "out of memory");
+    memcpy(b, MAGIC, 8);
+    put64(b + 8, c->n);
+    putd(b + 16, c->epoch_jyear);
+    for (size_t i = 0; i < c->n; i++) {
+        uint8_t *p = b + 24 + i * RECORD;
+        const struct nc_star *s = &c->star[i];
+        putd(p, s->ra_rad);
+        putd(p + 8, s->dec_rad);
+        putf(p + 16, s->pm_ra_mas_yr);
+        putf(p + 20, s->pm_dec_mas_yr);
+        putf(p + 24, s->v_mag);
+        putf(p + 28, s->b_v);
+    }
+    FILE *f = fopen(path, "wb");
+    int ok = f && fwrite(b, 1, size, f) == size;
+    ok = f && fclose(f) == 0 && ok;
+    free(b);
+    return ok ? 0 : nc_error(-EIO, "%s: cannot write the star index", path);
+}
+
+int nc_star_cat_load(const char *path, struct nc_star_cat *c)
+{
+    memset(c, 0, sizeof *c);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    uint8_t h[24];
+    int rc = 0;
+    if (fread(h, 1, 24, f) != 24 || memcmp(h, MAGIC, 8))
+        rc = nc_error(NC_ECONFIG, "%s: not a NavCam star index (write one with `navcam stars`)", path);
+    uint64_t n = rc ? 0 : get64(h + 8);
+    if (rc == 0 && (n == 0 || n > 100000000))
+        rc = nc_error(NC_ECONFIG, "%s: %llu stars", path, (unsigned long long)n);
+    uint8_t *b = rc ? NULL : malloc(n * RECORD);
+    if (rc == 0 && (!b || !(c->star = malloc(n * sizeof *c->star))))
+        rc = nc_error(-ENOMEM, "out of memory");
+    if (rc == 0 && fread(b, RECORD, n, f) != n)
+        rc = nc_error(NC_ECONFIG, "%s: truncated (%llu stars announced)", path, (unsigned long long)n);
+    fclose(f);
+    for (uint64_t i = 0; rc == 0 && i < n; i++) {
+        const uint8_t *p = b + i * RECORD;
+        struct nc_star *s = &c->star[i];
+        *s = (struct nc_star){getd(p), getd(p + 8), getf(p + 16), getf(p + 20), getf(p + 24), getf(p + 28)};
+        if (!(fabs(s->dec_rad) <= M_PI / 2 && isfinite(s->ra_rad) && isfinite(s->v_mag) && isfinite(s->b_v) &&
+              isfinite(s->pm_ra_mas_yr) && isfinite(s->pm_dec_mas_yr)) ||
+            (i && s->v_mag < c->star[i - 1].v_mag))
+            rc = nc_error(NC_ECONFIG, "%s: star %llu is not valid or not in magnitude order", path,
+                          (unsigned long long)i);
+    }
+    free(b);
+    c->n = (size_t)n;
+    c->epoch_jyear = rc ? 0 : getd(h + 16);
+    if (rc < 0)
+        nc_star_cat_free(c);
+    return rc;
+}
+
+void nc_star_cat_free(struct nc_star_cat *c)
+{
+    free(c->star);
+    memset(c, 0, sizeof *c);
+}
+
+size_t nc_star_cat_count_to(const struct nc_star_cat *c, double v_mag)
+{
+    size_t lo = 0, hi = c->n; /* first star fainter than v_mag */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->star[mid].v_mag <= v_mag)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* ---- directions --------------------------------------------------------------- */
+
+struct nc_vec3 nc_star_direction(const struct nc_star *s, double epoch_jyear, double jyear)
+{
+    const double ca = cos(s->ra_rad), sa = sin(s->ra_rad), cd = cos(s->dec_rad), sd = sin(s->dec_rad);
+    const double dt = jyear - epoch_jyear;
+    /* east (increasing RA) and north unit vectors of the tangent plane */
+    const struct nc_vec3 p = nc_v3(cd * ca, cd * sa, sd), e = nc_v3(-sa, ca, 0), nn = nc_v3(-sd * ca, -sd * sa, cd);
+    const double de = s->pm_ra_mas_yr * MAS_RAD * dt, dn = s->pm_dec_mas_yr * MAS_RAD * dt;
+    return nc_v3_unit(nc_v3_add(p, nc_v3_add(nc_v3_scale(e, de), nc_v3_scale(nn, dn))));
+}
+
+/* p' = (p / gamma + (1 + p.V / (1 + 1 / gamma)) V) / (1 + p.V), V = v / c
+ * (the Explanatory Supplement to the Astronomical Almanac, 1992, eq. 3.252-3). */
+struct nc_vec3 nc_aberrate(struct nc_vec3 p, struct nc_vec3 v_m_s)
+{
+    const struct nc_vec3 V = nc_v3_scale(v_m_s, 1.0 / LIGHT_M_S);
+    const double v2 = nc_v3_dot(V, V), ig = sqrt(1 - v2), pv = nc_v3_dot(p, V);
+    struct nc_vec3 q = nc_v3_add(nc_v3_scale(p, ig), nc_v3_scale(V, 1 + pv / (1 + ig)));
+    return nc_v3_unit(nc_v3_scale(q, 1 / (1 + pv)));
+}
+
+/* ---- drawing ------------------------------------------------------------------- */
+
+/* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance. */
+static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double y, double e)
+{
+    const int W = f->width_px, H = f->height_px;
+    const int x0 = (int)floor(x), y0 = (int)floor(y);
+    const double ax = x - x0, ay = y - y0;
+    const struct nc_vec3 d = nc_camera_dir(c, x, y);
+    const double cos3 = pow(nc_v3_norm(d), -3.0), omega = cos3 / (c->fx_px * c->fy_px); /* sr per pixel there */
+    const double L = e / omega, w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+    int in = 0;
+    for (int k = 0; k < 4; k++) {
+        int px = x0 + (k & 1), py = y0 + (k >> 1);
+        if (px < 0 || py < 0 || px >= W || py >= H || w[k] == 0)
+            continue;
+        f->radiance[(size_t)py * W + px] += (float)(L * w[k]);
+        in = 1;
+    }
+    return in;
+}
+
+long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s,
+                      const struct nc_point_source *p, size_t n, struct nc_frame *f, long *hidden)
+{
+    const struct nc_camera *c = &s->camera;
+    *hidden = 0;
+    if (f->width_px != c->width_px || f->height_px != c->height_px)
+        return nc_error(NC_ERANGE, "frame is %dx%d but the camera is %dx%d", f->width_px, f->height_px,
+                        c->width_px, c->height_px);
+    int rc = nc_rt_update(r->rt, s); /* the bodies at the scene's (mid-exposure) poses */
+    if (rc < 0)
+        return rc;
+    /* Steps over the exposure: at most 0.1 px of turning apart (stars are
+     * at infinity: only the camera's rotation moves them). */
+    const double turn_px = nc_v3_norm(c->angular_velocity_rad_s) * exposure_s * fmax(c->fx_px, c->fy_px);
+    const int K = turn_px > 0 ? (int)fmin(4096, ceil(turn_px / 0.1)) : 1;
+    /* Only the stars the frame can show: projected at mid-exposure within
+     * the frame, grown by the turn and a pixel. */
+    size_t *in = malloc((n ? n : 1) * sizeof *in), m = 0;
+    if (!in)
+        return nc_error(-ENOMEM, "out of memory");
+    const struct nc_quat to_cam = nc_quat_conj(c->attitude_q);
+    const double grow = turn_px + 2;
+    for (size_t i = 0; i < n; i++) {
+        double x, y;
+        struct nc_vec3 d = nc_quat_rotate(to_cam, p[i].dir);
+        if ((nc_camera_project(c, d, &x, &y) == 0 && x > -grow && y > -grow && x < c->width_px - 1 + grow &&
+             y < c->height_px - 1 + grow) ||
+            (turn_px > 0.1 * c->width_px && d.z > 0)) /* a long turn: every star ahead */
+            in[m++] = i;
+    }
+    long drawn = 0;
+    for (size_t i0 = 0; i0 < m; i0 += NC_PACKET) {
+        struct nc_ray16 ray;
+        int occ[NC_PACKET] = {0};
+        memset(&ray, 0, sizeof ray);
+        for (int l = 0; l < NC_PACKET; l++) {
+            const int ok = i0 + (size_t)l < m;
+            const struct nc_vec3 d = ok ? p[in[i0 + (size_t)l]].dir : nc_v3(0, 0, 1);
+            ray.valid[l] = ok ? -1 : 0;
+            ray.dx[l] = (float)d.x;
+            ray.dy[l] = (float)d.y;
+            ray.dz[l] = (float)d.z;
+            ray.tfar[l] = INFINITY;
+        }
+        nc_rt_occluded16(r->rt, &ray, occ);
+        for (int l = 0; l < NC_PACKET && i0 + (size_t)l < m; l++) {
+            const struct nc_point_source *q = &p[in[i0 + (size_t)l]];
+            if (occ[l]) {
+                ++*hidden;
+                continue;
+            }
+            int shown = 0;
+            for (int k = 0; k < K; k++) {
+                double dt = exposure_s * ((k + 0.5) / K - 0.5), x, y;
+                struct nc_quat a = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt)
+                                           : c->attitude_q;
+                struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), q->dir); /* camera frame */
+                if (nc_camera_project(c, d, &x, &y) == 0)
+                    shown |= splat(f, c, x, y, q->irradiance_w_m2 / K);
+            }
+            drawn += shown;
+        }
+    }
+    free(in);
+    return drawn;
+}

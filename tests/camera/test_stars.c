@@ -1,0 +1,209 @@
+/* test_stars.c - stars in the frame (camera/sky.h, render/stars.h):
+ *  1. the KStars stars.dat reader and NavCam's index (round trip, order,
+ *     errors that name the line);
+ *  2. proper motion and aberration against their formulas;
+ *  3. photometry through the camera model: a star's electrons, summed over
+ *     the PSF, against the zero point integrated here independently
+ *     (Simpson's rule over the 500-700 nm band); V + 5 gives 1/100;
+ *  4. the aberration of a 30 km/s observer moves the star's centroid by
+ *     atan(beta gamma) = 20.64 arcsec in the rendered frame;
+ *  5. a body in front hides the star; 1 and 2 threads give the same frame. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera/load.h"
+#include "camera/sky.h"
+#include "core/error.h"
+#include "testutil.h"
+
+#define AS (M_PI / 180 / 3600) /* one arcsecond, rad */
+
+/* A noise-free camera, 2.06 arcsec pixels (5 um at 0.5 m), looking at the
+ * direction of the synthetic index's first star; a small sphere elsewhere. */
+static const char scene_fmt[] = "bodies:\n"
+                                "  - name: rock\n"
+                                "    shape: {type: sphere, radius_m: 100}\n"
+                                "    position_m: [%.17g, %.17g, %.17g]\n"
+                                "    material: {model: lambert, A: 0.1}\n"
+                                "sun: {direction: [%.17g, %.17g, %.17g]}\n"
+                                "camera: {width_px: 96, height_px: 96, focal_length_m: 0.5, pixel_pitch_m: 5.0e-6,\n"
+                                "         position_m: [0, 0, 0], look_at_m: [%.17g, %.17g, %.17g], up: [0, 0, 1]}\n"
+                                "render: {samples_per_pixel: 1}\n"
+                                "optics: {f_number: 8, transmission: 0.9, passband: {from_m: 5.0e-7, to_m: 7.0e-7},\n"
+                                "         vignetting: none, psf: {type: gaussian, sigma_px: 1.0}}\n"
+                                "sensor: {qe: 0.6, read_noise_e: 0, dark_current_e_s: 0, shot_noise: false,\n"
+                                "         full_well_e: 1.0e9, gain_e_per_dn: 1000, adc_bits: 16}\n"
+                                "exposure: {time_s: 1.0}\n"
+                                "stars: {catalogue: '%s', limit_mag: 12, observer_velocity_m_s: [%.17g, %.17g, %.17g]}\n";
+
+struct shot {
+    double sum, cx, cy; /* electrons in the frame, centroid (px) */
+    struct nc_sky_stats st;
+};
+
+/* Render the scene (body at rock, stars) and take the electrons. */
+static struct shot shoot(struct nc_vec3 look, struct nc_vec3 rock, struct nc_vec3 v, int threads, float **keep)
+{
+    char yaml[4096], idx[1024];
+    snprintf(idx, sizeof idx, "%s", nc_test_path("stars.ncs"));
+    struct nc_vec3 sun = nc_v3_unit(look); /* behind anything in front of the camera: its side to us is dark */
+    snprintf(yaml, sizeof yaml, scene_fmt, rock.x, rock.y, rock.z, sun.x, sun.y, sun.z, look.x, look.y, look.z, idx,
+             v.x, v.y, v.z);
+    const char *path = nc_test_path("scene.yaml");
+    nc_test_write(path, yaml);
+    struct nc_scene s;
+    struct nc_camsys cs;
+    struct nc_sky sky;
+    struct shot out = {0};
+    int rc = nc_setup_load(path, NULL, 0, &s, &cs);
+    CHECK(rc >= 0 && nc_sky_load(path, NULL, 0, &sky) >= 0 && sky.on && nc_sky_prepare(&sky, &cs, &s.camera) >= 0,
+          "set-up: %s", nc_errmsg());
+    if (rc < 0 || !sky.on) {
+        fprintf(stderr, "test_stars: cannot go on without the scene\n");
+        exit(nc_test_end() ? 1 : 1);
+    }
+    struct nc_scene drawn = s;
+    nc_camsys_render_camera(&cs, &s.camera, &drawn.camera);
+    struct nc_renderer r;
+    struct nc_frame f;
+    nc_renderer_init(&r, &drawn, threads);
+    nc_frame_alloc(&f, drawn.camera.width_px, drawn.camera.height_px);
+    struct nc_exposure ex = {.exposure_s = 1.0};
+    float *e = malloc(sizeof(float) * 96 * 96);
+    CHECK(nc_render_exposure(&r, &drawn, &ex, &f, NULL) == 0 && nc_sky_draw(&sky, &r, &cs, &drawn, 0, 1.0, &f, &out.st) == 0 &&
+              nc_camsys_electrons(&cs, f.radiance, 1.0, e) == 0,
+          "render: %s", nc_errmsg());
+    double mx = 0, my = 0;
+    for (int y = 0; y < 96; y++)
+        for (int x = 0; x < 96; x++) {
+            out.sum += e[y * 96 + x];
+            mx += x * (double)e[y * 96 + x];
+            my += y * (double)e[y * 96 + x];
+        }
+    out.cx = out.sum > 0 ? mx / out.sum : NAN;
+    out.cy = out.sum > 0 ? my / out.sum : NAN;
+    if (keep)
+        *keep = e;
+    else
+        free(e);
+    nc_frame_free(&f);
+    nc_renderer_free(&r);
+    nc_sky_free(&sky);
+    nc_camsys_free(&cs);
+    nc_scene_free(&s);
+    return out;
+}
+
+/* Planck photon spectral radiance shape, lambda in m (any constant factor). */
+static double photons(double l, double t)
+{
+    const double h = 6.62607015e-34, c = 299792458.0, k = 1.380649e-23;
+    return 1.0 / (pow(l, 4) * expm1(h * c / (l * k * t)));
+}
+
+int main(void)
+{
+    /* 1. stars.dat and the index. */
+    const char *dat = nc_test_path("stars.dat");
+    nc_test_write(dat, "# a test catalogue in KStars' columns\n"
+                       "183656.34 +384701.3 +000201.0+000287.500128.9 00.03-0.00A0 0            , alp Lyr, Vega\n"
+                       "064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1            , alp CMa, Sirius\n"
+                       "232339.92 +553760.0 -000013.5-000019.900006.4 08.7800.01A? 0\n");
+    struct nc_star_cat c;
+    CHECK(nc_star_cat_read_kstars(dat, &c) == 0 && c.n == 3, "read: %s", nc_errmsg());
+    CHECK(c.star[0].v_mag == -1.44f && c.star[1].v_mag == 0.03f && c.star[2].v_mag == 8.78f, "brightest first");
+    CHECK(fabs(c.star[0].ra_rad * 180 / M_PI - 101.287166667) < 1e-8 &&
+              fabs(c.star[0].dec_rad * 180 / M_PI + 16.716111111) < 1e-8 && c.star[0].pm_dec_mas_yr == -1223.1f &&
+              c.star[0].b_v == 0.01f,
+          "Sirius: %.9f %.9f", c.star[0].ra_rad * 180 / M_PI, c.star[0].dec_rad * 180 / M_PI);
+    CHECK(fabs(c.star[2].dec_rad * 180 / M_PI - (55 + 38 / 60.0)) < 1e-9, "60.00 seconds read as a number");
+    const char *ix = nc_test_path("three.ncs");
+    struct nc_star_cat d;
+    CHECK(nc_star_cat_write(&c, ix) == 0 && nc_star_cat_load(ix, &d) == 0 && d.n == 3 && d.epoch_jyear == 2000 &&
+              !memcmp(d.star, c.star, 3 * sizeof *c.star),
+          "index round trip: %s", nc_errmsg());
+    CHECK(nc_star_cat_count_to(&d, 0.0) == 1 && nc_star_cat_count_to(&d, 9) == 3, "prefix to a magnitude");
+    nc_star_cat_free(&d);
+    nc_star_cat_free(&c);
+    nc_test_write(dat, "064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\nnot a star\n");
+    CHECK(nc_star_cat_read_kstars(dat, &c) < 0 && nc_test_contains(nc_errmsg(), "stars.dat:2"),
+          "a bad row names its line: %s", nc_errmsg());
+
+    /* 2. Proper motion: 1000 mas/yr north for 10 years is 10 arcsec. */
+    struct nc_star s0 = {.ra_rad = 0.3, .dec_rad = 0.2, .pm_dec_mas_yr = 1000, .v_mag = 5};
+    struct nc_vec3 a = nc_star_direction(&s0, 2000, 2000), b = nc_star_direction(&s0, 2000, 2010);
+    double moved = atan2(nc_v3_norm(nc_v3_cross(a, b)), nc_v3_dot(a, b)) / AS;
+    printf("proper motion: %.9f arcsec in 10 years at 1000 mas/yr\n", moved);
+    CHECK(fabs(moved - 10) < 1e-6 && b.z > a.z, "proper motion %.9f arcsec", moved);
+    /* Aberration, perpendicular to the motion: atan(beta gamma). */
+    const double beta = 3e4 / 299792458.0, want = atan(beta / sqrt(1 - beta * beta)) / AS;
+    struct nc_vec3 p = nc_v3(1, 0, 0), q = nc_aberrate(p, nc_v3(0, 3e4, 0));
+    double ab = atan2(nc_v3_norm(nc_v3_cross(p, q)), nc_v3_dot(p, q)) / AS;
+    printf("aberration at 30 km/s: %.6f arcsec (expected %.6f)\n", ab, want);
+    CHECK(fabs(ab - want) < 1e-6 && q.y > 0, "aberration %.6f arcsec", ab);
+
+    /* A synthetic index: a V 5 star of B-V 0.65 and a V 10 twin 20 px away. */
+    struct nc_star st[2] = {{.ra_rad = 1.0, .dec_rad = 0.4, .v_mag = 5.0f, .b_v = 0.65f},
+                            {.ra_rad = 1.0 + 40 * 1e-5 / cos(0.4), .dec_rad = 0.4, .v_mag = 10.0f, .b_v = 0.65f}};
+    struct nc_star_cat two = {.n = 2, .star = st, .epoch_jyear = 2000};
+    CHECK(nc_star_cat_write(&two, nc_test_path("stars.ncs")) == 0, "write");
+    struct nc_vec3 look = nc_star_direction(&st[0], 2000, 2000), away = nc_v3(0, 0, -1e4);
+
+    /* 3. Photometry. */
+    float *e1;
+    struct shot s1 = shoot(look, away, nc_v3(0, 0, 0), 2, &e1);
+    const double tk = 4600.0 * (1 / (0.92 * 0.65 + 1.7) + 1 / (0.92 * 0.65 + 0.62)), n = 2000;
+    double g = 0; /* int over 500-700 nm of photons(l) / photons(545 nm), m */
+    for (int i = 0; i <= n; i++) {
+        double l = 500e-9 + 200e-9 * i / n;
+        g += (i == 0 || i == n ? 1 : i % 2 ? 4 : 2) * photons(l, tk);
+    }
+    g *= 200e-9 / n / 3 / photons(545e-9, tk);
+    const double area = M_PI * pow(0.5 / 8, 2) / 4; /* aperture diameter f / N */
+    double e_v5 = 9.96e16 * pow(10, -0.4 * 5) * g * area * 0.9 * 0.6 * 1.0; /* e- in 1 s */
+    /* The two stars separately: each one's 15 x 15 px window. */
+    double w5 = 0, w10 = 0;
+    int x5 = (int)lround(s1.cx), y5 = (int)lround(s1.cy);
+    for (int y = -7; y <= 7; y++)
+        for (int x = -7; x <= 7; x++) {
+            w5 += e1[(y5 + y) * 96 + x5 + x];
+            if (x5 + x - 40 >= 0)
+                w10 += e1[(y5 + y) * 96 + x5 + x - 40];
+        }
+    printf("photometry: V 5, B-V 0.65 (T %.0f K): %.6g e- against %.6g predicted (%.4f); V 10: %.6g of V 5 "
+           "(1/100 expected)\n",
+           tk, w5, e_v5, w5 / e_v5, w10 / w5);
+    CHECK(fabs(w5 / e_v5 - 1) < 0.02, "star electrons %.6g, zero point predicts %.6g", w5, e_v5);
+    CHECK(fabs(w10 / w5 - 0.01) < 1e-4, "V + 5: ratio %.6g", w10 / w5);
+    CHECK(s1.st.drawn == 2 && s1.st.hidden == 0 && s1.st.limit_mag == 12, "stats: drawn %ld hidden %ld limit %g",
+          s1.st.drawn, s1.st.hidden, s1.st.limit_mag);
+
+    /* 4. Aberration in the frame: 30 km/s along the camera's +x axis. */
+    struct nc_vec3 right = nc_v3_unit(nc_v3_cross(look, nc_v3(0, 0, 1))); /* look x up: image +x */
+    float *e2;
+    shoot(look, away, nc_v3_scale(right, 3e4), 2, &e2);
+    double c1 = 0, c2 = 0, m1 = 0, m2 = 0; /* centroids in a window that holds the V 5 star, not its twin */
+    for (int y = -7; y <= 7; y++)
+        for (int x = -7; x <= 20; x++) {
+            double v1 = e1[(y5 + y) * 96 + x5 + x], v2 = e2[(y5 + y) * 96 + x5 + x];
+            m1 += v1, c1 += (x5 + x) * v1, m2 += v2, c2 += (x5 + x) * v2;
+        }
+    double dx_px = c2 / m2 - c1 / m1, shift = atan(dx_px * 1e-5) / AS;
+    printf("aberration in the frame: the star moved %.4f px = %.4f arcsec (expected %.4f)\n", dx_px, shift, want);
+    CHECK(fabs(shift - want) < 0.1, "aberration in the frame %.4f arcsec, expected %.4f", shift, want);
+    free(e2);
+
+    /* 5. Occultation, and threads. */
+    struct shot s3 = shoot(look, nc_v3_scale(look, 1e4), nc_v3(0, 0, 0), 2, NULL);
+    printf("occultation: %ld hidden, %ld drawn, %.3g e- in the frame\n", s3.st.hidden, s3.st.drawn, s3.sum);
+    CHECK(s3.st.hidden == 2 && s3.st.drawn == 0 && s3.sum < 1e-6 * s1.sum, "a body in front: hidden %ld, %g e-",
+          s3.st.hidden, s3.sum);
+    float *e4;
+    shoot(look, away, nc_v3(0, 0, 0), 1, &e4);
+    CHECK(!memcmp(e1, e4, sizeof(float) * 96 * 96), "1 and 2 threads: the same frame");
+    free(e1);
+    free(e4);
+    return nc_test_end();
+}
