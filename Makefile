@@ -36,6 +36,7 @@ bench: build
 	bench/startup.sh $(BUILD)
 	$(BUILD)/bench_render
 	$(BUILD)/bench_lod
+	$(BUILD)/bench_stars
 	$(BUILD)/bench_rubble
 	$(BUILD)/bench_brdf
 	$(BUILD)/bench_sensor

@@ -32,6 +32,9 @@ struct nc_frame_record {
     double boulder_min_m;        /* smallest boulder diameter traced, m (0: every rock, or none) */
     double rock_fold_theta_bar_deg; /* roughness the rocks not traced were folded into, deg (-1: none) */
     int samples_per_pixel, bounces, soft_shadows, quality_auto; /* the render settings used (auto: its choice) */
+    int stars_on;                   /* the scene has a `stars` section: */
+    double star_limit_mag;          /* the limiting magnitude used */
+    long stars_drawn, stars_hidden; /* stars in the frame, and hidden by bodies */
     double render_ms, camera_ms; /* render (incl. smear) and camera model time */
     int width_px, height_px, adc_bits;
     const uint16_t *dn;          /* the digitised frame */

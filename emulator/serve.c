@@ -40,6 +40,8 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
         (rc = nc_camsys_from_config(cfg.root, &e->scene.camera, e->scene.camera.focal_length_m, &e->cs)) >= 0)
         *have_cs = 1;
     if (rc >= 0)
+        rc = nc_sky_from_config(cfg.root, &e->sky);
+    if (rc >= 0)
         rc = nc__serve_config(&cfg, e, dir);
     if (rc >= 0)
         rc = nc_cfg_check_unused(&cfg);
@@ -47,6 +49,8 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
     if (rc >= 0 && !(e->cs.sensor.pixel_pitch_m > 0))
         rc = nc_error(NC_ECONFIG,
                       "serve needs the camera model: give camera.focal_length_m and pixel_pitch_m, or sensor.pixel_pitch_m");
+    if (rc >= 0)
+        rc = nc_sky_prepare(&e->sky, &e->cs, &e->scene.camera);
     if (rc >= 0)
         rc = nc_renderer_init(&e->renderer, &e->scene, opt->threads);
     if (rc >= 0 && !(e->clients = calloc((size_t)e->max_clients, sizeof *e->clients)))
@@ -192,6 +196,7 @@ static void teardown(struct nc__emu *e, int have_scene, int have_cs)
         nc_renderer_free(&e->renderer);
     if (have_cs)
         nc_camsys_free(&e->cs);
+    nc_sky_free(&e->sky);
     if (have_scene)
         nc_scene_free(&e->scene);
     free(e);

@@ -18,6 +18,7 @@
 #include <stdio.h>
 
 #include "camera/camsys.h"
+#include "camera/sky.h"
 #include "emulator/output.h"
 #include "emulator/serve.h"
 #include "emulator/timeline.h"
@@ -103,6 +104,7 @@ struct nc__emu {
     /* the camera */
     struct nc_scene scene;
     struct nc_camsys cs;
+    struct nc_sky sky; /* the `stars` section (sky.on = 0 without one) */
     struct nc_renderer renderer;
     struct nc_output out[NC_SERVE_MAX_OUTPUTS];
     int nout;

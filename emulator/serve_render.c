@@ -137,6 +137,7 @@ struct staged {
     int64_t gap, t0, t1; /* render start and end, CLOCK_MONOTONIC */
     int rc, ts, buf;
     double lod_error_m, boulder_min_m, rock_fold_theta_bar_deg;
+    struct nc_sky_stats stars;
     struct nc_render_settings used; /* render.quality: auto's choice, or the scene's */
 };
 
@@ -201,6 +202,8 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .time_samples = x->ts, .lod_error_m = x->lod_error_m, .boulder_min_m = x->boulder_min_m,
         .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .samples_per_pixel = x->used.samples_per_pixel,
         .bounces = x->used.bounces, .soft_shadows = x->used.soft_shadows, .quality_auto = x->used.quality_auto,
+        .stars_on = e->sky.on, .star_limit_mag = x->stars.limit_mag, .stars_drawn = x->stars.drawn,
+        .stars_hidden = x->stars.hidden,
         .render_ms = (x->t1 - x->t0) * 1e-6,
         .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
         .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
@@ -297,6 +300,8 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         x.used = at.render;
         if (x.rc >= 0)
             x.rc = nc_render_exposure(&e->renderer, &at, &ex, f, &x.ts);
+        if (x.rc >= 0 && e->sky.on) /* stars at the mid-exposure time, through this frame's exposure */
+            x.rc = nc_sky_draw(&e->sky, &e->renderer, &e->cs, &at, j.mid_sim_ns * 1e-9, j.exposure_s, f, &x.stars);
         x.t1 = nc_mono_ns();
         x.lod_error_m = nc_rt_lod_error_m(e->renderer.rt);
         x.boulder_min_m = nc_rt_boulder_min_m(e->renderer.rt);
