@@ -5,9 +5,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "app/cli.h"
+#include "core/clock.h"
 #include "core/error.h"
 #include "render/stars.h"
 
@@ -27,12 +27,7 @@ static const char stars_help[] =
     "\n"
     "Use the index in a scene: stars: {catalogue: INDEX} (docs/stars.md).\n";
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
+static double now_ms(void) { return (double)nc_mono_ns() * 1e-6; }
 
 static int info(const char *path)
 {

@@ -1,6 +1,7 @@
 /* protocol.c - encoding and validating pose protocol messages. */
 #include "navcam/protocol.h"
 
+#include "core/le.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -16,38 +17,6 @@ const char *nc_reject_name(enum nc_reject r)
     default:
         return "accepted";
     }
-}
-
-/* Little-endian scalar access, independent of host order and alignment. */
-static void put_u16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8); }
-static void put_u32(uint8_t *p, uint32_t v)
-{
-    for (int i = 0; i < 4; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-static void put_u64(uint8_t *p, uint64_t v)
-{
-    for (int i = 0; i < 8; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-static uint16_t get_u16(const uint8_t *p) { return (uint16_t)(p[0] | p[1] << 8); }
-static uint32_t get_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-static uint64_t get_u64(const uint8_t *p) { return (uint64_t)get_u32(p) | (uint64_t)get_u32(p + 4) << 32; }
-static void put_f64(uint8_t *p, double v)
-{
-    uint64_t u;
-    memcpy(&u, &v, 8);
-    put_u64(p, u);
-}
-static double get_f64(const uint8_t *p)
-{
-    uint64_t u = get_u64(p);
-    double v;
-    memcpy(&v, &u, 8);
-    return v;
 }
 
 size_t nc_msg_size(enum nc_msg_type type, uint32_t flags)
@@ -75,13 +44,13 @@ size_t nc_msg_size(enum nc_msg_type type, uint32_t flags)
 
 static uint8_t *put_vec(uint8_t *p, struct nc_vec3 v)
 {
-    put_f64(p, v.x), put_f64(p + 8, v.y), put_f64(p + 16, v.z);
+    nc_le_put_f64(p, v.x), nc_le_put_f64(p + 8, v.y), nc_le_put_f64(p + 16, v.z);
     return p + 24;
 }
 
 static uint8_t *put_quat(uint8_t *p, struct nc_quat q)
 {
-    put_f64(p, q.w), put_f64(p + 8, q.x), put_f64(p + 16, q.y), put_f64(p + 24, q.z);
+    nc_le_put_f64(p, q.w), nc_le_put_f64(p + 8, q.x), nc_le_put_f64(p + 16, q.y), nc_le_put_f64(p + 24, q.z);
     return p + 32;
 }
 
@@ -90,15 +59,15 @@ size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap)
     size_t n = nc_msg_size(m->type, m->flags);
     if (n > cap)
         return 0;
-    put_u32(buf, NC_PROTO_MAGIC);
-    put_u16(buf + 4, NC_PROTO_VERSION);
-    put_u16(buf + 6, (uint16_t)m->type);
-    put_u32(buf + 8, (uint32_t)n);
-    put_u32(buf + 12, m->sequence);
-    put_u32(buf + 16, m->flags);
-    put_u32(buf + 20, 0); /* reserved */
+    nc_le_put_u32(buf, NC_PROTO_MAGIC);
+    nc_le_put_u16(buf + 4, NC_PROTO_VERSION);
+    nc_le_put_u16(buf + 6, (uint16_t)m->type);
+    nc_le_put_u32(buf + 8, (uint32_t)n);
+    nc_le_put_u32(buf + 12, m->sequence);
+    nc_le_put_u32(buf + 16, m->flags);
+    nc_le_put_u32(buf + 20, 0); /* reserved */
     uint8_t *p = buf + NC_PROTO_HEADER_BYTES;
-    put_u64(p, (uint64_t)m->sim_time_ns);
+    nc_le_put_u64(p, (uint64_t)m->sim_time_ns);
     p += 8;
     if (m->type == NC_MSG_POSE) {
         p = put_vec(p, m->cam_position_m);
@@ -117,32 +86,32 @@ size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap)
             p = put_vec(p, m->body_angular_velocity_rad_s);
         }
     } else if (m->type == NC_MSG_FRAME) {
-        put_u64(p, m->frame);
-        put_u32(p + 8, m->status);
-        put_u32(p + 12, 0);
+        nc_le_put_u64(p, m->frame);
+        nc_le_put_u32(p + 8, m->status);
+        nc_le_put_u32(p + 12, 0);
         p += 16;
     }
     if (m->flags & NC_MSG_EXPOSURE) {
-        put_f64(p, m->exposure_s);
+        nc_le_put_f64(p, m->exposure_s);
         p += 8;
     }
     if (m->flags & NC_MSG_GAIN) {
-        put_f64(p, m->gain_db);
+        nc_le_put_f64(p, m->gain_db);
         p += 8;
     }
-    put_u32(p, (uint32_t)crc32(0L, buf, (uInt)(p - buf)));
+    nc_le_put_u32(p, (uint32_t)crc32(0L, buf, (uInt)(p - buf)));
     return n;
 }
 
 static const uint8_t *get_vec(const uint8_t *p, struct nc_vec3 *v)
 {
-    *v = nc_v3(get_f64(p), get_f64(p + 8), get_f64(p + 16));
+    *v = nc_v3(nc_le_get_f64(p), nc_le_get_f64(p + 8), nc_le_get_f64(p + 16));
     return p + 24;
 }
 
 static const uint8_t *get_quat(const uint8_t *p, struct nc_quat *q)
 {
-    *q = (struct nc_quat){get_f64(p), get_f64(p + 8), get_f64(p + 16), get_f64(p + 24)};
+    *q = (struct nc_quat){nc_le_get_f64(p), nc_le_get_f64(p + 8), nc_le_get_f64(p + 16), nc_le_get_f64(p + 24)};
     return p + 32;
 }
 
@@ -164,32 +133,32 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
         return NC_REJECT_TRUNCATED;
     if (len > NC_PROTO_MAX_BYTES)
         return NC_REJECT_OVERSIZED;
-    if (get_u32(buf) != NC_PROTO_MAGIC)
+    if (nc_le_get_u32(buf) != NC_PROTO_MAGIC)
         return NC_REJECT_BAD_MAGIC;
-    if (get_u16(buf + 4) != NC_PROTO_VERSION)
+    if (nc_le_get_u16(buf + 4) != NC_PROTO_VERSION)
         return NC_REJECT_BAD_VERSION;
-    uint16_t type = get_u16(buf + 6);
+    uint16_t type = nc_le_get_u16(buf + 6);
     if (type != NC_MSG_POSE && type != NC_MSG_TRIGGER && type != NC_MSG_FRAME)
         return NC_REJECT_BAD_TYPE;
-    uint32_t flags = get_u32(buf + 16);
+    uint32_t flags = nc_le_get_u32(buf + 16);
     if (flags & ~NC_MSG_KNOWN_FLAGS)
         return NC_REJECT_BAD_FLAGS;
     size_t want = nc_msg_size((enum nc_msg_type)type, flags);
-    if (get_u32(buf + 8) != want)
+    if (nc_le_get_u32(buf + 8) != want)
         return NC_REJECT_BAD_LENGTH;
     if (len < want)
         return NC_REJECT_TRUNCATED;
     if (len > want)
         return NC_REJECT_BAD_LENGTH;
-    if (get_u32(buf + want - 4) != (uint32_t)crc32(0L, buf, (uInt)(want - 4)))
+    if (nc_le_get_u32(buf + want - 4) != (uint32_t)crc32(0L, buf, (uInt)(want - 4)))
         return NC_REJECT_BAD_CRC;
 
     memset(m, 0, sizeof *m);
     m->type = (enum nc_msg_type)type;
-    m->sequence = get_u32(buf + 12);
+    m->sequence = nc_le_get_u32(buf + 12);
     m->flags = flags;
     const uint8_t *p = buf + NC_PROTO_HEADER_BYTES;
-    m->sim_time_ns = (int64_t)get_u64(p);
+    m->sim_time_ns = (int64_t)nc_le_get_u64(p);
     p += 8;
     m->cam_attitude_q = m->body_attitude_q = (struct nc_quat){1, 0, 0, 0};
     if (type == NC_MSG_POSE) {
@@ -209,16 +178,16 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
             p = get_vec(p, &m->body_angular_velocity_rad_s);
         }
     } else if (type == NC_MSG_FRAME) {
-        m->frame = get_u64(p);
-        m->status = get_u32(p + 8);
+        m->frame = nc_le_get_u64(p);
+        m->status = nc_le_get_u32(p + 8);
         p += 16;
     }
     if (flags & NC_MSG_EXPOSURE) {
-        m->exposure_s = get_f64(p);
+        m->exposure_s = nc_le_get_f64(p);
         p += 8;
     }
     if (flags & NC_MSG_GAIN) {
-        m->gain_db = get_f64(p);
+        m->gain_db = nc_le_get_f64(p);
         p += 8;
     }
     /* Values: all finite, quaternions unit, the rest in physical range. */

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/le.h"
 #include "render/rt.h"
 #include "render/scene.h"
 
@@ -97,46 +98,6 @@ int nc_star_cat_read_kstars(const char *path, struct nc_star_cat *c)
 #define MAGIC "NCSTARS1"
 #define RECORD 32
 
-static void put64(uint8_t *p, uint64_t v)
-{
-    for (int i = 0; i < 8; i++)
-        p[i] = (uint8_t)(v >> (8 * i));
-}
-static uint64_t get64(const uint8_t *p)
-{
-    uint64_t v = 0;
-    for (int i = 7; i >= 0; i--)
-        v = v << 8 | p[i];
-    return v;
-}
-static void putd(uint8_t *p, double d)
-{
-    uint64_t u;
-    memcpy(&u, &d, 8);
-    put64(p, u);
-}
-static double getd(const uint8_t *p)
-{
-    uint64_t u = get64(p);
-    double d;
-    memcpy(&d, &u, 8);
-    return d;
-}
-static void putf(uint8_t *p, float x)
-{
-    uint32_t u;
-    memcpy(&u, &x, 4);
-    for (int i = 0; i < 4; i++)
-        p[i] = (uint8_t)(u >> (8 * i));
-}
-static float getf(const uint8_t *p)
-{
-    uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-    float x;
-    memcpy(&x, &u, 4);
-    return x;
-}
-
 int nc_star_cat_write(const struct nc_star_cat *c, const char *path)
 {
     size_t size = 24 + c->n * RECORD;
@@ -144,17 +105,17 @@ int nc_star_cat_write(const struct nc_star_cat *c, const char *path)
     if (!b)
         return nc_error(-ENOMEM, "out of memory");
     memcpy(b, MAGIC, 8);
-    put64(b + 8, c->n);
-    putd(b + 16, c->epoch_jyear);
+    nc_le_put_u64(b + 8, c->n);
+    nc_le_put_f64(b + 16, c->epoch_jyear);
     for (size_t i = 0; i < c->n; i++) {
         uint8_t *p = b + 24 + i * RECORD;
         const struct nc_star *s = &c->star[i];
-        putd(p, s->ra_rad);
-        putd(p + 8, s->dec_rad);
-        putf(p + 16, s->pm_ra_mas_yr);
-        putf(p + 20, s->pm_dec_mas_yr);
-        putf(p + 24, s->v_mag);
-        putf(p + 28, s->b_v);
+        nc_le_put_f64(p, s->ra_rad);
+        nc_le_put_f64(p + 8, s->dec_rad);
+        nc_le_put_f32(p + 16, s->pm_ra_mas_yr);
+        nc_le_put_f32(p + 20, s->pm_dec_mas_yr);
+        nc_le_put_f32(p + 24, s->v_mag);
+        nc_le_put_f32(p + 28, s->b_v);
     }
     FILE *f = fopen(path, "wb");
     int ok = f && fwrite(b, 1, size, f) == size;
@@ -173,7 +134,7 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
     int rc = 0;
     if (fread(h, 1, 24, f) != 24 || memcmp(h, MAGIC, 8))
         rc = nc_error(NC_ECONFIG, "%s: not a NavCam star index (write one with `navcam stars`)", path);
-    uint64_t n = rc ? 0 : get64(h + 8);
+    uint64_t n = rc ? 0 : nc_le_get_u64(h + 8);
     if (rc == 0 && (n == 0 || n > 100000000))
         rc = nc_error(NC_ECONFIG, "%s: %llu stars", path, (unsigned long long)n);
     uint8_t *b = rc ? NULL : malloc(n * RECORD);
@@ -185,7 +146,7 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
     for (uint64_t i = 0; rc == 0 && i < n; i++) {
         const uint8_t *p = b + i * RECORD;
         struct nc_star *s = &c->star[i];
-        *s = (struct nc_star){getd(p), getd(p + 8), getf(p + 16), getf(p + 20), getf(p + 24), getf(p + 28)};
+        *s = (struct nc_star){nc_le_get_f64(p), nc_le_get_f64(p + 8), nc_le_get_f32(p + 16), nc_le_get_f32(p + 20), nc_le_get_f32(p + 24), nc_le_get_f32(p + 28)};
         if (!(fabs(s->dec_rad) <= M_PI / 2 && isfinite(s->ra_rad) && isfinite(s->v_mag) && isfinite(s->b_v) &&
               isfinite(s->pm_ra_mas_yr) && isfinite(s->pm_dec_mas_yr)) ||
             (i && s->v_mag < c->star[i - 1].v_mag))
@@ -194,7 +155,7 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
     }
     free(b);
     c->n = (size_t)n;
-    c->epoch_jyear = rc ? 0 : getd(h + 16);
+    c->epoch_jyear = rc ? 0 : nc_le_get_f64(h + 16);
     if (rc < 0)
         nc_star_cat_free(c);
     return rc;

@@ -4,15 +4,7 @@
 #include <string.h>
 #include <zlib.h>
 
-static void put_u16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8); }
-static void put_u32(uint8_t *p, uint32_t v) { put_u16(p, (uint16_t)v), put_u16(p + 2, (uint16_t)(v >> 16)); }
-static void put_u64(uint8_t *p, uint64_t v) { put_u32(p, (uint32_t)v), put_u32(p + 4, (uint32_t)(v >> 32)); }
-static void put_f64(uint8_t *p, double d)
-{
-    uint64_t u;
-    memcpy(&u, &d, sizeof u);
-    put_u64(p, u);
-}
+#include "core/le.h"
 
 /* The metadata block (docs/gige.md gives the layout), little-endian: a
  * 48-byte core with its own CRC (fits a Mono8 row of 48 pixels), then the
@@ -21,27 +13,27 @@ void nc__gige_metadata(const struct nc_frame_record *r, uint8_t m[NC_GIGE_META_B
 {
     memset(m, 0, NC_GIGE_META_BYTES);
     memcpy(m, "NCMD", 4);
-    put_u16(m + 4, 1);
-    put_u16(m + 6, NC_GIGE_META_BYTES);
-    put_u64(m + 8, r->frame);
-    put_u64(m + 16, (uint64_t)r->exposure_start_sim_ns);
-    put_f64(m + 24, r->exposure_s);
-    put_f64(m + 32, r->gain_db);
-    put_u32(m + 40, r->request_sequence);
-    put_u32(m + 44, (uint32_t)crc32(0L, m, 44));
-    put_u64(m + 48, (uint64_t)r->trigger_sim_ns);
-    put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
-    put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
+    nc_le_put_u16(m + 4, 1);
+    nc_le_put_u16(m + 6, NC_GIGE_META_BYTES);
+    nc_le_put_u64(m + 8, r->frame);
+    nc_le_put_u64(m + 16, (uint64_t)r->exposure_start_sim_ns);
+    nc_le_put_f64(m + 24, r->exposure_s);
+    nc_le_put_f64(m + 32, r->gain_db);
+    nc_le_put_u32(m + 40, r->request_sequence);
+    nc_le_put_u32(m + 44, (uint32_t)crc32(0L, m, 44));
+    nc_le_put_u64(m + 48, (uint64_t)r->trigger_sim_ns);
+    nc_le_put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
+    nc_le_put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
     const struct nc_pose *p = &r->pose;
     const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
                           p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, p->sun.x,
                           p->sun.y,            p->sun.z};
     for (int i = 0; i < 10; i++)
-        put_f64(m + 72 + 8 * i, v[i]);
+        nc_le_put_f64(m + 72 + 8 * i, v[i]);
     m[152] = (uint8_t)p->sun_is_position;
     m[153] = (uint8_t)r->pose_quality;
-    put_u16(m + 154, (uint16_t)r->adc_bits);
-    put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
+    nc_le_put_u16(m + 154, (uint16_t)r->adc_bits);
+    nc_le_put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
 }
 
 /* A DN as the pixel format stores it: (dn << left) >> right. */
@@ -63,7 +55,7 @@ static void row16(const uint16_t *restrict src, int n, int left, int right, uint
 #if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
         memcpy(o + 2 * x, &v, 2); /* one vectorised store */
 #else
-        put_u16(o + 2 * x, v);
+        nc_le_put_u16(o + 2 * x, v);
 #endif
     }
 }
