@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -59,8 +60,11 @@ int nc_sky_from_config(struct nc_cfg_node *root, struct nc_sky *sky)
         return rc;
     if (!(nc_v3_norm(sky->observer_velocity_m_s) < 0.01 * 299792458.0))
         return nc_cfg_error(nc_cfg_get(m, "observer_velocity_m_s"), "expected a speed below 1 %% of light's");
-    if ((rc = nc_star_cat_load(sky->path, &sky->cat)) < 0)
-        return nc_cfg_error(cat, "%s", nc_errmsg());
+    if ((rc = nc_star_cat_load(sky->path, &sky->cat)) < 0) {
+        char why[512];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_cfg_error(cat, "%s", why);
+    }
     sky->on = 1;
     return 0;
 }

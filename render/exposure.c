@@ -68,6 +68,8 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
     int strata = (int)lround(sqrt((double)s->render.samples_per_pixel)), S = strata > 1 ? strata * strata : 1;
     /* at most 0.5 px of motion between time samples */
     int K = fold_time_samples(motion > 0 ? (int)fmin(maxk, ceil(motion / 0.5)) : 1, S);
+    if (K > maxk && K > S) /* rounded up past the cap: the largest multiple of S within it */
+        K = S * (maxk / S > 1 ? maxk / S : 1);
     if (time_samples)
         *time_samples = K;
     if (K == 1 && !ex->rolling)

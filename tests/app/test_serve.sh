@@ -161,11 +161,12 @@ for d, mode in zip(sys.argv[1:], ["freerun", "trigger"]):
     assert s["dropped"]["overrun"] > 0 and s["frames_delivered"] >= 3 and s["dropped"]["queue_full"] == 0, s
     assert asked == made, (asked, made)
     # No backlog: a frame whose render could not start within one period
-    # (5 ms free-run; the time since the trigger before, 10 ms and its
-    # jitter, in trigger mode) after its exposure ended is an overrun, so
-    # waiting never exceeds it. A queue would add whole renders.
+    # after its exposure ended is an overrun, so waiting never exceeds it.
+    # The period is the time since the tick or trigger before: 5 or 10 ms,
+    # twice that after one a loaded machine's timer thread missed, plus
+    # jitter. A queue would add whole renders (over 100 ms here).
     ahead = 5 if mode == "freerun" else 10
-    slack = ahead + (0.5 if mode == "freerun" else 3)
+    slack = 2 * ahead + 2
     assert wait <= slack, (wait, slack, ren, spread)
     assert lat <= ren + slack + 5, (lat, ren, slack)
     assert 0 < s["resulting_frame_rate_hz"] < 100
