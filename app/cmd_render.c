@@ -242,6 +242,14 @@ int main(int argc, char **argv)
     if (rc >= 0 && sky.on && (rc = nc_sky_draw(&sky, &r, &cs, &drawn, 0, exposure, &f, &sst)) >= 0)
         snprintf(starinfo, sizeof starinfo, "limit_mag=%.2f drawn=%ld hidden=%ld", sst.limit_mag, sst.drawn,
                  sst.hidden);
+    /* The Sun: drawn when its disk reaches the frame; a warning in or near it. */
+    struct nc_sun_view sv = {0};
+    char sunwarn[80] = "", suninfo[200] = "";
+    if (rc >= 0 && (rc = nc_render_sun(&r, &drawn, NC_SUN_NEAR_DEG, &f, &sv)) >= 0) {
+        nc_sun_view_warning(&sv, sunwarn, sizeof sunwarn);
+        snprintf(suninfo, sizeof suninfo, "off_axis_deg=%.4f edge_deg=%.4f in_field=%d hidden=%d%s%s", sv.off_axis_deg,
+                 sv.edge_deg, sv.in_field, sv.hidden, sunwarn[0] ? " warning=" : "", sunwarn);
+    }
     double t2 = now_ms(), scale = 0;
     /* Levels of detail and the smallest boulder traced (0: every rock). */
     char lod[40], rocks[40];
@@ -259,8 +267,10 @@ int main(int argc, char **argv)
         if (r.fold_theta_bar_deg[i] >= 0)
             o += snprintf(fold + o, sizeof fold - (size_t)o, "%s%s=%.6g", o ? "," : "", scene.body[i].name,
                           r.fold_theta_bar_deg[i]);
-    struct nc_image_attr extra[6] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}, {0}, {0}};
+    struct nc_image_attr extra[7] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}, {0}, {0}, {0}};
     int nextra = 2;
+    if (suninfo[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:sun_view", suninfo};
     if (starinfo[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:stars", starinfo};
     if (normals[0])
@@ -280,6 +290,8 @@ int main(int argc, char **argv)
                tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
         if (chosen[0])
             printf("  render.quality auto: %s\n", chosen);
+        if (sunwarn[0])
+            printf("  WARNING: %s (its centre %.2f deg off axis)\n", sunwarn, sv.off_axis_deg);
         if (sky.on)
             printf("  stars: to V %.2f, %ld in the frame, %ld hidden by bodies (%.1f ms)\n", sst.limit_mag, sst.drawn,
                    sst.hidden, t2 - ts0);

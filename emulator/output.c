@@ -71,10 +71,17 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
                  (long long)r->trigger_mono_ns, (long long)r->exposure_start_mono_ns, (long long)r->exposure_end_mono_ns);
         snprintf(ms, sizeof ms, "\"render_ms\": %.3f, \"camera_ms\": %.3f, ", r->render_ms, r->camera_ms);
     }
-    char stars[120] = "";
+    char stars[320] = "";
     if (r->stars_on)
         snprintf(stars, sizeof stars, "\"stars\": {\"limit_mag\": %.4g, \"drawn\": %ld, \"hidden\": %ld}, ",
                  r->star_limit_mag, r->stars_drawn, r->stars_hidden);
+    if (r->sun_in_field || r->sun_near_field) { /* the Sun in or near the field: a warning */
+        size_t k = strlen(stars);
+        snprintf(stars + k, sizeof stars - k,
+                 "\"sun\": {\"warning\": \"%s\", \"off_axis_deg\": %.6g, \"edge_deg\": %.6g, \"hidden\": %s}, ",
+                 r->sun_in_field ? "sun in field" : "sun near field", r->sun_off_axis_deg, r->sun_edge_deg,
+                 r->sun_hidden ? "true" : "false");
+    }
     int n = snprintf(
         buf, len,
         "{\"frame\": %llu, \"request_sequence\": %u, \"trigger_source\": \"%s\", "

@@ -35,6 +35,8 @@ struct nc_frame_record {
     int stars_on;                   /* the scene has a `stars` section: */
     double star_limit_mag;          /* the limiting magnitude used */
     long stars_drawn, stars_hidden; /* stars in the frame, and hidden by bodies */
+    double sun_off_axis_deg, sun_edge_deg; /* the Sun from the boresight, and from the frame's edge (< 0: in it) */
+    int sun_in_field, sun_near_field, sun_hidden;
     double render_ms, camera_ms; /* render (incl. smear) and camera model time */
     int width_px, height_px, adc_bits;
     const uint16_t *dn;          /* the digitised frame */

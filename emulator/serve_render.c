@@ -138,6 +138,7 @@ struct staged {
     int rc, ts, buf;
     double lod_error_m, boulder_min_m, rock_fold_theta_bar_deg;
     struct nc_sky_stats stars;
+    struct nc_sun_view sun;
     struct nc_render_settings used; /* render.quality: auto's choice, or the scene's */
 };
 
@@ -203,7 +204,8 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .samples_per_pixel = x->used.samples_per_pixel,
         .bounces = x->used.bounces, .soft_shadows = x->used.soft_shadows, .quality_auto = x->used.quality_auto,
         .stars_on = e->sky.on, .star_limit_mag = x->stars.limit_mag, .stars_drawn = x->stars.drawn,
-        .stars_hidden = x->stars.hidden,
+        .stars_hidden = x->stars.hidden, .sun_off_axis_deg = x->sun.off_axis_deg, .sun_edge_deg = x->sun.edge_deg,
+        .sun_in_field = x->sun.in_field, .sun_near_field = x->sun.near_field, .sun_hidden = x->sun.hidden,
         .render_ms = (x->t1 - x->t0) * 1e-6,
         .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
         .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
@@ -302,6 +304,8 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
             x.rc = nc_render_exposure(&e->renderer, &at, &ex, f, &x.ts);
         if (x.rc >= 0 && e->sky.on) /* stars at the mid-exposure time, through this frame's exposure */
             x.rc = nc_sky_draw(&e->sky, &e->renderer, &e->cs, &at, j.mid_sim_ns * 1e-9, j.exposure_s, f, &x.stars);
+        if (x.rc >= 0) /* the Sun drawn if its disk reaches the frame; in the record if in or near it */
+            x.rc = nc_render_sun(&e->renderer, &at, NC_SUN_NEAR_DEG, f, &x.sun);
         x.t1 = nc_mono_ns();
         x.lod_error_m = nc_rt_lod_error_m(e->renderer.rt);
         x.boulder_min_m = nc_rt_boulder_min_m(e->renderer.rt);

@@ -59,6 +59,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:normals", "NORMALS"},
     {"navcam:rock_fold_theta_bar_deg", "ROCKFOLD"},
     {"navcam:stars", "STARS"},
+    {"navcam:sun_view", "SUNVIEW"},
 };
 
 /* 1 when attrs ask for the archive row order (row 1 at the bottom). */

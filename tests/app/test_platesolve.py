@@ -102,7 +102,7 @@ failed = 0
 for fov, ra, dec, roll, t in cases:
     f_m = W * PITCH / (2 * math.tan(math.radians(fov) / 2))
     m, q = attitude(ra, dec, roll)
-    behind = [-1e7 * c for c in unit(math.radians(ra), math.radians(dec))]
+    behind = [-1e7 * c for c in unit(math.radians(ra), math.radians(dec))]  # the body, and the Sun's side
     name = f"fov{fov:g}"
     scene = os.path.join(tmp, name + ".yaml")
     with open(scene, "w") as fh:
@@ -112,7 +112,7 @@ bodies:
     shape: {{type: sphere, radius_m: 1000}}
     position_m: [{behind[0]!r}, {behind[1]!r}, {behind[2]!r}]
     material: {{model: lambert, A: 0.1}}
-sun: {{direction: [1, 0, 0]}}
+sun: {{direction: [{behind[0] / 1e7!r}, {behind[1] / 1e7!r}, {behind[2] / 1e7!r}]}}  # behind the camera
 camera: {{width_px: {W}, height_px: {H}, focal_length_m: {f_m!r}, pixel_pitch_m: {PITCH},
          position_m: [0, 0, 0], attitude_q: [{q[0]!r}, {q[1]!r}, {q[2]!r}, {q[3]!r}]}}
 render: {{samples_per_pixel: 1}}

@@ -7,7 +7,9 @@
  *     (Simpson's rule over the 500-700 nm band); V + 5 gives 1/100;
  *  4. the aberration of a 30 km/s observer moves the star's centroid by
  *     atan(beta gamma) = 20.64 arcsec in the rendered frame;
- *  5. a body in front hides the star; 1 and 2 threads give the same frame. */
+ *  5. a body in front hides the star; 1 and 2 threads give the same frame;
+ *  6. the Sun: its disk drawn in the field carries its whole irradiance, a
+ *     body in front hides it, and the warnings say in or near the field. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -205,5 +207,52 @@ int main(void)
     CHECK(!memcmp(e1, e4, sizeof(float) * 96 * 96), "1 and 2 threads: the same frame");
     free(e1);
     free(e4);
+
+    /* 6. The Sun, 1 deg off the boresight of a 3.7 deg field (its disk
+     * about 9 px in radius), then 5 and 30 deg off, then behind a body. */
+    const double offs[] = {1, 5, 30, 1};
+    for (int k = 0; k < 4; k++) {
+        char sunset[160], rockset[160];
+        double o = offs[k] * M_PI / 180;
+        snprintf(sunset, sizeof sunset, "sun.direction=[%.17g, 0, %.17g]", sin(o), cos(o));
+        snprintf(rockset, sizeof rockset, "bodies.0.position_m=[%.17g, 0, %.17g]", k == 3 ? 1e4 * sin(o) : 0.0,
+                 k == 3 ? 1e4 * cos(o) : -1e4);
+        const char *sets[] = {sunset, rockset};
+        struct nc_scene sc;
+        nc_test_scene("bodies:\n  - shape: {type: sphere, radius_m: 200}\n    material: {model: lambert, A: 0.1}\n"
+                      "sun: {direction: [0, 0, 1]}\n"
+                      "camera: {width_px: 128, height_px: 128, fx_px: 2000, fy_px: 2000, position_m: [0, 0, 0],\n"
+                      "         attitude_q: [1, 0, 0, 0]}\n",
+                      sets, 2, &sc);
+        struct nc_renderer rs;
+        struct nc_frame fs;
+        struct nc_sun_view sv;
+        char warn[80];
+        nc_renderer_init(&rs, &sc, 2);
+        nc_frame_alloc(&fs, 128, 128);
+        CHECK(nc_render_sun(&rs, &sc, NC_SUN_NEAR_DEG, &fs, &sv) == 0, "sun: %s", nc_errmsg());
+        nc_sun_view_warning(&sv, warn, sizeof warn);
+        struct nc_vec3 sd;
+        double irr;
+        nc_scene_sun_at(&sc, sc.camera.position_m, &sd, &irr);
+        printf("sun %g deg off axis: edge %.3f deg, in field %d, hidden %d, drawn %.6g of its irradiance, "
+               "warning '%s'\n",
+               offs[k], sv.edge_deg, sv.in_field, sv.hidden, sv.drawn_w_m2 / irr, warn);
+        if (k == 0)
+            CHECK(sv.in_field && !sv.hidden && fabs(sv.drawn_w_m2 / irr - 1) < 0.005 && !strcmp(warn, "sun in field"),
+                  "the Sun in the field: drawn %.5f of its irradiance", sv.drawn_w_m2 / irr);
+        if (k == 1) /* the edge 64 px from the centre (1.833 deg), the Sun's radius 0.267 deg */
+            CHECK(!sv.in_field && sv.near_field && fabs(sv.edge_deg - (5 - atan(64.0 / 2000) * 180 / M_PI - 0.2666)) < 0.01 &&
+                      sv.drawn_w_m2 == 0 && nc_test_contains(warn, "deg from the field"),
+                  "the Sun near the field: edge %.4f deg", sv.edge_deg);
+        if (k == 2)
+            CHECK(!sv.in_field && !sv.near_field && !warn[0], "the Sun far from the field");
+        if (k == 3)
+            CHECK(sv.in_field && sv.hidden && sv.drawn_w_m2 == 0 && !strcmp(warn, "sun in field, hidden by a body"),
+                  "the Sun behind a body");
+        nc_frame_free(&fs);
+        nc_renderer_free(&rs);
+        nc_scene_free(&sc);
+    }
     return nc_test_end();
 }
