@@ -161,7 +161,7 @@ int nc_sky_draw(struct nc_sky *sky, struct nc_renderer *r, const struct nc_camsy
             continue;
         sky->pts[m++] = (struct nc_point_source){nc_aberrate(sky->dir[i], v), sky->e_w_m2[i]};
     }
-    long hidden = 0, drawn = nc_render_points(r, s, exposure_s, sky->pts, m, f, &hidden);
+    long hidden = 0, drawn = nc_render_points(r, s, exposure_s, sky->pts, m, 1, f, &hidden);
     if (drawn < 0)
         return (int)drawn;
     st->considered = (long)m;

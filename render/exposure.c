@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "render/render.h"
+#include "render/stars.h"
 
 double nc_render_motion_px(const struct nc_scene *s, double T)
 {
@@ -59,21 +60,11 @@ static int fold_time_samples(int k0, int S)
     return S * ((k0 + S - 1) / S);
 }
 
-int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex,
-                       struct nc_frame *f, int *time_samples)
+/* The exposure's K time samples (K > 1 or a rolling shutter), S strata. */
+static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex, int K,
+                             int S, struct nc_frame *f)
 {
     const double T = ex->exposure_s;
-    const int maxk = ex->max_time_samples > 0 ? ex->max_time_samples : 256;
-    double motion = nc_render_motion_px(s, T);
-    int strata = (int)lround(sqrt((double)s->render.samples_per_pixel)), S = strata > 1 ? strata * strata : 1;
-    /* at most 0.5 px of motion between time samples */
-    int K = fold_time_samples(motion > 0 ? (int)fmin(maxk, ceil(motion / 0.5)) : 1, S);
-    if (K > maxk && K > S) /* rounded up past the cap: the largest multiple of S within it */
-        K = S * (maxk / S > 1 ? maxk / S : 1);
-    if (time_samples)
-        *time_samples = K;
-    if (K == 1 && !ex->rolling)
-        return nc_render_frame(r, s, f);
     const int W = f->width_px, H = f->height_px, bands = nc_render_tile_rows(s);
     const size_t n = (size_t)W * (size_t)H;
     struct nc_frame sub;
@@ -127,3 +118,31 @@ out:
     free(a.cov);
     return rc;
 }
+
+int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex,
+                       struct nc_frame *f, int *time_samples)
+{
+    const double T = ex->exposure_s;
+    const int maxk = ex->max_time_samples > 0 ? ex->max_time_samples : 256;
+    double motion = nc_render_motion_px(s, T);
+    int strata = (int)lround(sqrt((double)s->render.samples_per_pixel)), S = strata > 1 ? strata * strata : 1;
+    /* at most 0.5 px of motion between time samples */
+    int K = fold_time_samples(motion > 0 ? (int)fmin(maxk, ceil(motion / 0.5)) : 1, S);
+    if (K > maxk && K > S) /* rounded up past the cap: the largest multiple of S within it */
+        K = S * (maxk / S > 1 ? maxk / S : 1);
+    if (time_samples)
+        *time_samples = K;
+    /* Bodies smaller than a pixel: their light as points (render/stars.h),
+     * measured at mid-exposure; their ray hits give none meanwhile. */
+    struct nc_point_source pts[NC_MAX_BODIES];
+    int np = nc_render_point_bodies(r, s, pts), rc = np;
+    if (rc >= 0)
+        rc = K == 1 && !ex->rolling ? nc_render_frame(r, s, f) : time_samples_into(r, s, ex, K, S, f);
+    if (rc >= 0 && np > 0) { /* anything in front of them is in their own renders: no occlusion rays */
+        long hidden, drawn = nc_render_points(r, s, T, pts, (size_t)np, 0, f, &hidden);
+        rc = drawn < 0 ? (int)drawn : 0;
+    }
+    memset(r->as_point, 0, sizeof r->as_point);
+    return rc;
+}
+

@@ -545,6 +545,8 @@ static void shade_tile(struct job *j, int tile)
                     indirect16(j, &sf, x0 + bx, y0 + by, sidx, L, iof, &cnt);
                 for (int i = 0; i < NC_PACKET; i++) {
                     int o = (by + (i >> 2)) * TILE + bx + (i & 3);
+                    if (sf.body[i] >= 0 && j->r->as_point[sf.body[i]])
+                        L[i] = iof[i] = 0; /* its light comes as a point (nc_render_exposure) */
                     acc_L[o] += L[i];
                     acc_iof[o] += iof[i];
                 }

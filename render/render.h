@@ -50,6 +50,10 @@ struct nc_renderer {
      * material was rendered with after folding in the rocks not traced, or
      * -1 where nothing was folded (scene.h, render.boulder_fold). */
     double fold_theta_bar_deg[NC_MAX_BODIES];
+    /* Bodies nc_render_exposure draws as point sources (smaller than a
+     * pixel): their ray hits hide what is behind them but give no light;
+     * their light is added as a point (render/stars.h). 0 outside it. */
+    unsigned char as_point[NC_MAX_BODIES];
 };
 
 int nc_frame_alloc(struct nc_frame *f, int width_px, int height_px);

@@ -225,7 +225,7 @@ static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double
 }
 
 long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s,
-                      const struct nc_point_source *p, size_t n, struct nc_frame *f, long *hidden)
+                      const struct nc_point_source *p, size_t n, int occlusion, struct nc_frame *f, long *hidden)
 {
     const struct nc_camera *c = &s->camera;
     *hidden = 0;
@@ -268,7 +268,8 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
             ray.dz[l] = (float)d.z;
             ray.tfar[l] = INFINITY;
         }
-        nc_rt_occluded16(r->rt, &ray, occ);
+        if (occlusion)
+            nc_rt_occluded16(r->rt, &ray, occ);
         for (int l = 0; l < NC_PACKET && i0 + (size_t)l < m; l++) {
             const struct nc_point_source *q = &p[in[i0 + (size_t)l]];
             if (occ[l]) {
@@ -400,4 +401,52 @@ void nc_sun_view_warning(const struct nc_sun_view *v, char *buf, size_t len)
         snprintf(buf, len, "sun %.1f deg from the field", v->edge_deg);
     else if (len)
         buf[0] = 0;
+}
+
+/* ---- bodies smaller than a pixel ---------------------------------------------- */
+
+int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, struct nc_point_source *p)
+{
+    const struct nc_camera *c = &s->camera;
+    unsigned char point[NC_MAX_BODIES] = {0};
+    int n = 0;
+    memset(r->as_point, 0, sizeof r->as_point);
+    for (int b = 0; b < s->nbodies; b++) {
+        const struct nc_vec3 rel = nc_v3_sub(s->body[b].position_m, c->position_m);
+        const double d = nc_v3_norm(rel), R = s->body[b].bounding_radius_m;
+        if (!(d > R) || 2 * asin(R / d) * fmax(c->fx_px, c->fy_px) >= 1.0)
+            continue;
+        enum { Z = 32 };
+        struct nc_scene z = *s; /* shallow: shares meshes and materials */
+        const double F = 12.0 / tan(asin(R / d)); /* the bounding sphere 24 px across */
+        z.camera = (struct nc_camera){.width_px = Z, .height_px = Z, .fx_px = F, .fy_px = F, .cx_px = 0.5 * (Z - 1),
+                                      .cy_px = 0.5 * (Z - 1), .position_m = c->position_m};
+        const struct nc_vec3 dir = nc_v3_scale(rel, 1 / d);
+        const struct nc_vec3 up = fabs(dir.z) < 0.9 ? nc_v3(0, 0, 1) : nc_v3(1, 0, 0);
+        nc_quat_look_at(c->position_m, s->body[b].position_m, up, &z.camera.attitude_q);
+        z.render.samples_per_pixel = 16;
+        z.render.quality_auto = 0;
+        struct nc_frame zf;
+        int rc = nc_frame_alloc(&zf, Z, Z);
+        if (rc >= 0)
+            rc = nc_render_frame(r, &z, &zf);
+        if (rc < 0) {
+            nc_frame_free(&zf);
+            return rc;
+        }
+        double e = 0;
+        struct nc_vec3 m = nc_v3(0, 0, 0);
+        for (int y = 0; y < Z; y++)
+            for (int x = 0; x < Z; x++) {
+                const struct nc_vec3 q = nc_camera_dir(&z.camera, x, y);
+                const double w = zf.radiance[y * Z + x] * pow(nc_v3_norm(q), -3.0) / (F * F); /* L Omega */
+                e += w;
+                m = nc_v3_add(m, nc_v3_scale(nc_quat_rotate(z.camera.attitude_q, nc_v3_unit(q)), w));
+            }
+        nc_frame_free(&zf);
+        p[n++] = (struct nc_point_source){e > 0 ? nc_v3_unit(m) : dir, e};
+        point[b] = 1;
+    }
+    memcpy(r->as_point, point, sizeof point);
+    return n;
 }

@@ -60,11 +60,22 @@ struct nc_point_source {
  * irradiance spread bilinearly over the four pixels around that point (so
  * the centroid keeps the sub-pixel position) as radiance E / Omega_pixel;
  * over the exposure (exposure_s, the camera's rates) it moves as the camera
- * turns, in steps of at most 0.1 px. A body in front hides it (traced with
- * r's ray tracer at the scene's poses). Returns how many were drawn (in the
+ * turns, in steps of at most 0.1 px. With occlusion, a body in front hides
+ * it (traced with r's ray tracer at the scene's poses). Returns how many were drawn (in the
  * frame and not hidden), or < 0 on error; *hidden counts the hidden ones. */
 long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s,
-                      const struct nc_point_source *p, size_t n, struct nc_frame *f, long *hidden);
+                      const struct nc_point_source *p, size_t n, int occlusion, struct nc_frame *f, long *hidden);
+
+/* The scene's bodies that are smaller than a pixel from its camera (their
+ * bounding sphere's angular diameter under one pixel): each one's light as
+ * a point source, its irradiance at the aperture and its brightness
+ * centroid, from a 32 x 32 render (16 samples a pixel) of the scene zoomed
+ * onto it from the same place (so its phase, shadows and anything in front
+ * are as the camera sees them). Sets r->as_point for them; returns how many
+ * were written to p (NC_MAX_BODIES at most), or < 0 on error. A ray-traced
+ * sub-pixel body is hit by few samples or none: as a point its light is
+ * all there, where it is. */
+int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, struct nc_point_source *p);
 
 /* Where the Sun is for the camera, and what of it the frame shows. "Near"
  * the field: within NC_SUN_NEAR_DEG of its edge (stray light in a real

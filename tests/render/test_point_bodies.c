@@ -1,0 +1,81 @@
+/* test_point_bodies.c - a body smaller than a pixel is drawn as a point
+ * source (render/stars.h, nc_render_point_bodies): a Lambert sphere 0.4 px
+ * across at zero phase gives the frame exactly its analytic irradiance
+ * p J (R/D)^2 (p = 2A/3), at one sample a pixel as at sixteen, with its
+ * centroid where it projects; a sphere in front hides it; a resolved body
+ * is rendered as before. (A second body, off the Sun's line, is the
+ * screen that hides it in one case.) */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "render/stars.h"
+#include "testutil.h"
+
+static const char yaml[] = "bodies:\n"
+                           "  - name: moon\n"
+                           "    shape: {type: sphere, radius_m: 2}\n"
+                           "    position_m: [3.3, -1.7, 10000]\n"
+                           "    material: {model: lambert, A: 1}\n"
+                           "  - name: screen\n"
+                           "    shape: {type: sphere, radius_m: 50}\n"
+                           "    position_m: [0, 5000, -20000]\n"
+                           "    material: {model: lambert, A: 1}\n"
+                           "sun: {direction: [0, 0, -1]}\n"
+                           "camera: {width_px: 64, height_px: 48, fx_px: 1000, fy_px: 1000,\n"
+                           "         position_m: [0, 0, 0], attitude_q: [1, 0, 0, 0]}\n";
+
+static void shoot(const char *const *sets, int nsets, double *sum, double *cx, double *cy)
+{
+    struct nc_scene s;
+    nc_test_scene(yaml, sets, nsets, &s);
+    struct nc_renderer r;
+    struct nc_frame f;
+    struct nc_exposure ex = {.exposure_s = 0.01};
+    nc_renderer_init(&r, &s, 2);
+    nc_frame_alloc(&f, 64, 48);
+    CHECK(nc_render_exposure(&r, &s, &ex, &f, NULL) == 0, "render");
+    double m = 0, mx = 0, my = 0;
+    for (int y = 0; y < 48; y++)
+        for (int x = 0; x < 64; x++) {
+            double v = f.radiance[y * 64 + x];
+            m += v, mx += x * v, my += y * v;
+        }
+    *sum = m;
+    *cx = m > 0 ? mx / m : NAN;
+    *cy = m > 0 ? my / m : NAN;
+    nc_frame_free(&f);
+    nc_renderer_free(&r);
+    nc_scene_free(&s);
+}
+
+int main(void)
+{
+    struct nc_scene s;
+    nc_test_scene(yaml, NULL, 0, &s);
+    /* sum of radiance = irradiance * fx * fy (each pixel 1 / (fx fy) sr on axis) */
+    const double D = sqrt(3.3 * 3.3 + 1.7 * 1.7 + 1e8), want = 2.0 / 3.0 * s.sun.irradiance_w_m2 * pow(2 / D, 2) * 1e6;
+    const double px = 31.5 + 1000 * 3.3 / 10000, py = 23.5 - 1000 * 1.7 / 10000;
+    nc_scene_free(&s);
+    const char *spp1[] = {"render.samples_per_pixel=1"}, *spp16[] = {"render.samples_per_pixel=16"};
+    const char *front[] = {"bodies.1.position_m=[0.33, -0.17, 1000]", "bodies.1.material={model: lambert, A: 0}"};
+    double sum, cx, cy;
+    shoot(spp1, 1, &sum, &cx, &cy);
+    printf("a 0.4 px Lambert sphere, 1 sample a pixel: %.6f of p J (R/D)^2, centroid (%.4f, %.4f) vs (%.4f, %.4f)\n",
+           sum / want, cx, cy, px, py);
+    CHECK(fabs(sum / want - 1) < 0.005, "1 spp: %.5f of the analytic flux", sum / want);
+    CHECK(fabs(cx - px) < 0.01 && fabs(cy - py) < 0.01, "centroid (%.4f, %.4f)", cx, cy);
+    double sum16;
+    shoot(spp16, 1, &sum16, &cx, &cy);
+    printf("16 samples a pixel: %.6f; the same light as at 1 (%.2e apart)\n", sum16 / want, fabs(sum16 / sum - 1));
+    CHECK(fabs(sum16 / sum - 1) < 1e-6, "1 and 16 samples a pixel: %.6f vs %.6f", sum / want, sum16 / want);
+    shoot(front, 2, &sum, &cx, &cy);
+    printf("behind a black sphere: %.3g of the flux\n", sum / want);
+    CHECK(sum < 1e-9 * want, "a body in front hides it: %.3g", sum / want);
+    /* Resolved (4 px across): rendered as before, by rays. */
+    const char *big[] = {"bodies.0.shape={type: sphere, radius_m: 20}", "render.samples_per_pixel=64"};
+    shoot(big, 2, &sum, &cx, &cy);
+    printf("4 px across, by rays at 64 samples: %.5f of p J (R/D)^2\n", sum / (want * 100));
+    CHECK(fabs(sum / (want * 100) - 1) < 0.01, "resolved: %.5f", sum / (want * 100));
+    return nc_test_end();
+}
