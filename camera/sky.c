@@ -87,6 +87,9 @@ int nc_sky_prepare(struct nc_sky *sky, const struct nc_camsys *cs, const struct 
     if (!o->star_band)
         return nc_error(NC_ECONFIG, "stars: the camera's passband needs its shape (optics.passband {from_m, to_m} "
                                     "or optics.passband_table), not only band_fraction and wavelength_m");
+    if (!(cs->sensor.pixel_pitch_m > 0 && geom->fx_px > 0))
+        return nc_error(NC_ECONFIG, "stars: their light needs the aperture's area: give camera.focal_length_m with "
+                                    "camera.pixel_pitch_m (or sensor.pixel_pitch_m) and optics.f_number");
     const size_t n = sky->cat.n;
     free(sky->e_w_m2);
     free(sky->e_per_s);
