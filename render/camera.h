@@ -9,6 +9,8 @@
 #ifndef NC_CAMERA_H
 #define NC_CAMERA_H
 
+#include <math.h>
+
 #include "core/config.h"
 #include "core/vec.h"
 
@@ -34,6 +36,14 @@ struct nc_camera {
 static inline struct nc_vec3 nc_camera_dir(const struct nc_camera *c, double x, double y)
 {
     return nc_v3((x - c->cx_px) / c->fx_px, (y - c->cy_px) / c->fy_px, 1.0);
+}
+
+/* The solid angle (sr) of the pinhole pixel that looks along camera-frame
+ * direction dir (nc_camera_dir) for focal lengths fx, fy (px): cos^3 of its
+ * field angle over fx fy. */
+static inline double nc_camera_pixel_sr(double fx_px, double fy_px, struct nc_vec3 dir)
+{
+    return pow(nc_v3_norm(dir) / dir.z, -3.0) / (fx_px * fy_px);
 }
 
 /* The ray (camera frame, unnormalised, z = 1) that the lens images onto

@@ -210,8 +210,7 @@ static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double
     const int W = f->width_px, H = f->height_px;
     const int x0 = (int)floor(x), y0 = (int)floor(y);
     const double ax = x - x0, ay = y - y0;
-    const struct nc_vec3 d = nc_camera_dir(c, x, y);
-    const double cos3 = pow(nc_v3_norm(d), -3.0), omega = cos3 / (c->fx_px * c->fy_px); /* sr per pixel there */
+    const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_dir(c, x, y));
     const double L = e / omega, w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
     int in = 0;
     for (int k = 0; k < 4; k++) {
@@ -385,7 +384,7 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
                 continue;
             lit += open;
             const double cov = (double)open / (SUB * SUB);
-            const double omega = pow(nc_v3_norm(nc_camera_dir(c, x, y)), -3.0) / (c->fx_px * c->fy_px);
+            const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_dir(c, x, y));
             f->radiance[(size_t)y * f->width_px + x] += (float)(L * cov);
             v->drawn_w_m2 += L * cov * omega;
         }
@@ -439,7 +438,7 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
         for (int y = 0; y < Z; y++)
             for (int x = 0; x < Z; x++) {
                 const struct nc_vec3 q = nc_camera_dir(&z.camera, x, y);
-                const double w = zf.radiance[y * Z + x] * pow(nc_v3_norm(q), -3.0) / (F * F); /* L Omega */
+                const double w = zf.radiance[y * Z + x] * nc_camera_pixel_sr(F, F, q); /* L Omega */
                 e += w;
                 m = nc_v3_add(m, nc_v3_scale(nc_quat_rotate(z.camera.attitude_q, nc_v3_unit(q)), w));
             }
