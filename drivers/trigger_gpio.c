@@ -30,10 +30,10 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/windows.h"
 #include "emulator/trigger.h"
 
 #define CONSUMER "navcam"
-#define MAX_WINDOWS 64
 
 struct gpio_line {
     struct gpiod_chip *chip; /* owned unless shared with the trigger line */
@@ -50,9 +50,8 @@ struct gpio_trig {
     int running;
     atomic_int stop;
     pthread_mutex_t lock; /* the exposure windows */
-    struct nc_trigger_window win[MAX_WINDOWS];
-    int whead, wcount, wseen[MAX_WINDOWS];
-    unsigned long strobes, strobe_missed, read_errors;
+    struct nc_windows win;
+    unsigned long read_errors;
     int warned_clock;
 };
 
@@ -202,36 +201,6 @@ static void set_strobe(struct gpio_trig *g, int on)
     g->strobe_on = on;
 }
 
-/* Where the strobe should be now; returns the time of the next change
- * (INT64_MAX when no window is pending). Windows are kept in arrival order,
- * which is start order; overlapping windows simply keep the line active. */
-static int64_t strobe_plan(struct gpio_trig *g, int64_t now, int *want)
-{
-    int64_t next = INT64_MAX;
-    *want = 0;
-    pthread_mutex_lock(&g->lock);
-    while (g->wcount && g->win[g->whead].end_mono_ns <= now) {
-        if (!g->wseen[g->whead])
-            g->strobe_missed++; /* the whole window passed before this thread ran */
-        g->whead = (g->whead + 1) % MAX_WINDOWS;
-        g->wcount--;
-    }
-    for (int i = 0; i < g->wcount; i++) {
-        int k = (g->whead + i) % MAX_WINDOWS;
-        const struct nc_trigger_window *w = &g->win[k];
-        if (w->start_mono_ns <= now) {
-            *want = 1;
-            if (!g->wseen[k])
-                g->wseen[k] = 1, g->strobes++;
-            next = w->end_mono_ns < next ? w->end_mono_ns : next;
-        } else {
-            next = w->start_mono_ns < next ? w->start_mono_ns : next;
-        }
-    }
-    pthread_mutex_unlock(&g->lock);
-    return next;
-}
-
 static void read_edges(struct gpio_trig *g, int fd)
 {
     struct gpiod_line_event ev[16];
@@ -264,18 +233,15 @@ static void *gpio_thread(void *arg)
     while (!atomic_load(&g->stop)) {
         int64_t now = nc_mono_ns(), next = INT64_MAX;
         if (g->have_strobe) {
-            int want;
-            next = strobe_plan(g, now, &want);
-            set_strobe(g, want);
+            uint32_t want;
+            pthread_mutex_lock(&g->lock);
+            next = nc_windows_plan(&g->win, now, &want);
+            pthread_mutex_unlock(&g->lock);
+            set_strobe(g, want & 1);
         }
         struct pollfd p[2] = {{.fd = efd, .events = POLLIN}, {.fd = g->wake_fd, .events = POLLIN}};
-        struct timespec ts, *tp = NULL;
-        if (next != INT64_MAX) {
-            int64_t d = next > now ? next - now : 0;
-            ts = (struct timespec){(time_t)(d / 1000000000), (long)(d % 1000000000)};
-            tp = &ts;
-        }
-        if (ppoll(p, 2, tp, NULL) < 0 && errno != EINTR) {
+        struct timespec ts;
+        if (ppoll(p, 2, nc_windows_timeout(next, now, &ts), NULL) < 0 && errno != EINTR) {
             nc_log_error("trigger/gpio", "ppoll: %s", strerror(errno));
             break;
         }
@@ -328,15 +294,7 @@ static int gpio_control(void *priv, const char *request, void *arg)
         return NC_EUNSUPPORTED;
     const struct nc_trigger_window *w = arg;
     pthread_mutex_lock(&g->lock);
-    if (g->wcount == MAX_WINDOWS) { /* a storm: stretch the newest window */
-        struct nc_trigger_window *last = &g->win[(g->whead + g->wcount - 1) % MAX_WINDOWS];
-        if (w->end_mono_ns > last->end_mono_ns)
-            last->end_mono_ns = w->end_mono_ns;
-    } else {
-        int k = (g->whead + g->wcount++) % MAX_WINDOWS;
-        g->win[k] = *w;
-        g->wseen[k] = 0;
-    }
+    nc_windows_add(&g->win, w->start_mono_ns, w->end_mono_ns, 0); /* a storm stretches the newest window */
     pthread_mutex_unlock(&g->lock);
     wake(g);
     return 0;
@@ -346,9 +304,9 @@ static void gpio_close(void *priv)
 {
     struct gpio_trig *g = priv;
     gpio_stop(g);
-    if (g->have_strobe && (g->strobe_missed || g->read_errors))
+    if (g->have_strobe && (g->win.missed || g->read_errors))
         nc_log_info("trigger/gpio", "%lu strobes, %lu exposure windows passed before the strobe could be "
-                    "driven, %lu event read errors", g->strobes, g->strobe_missed, g->read_errors);
+                    "driven, %lu event read errors", g->win.started, g->win.missed, g->read_errors);
     struct gpiod_chip *shared = g->in.line ? gpiod_line_get_chip(g->in.line) : NULL;
     release_line(&g->strobe, shared);
     release_line(&g->in, NULL);

@@ -114,8 +114,20 @@ void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f)
             pthread_mutex_unlock(&e->acq_lock);
         }
         fprintf(f, "\"trigger\": {\"driver\": \"%s\", \"edges\": %lu, \"wrong_edge\": %lu, \"debounced\": %lu, "
-                   "\"accepted\": %lu}, ",
+                   "\"accepted\": %lu",
                 e->have_line ? e->line.drv->name : "software", c.edges, c.wrong_edge, c.debounced, c.accepted);
+        /* The driver's own counters, under its name, when it keeps any. */
+        char *own = NULL;
+        size_t len = 0;
+        FILE *m = e->have_line ? open_memstream(&own, &len) : NULL;
+        if (m) {
+            int rc = nc_trigger_control(&e->line, "stats", m);
+            fclose(m);
+            if (rc == 0 && len)
+                fprintf(f, ", \"%s\": %s", e->line.drv->name, own);
+            free(own);
+        }
+        fprintf(f, "}, ");
     }
     if (e->have_freerun) {
         struct nc_trigger_counts c;

@@ -57,8 +57,9 @@ struct nc_trigger_driver {
     int (*start)(void *priv);
     /* After stop() returns no edge is fired any more. */
     void (*stop)(void *priv);
-    /* Generic hook ("rate_hz" for timers, "exposure" for strobes);
-     * NULL: nothing supported. */
+    /* Generic hook ("rate_hz" for timers, "exposure" for strobes, "stats"
+     * with a FILE * to write the driver's own counters to as one JSON
+     * object); NULL: nothing supported. */
     int (*control)(void *priv, const char *request, void *arg);
     void (*close)(void *priv);
 };

@@ -24,7 +24,7 @@ if [ "${1:-}" = --test ]; then
   pkgs+=(clang libclang-rt-14-dev aravis-tools-cli gpiod v4l-utils astrometry.net
          astrometry-data-tycho2-10-19-littleendian)
   case "$(uname -m)" in
-    x86_64) pkgs+=(qemu-system-x86 busybox-static cpio kmod xz-utils dkms linux-headers-amd64 v4l2loopback-dkms) ;;
+    x86_64) pkgs+=(qemu-system-x86 busybox-static cpio kmod xz-utils dkms linux-headers-amd64 v4l2loopback-dkms udev) ;;
   esac
 fi
 

@@ -57,7 +57,7 @@ done
 for c in replay pose; do
   case "$(needed "$libexec/navcam-$c")" in *OpenImageIO*|*embree*|*yaml*) bad "navcam-$c links the renderer: $(needed "$libexec/navcam-$c")" ;; *) ok ;; esac
 done
-expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio)" -- \
+expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio, usb)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
 expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
 expect 1 "serve.trigger.activation" -- "$navcam" serve --set serve.mode=trigger \
@@ -200,6 +200,19 @@ PY
   expect 0 "wrote $tmp/example.png: 48x48" -- "$navcam" render "$f" -o "$tmp/example.png" \
     --set camera.width_px=48 --set camera.height_px=48 "${extra[@]}"
 done
+
+# The reference USB trigger adapter: its help, its argument errors, and the
+# stand-alone build its README gives (board-side: no NavCam libraries).
+adapter=$(dirname "$navcam")/navcam-usb-adapter
+if [ -x "$adapter" ]; then
+  expect 0 "--ffs DIR" -- "$adapter" --help
+  expect 2 "usage: navcam-usb-adapter" -- "$adapter" --chip gpiochip0
+  expect 1 "$tmp/no-ffs/ep0: No such file or directory (is FunctionFS mounted there?)" -- \
+    "$adapter" --ffs "$tmp/no-ffs" --chip /dev/null --input 0
+  build_cmd=$(grep -A1 '^gcc ' "$src/adapters/usb-trigger/README.md" | sed 's/\\$//' | tr -d '\n')
+  (cd "$src" && eval "${build_cmd/-o navcam-usb-adapter/-o $tmp/adapter -Wall -Wextra -Werror}") && [ -x "$tmp/adapter" ] && ok ||
+    bad "the stand-alone build in adapters/usb-trigger/README.md failed: $build_cmd"
+fi
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -11,7 +11,9 @@ Checks, on the source tree and the built static libraries:
   3. library code never prints to stderr itself (core/log.c does) and never
      installs a signal handler;
   4. no source file (tests and benchmarks too) is over 520 lines, but the
-     render hot path.
+     render hot path;
+  5. adapters/ (programs for other boards, such as the USB trigger adapter)
+     use the wire protocols and core/ only: proto/, core/, include/.
 Usage: test_layers.py SOURCE_DIR BUILD_DIR
 """
 import os
@@ -19,7 +21,8 @@ import re
 import subprocess
 import sys
 
-LAYERS = ["include", "core", "render", "camera", "proto", "emulator", "drivers", "app"]
+LAYERS = ["include", "core", "render", "camera", "proto", "emulator", "drivers", "app", "adapters"]
+ADAPTERS_MAY_USE = {"include", "core", "proto", "adapters"}
 RANK = {name: i for i, name in enumerate(LAYERS)}
 LIBS = {"navcam_core": "core", "navcam_render": "render", "navcam_camera": "camera", "navcam_proto": "proto",
         "navcam_client": "proto", "navcam_emulator": "emulator", "navcam_drivers": "drivers", "navcam_cli": "app"}
@@ -73,10 +76,12 @@ for rel in sources():
             edges[(layer, tl)] = edges.get((layer, tl), 0) + 1
         if tl is None or RANK[tl] > RANK[layer]:
             failures.append(f"{rel}:{n}: {layer}/ includes {target} from the higher layer {tl}/")
+        elif layer == "adapters" and tl not in ADAPTERS_MAY_USE:
+            failures.append(f"{rel}:{n}: an adapter program includes {target}: adapters use proto/ and core/ only")
     lines = text.count("\n")
     if lines > MAX_LINES and rel not in HOT_PATH:
         failures.append(f"{rel}: {lines} lines (at most {MAX_LINES} outside the render hot path)")
-    if layer not in ("app",) and rel != "core/log.c":
+    if layer not in ("app", "adapters") and rel != "core/log.c":
         code = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
         if re.search(r"\bstderr\b|\bperror\s*\(", code):
             failures.append(f"{rel}: a library writes to stderr itself (use core/log.h)")

@@ -13,18 +13,12 @@ B: a storm: every edge is accounted for (accepted, debounced, wrong edge),
 C: the V4L2 device failed mid-run: the failure was reported and counted,
    the file output kept every frame, and the output came back.
 """
-import json
 import os
 import sys
 
+from vmcheck import check, csv_rows, failures, level_at, records, stats
+
 out, n_edges = sys.argv[1], int(sys.argv[2])
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
 
 
 def fits_dn(path):
@@ -56,21 +50,6 @@ def fits_dn(path):
     raw = data[pos:pos + 2 * n]
     vals = [int.from_bytes(raw[2 * i:2 * i + 2], "big", signed=True) + int(bzero) for i in range(n)]
     return w, h, vals
-
-
-def records(path):
-    with open(path) as f:
-        return [json.loads(line) for line in f if line.strip()]
-
-
-def csv_rows(path):
-    with open(path) as f:
-        return [[int(x) for x in line.split(",")] for line in f if line.strip()]
-
-
-def stats(d):
-    with open(os.path.join(out, d, "stats.json")) as f:
-        return json.loads(f.read().strip().splitlines()[-1])
 
 
 # ---- A ----------------------------------------------------------------------
@@ -105,15 +84,6 @@ check(all(r["exposure_start_mono_ns"] == r["trigger_mono_ns"] for r in recs), "A
 strobe = csv_rows(os.path.join(out, "a/strobe.csv"))
 
 
-def level_at(samples, t):
-    v = samples[0][1]
-    for ts, val in samples:
-        if ts > t:
-            break
-        v = val
-    return v
-
-
 def active_in(samples, start, end, level):
     """Whether the line was at `level` at some time in [start, end]."""
     if level_at(samples, start) == level:
@@ -136,7 +106,7 @@ if len(rises) == len(recs) and len(falls) == len(recs):
           % (min(on_err), max(on_err), min(off_err), max(off_err)))
 check(all(level_at(strobe, (r["exposure_start_mono_ns"] + r["exposure_end_mono_ns"]) // 2) == 1 for r in recs),
       "A: strobe high at mid-exposure of every frame")
-sa = stats("a")
+sa = stats(out, "a")
 check(sa["trigger"]["accepted"] == n_edges and sa["trigger"]["edges"] == 2 * n_edges,
       f"A: the gate saw {sa['trigger']['edges']} edges and accepted {sa['trigger']['accepted']}")
 check(all(o["failed"] == 0 for o in sa["outputs"]), "A: no output failed")
@@ -150,7 +120,7 @@ if lat:
           f"p50 {p50:.2f} ms, p99 {p99:.2f} ms")
 
 # ---- B ----------------------------------------------------------------------
-sb = stats("b")
+sb = stats(out, "b")
 tb = sb["trigger"]
 check(tb["edges"] == tb["accepted"] + tb["debounced"] + tb["wrong_edge"],
       f"B: storm edges all accounted for: {tb['edges']} = {tb['accepted']} accepted + {tb['debounced']} debounced + "
@@ -171,7 +141,7 @@ check(sent is not None and sb["messages"] == sent and sum(sb["rejected"].values(
       f"B: poses sent during the storm {sent}, received {sb['messages']}, rejected {sum(sb['rejected'].values())}")
 
 # ---- C ----------------------------------------------------------------------
-sc = stats("c")
+sc = stats(out, "c")
 v4l2, files = sc["outputs"][0], sc["outputs"][1]
 check(v4l2["failed"] > 0, f"C: the V4L2 output counted {v4l2['failed']} failed frames")
 check(files["failed"] == 0 and files["submitted"] == sc["frames_delivered"],

@@ -13,7 +13,7 @@ edges=${5:-12}
 cd "$out"
 rm -rf a b c && mkdir -p a b c
 
-step() { echo "== $*"; }
+. "$(dirname "$0")/guest_lib.sh"
 trap 'echo "guest_v4l2_gpio.sh: line $LINENO: $BASH_COMMAND failed"' ERR
 serve_pid= serve_dir=
 cleanup() {
@@ -29,23 +29,9 @@ trap cleanup EXIT
 step "loading v4l2loopback, gpio-sim"
 modprobe -d $mods v4l2loopback devices=1 video_nr=3 card_label=NavCam exclusive_caps=1 max_buffers=2
 modprobe -d $mods gpio-sim
-cfs=/sys/kernel/config/gpio-sim/navcam
-mkdir $cfs $cfs/bank0
-echo 4 >$cfs/bank0/num_lines
-mkdir $cfs/bank0/line0 $cfs/bank0/line1
-echo TRIG >$cfs/bank0/line0/name
-echo STROBE >$cfs/bank0/line1/name
-echo 1 >$cfs/live
-chip=$(cat $cfs/bank0/chip_name)
-sim=/sys/devices/platform/$(cat $cfs/dev_name)/$chip
+sim_chip navcam 4
 echo "gpio-sim: $chip at $sim; v4l2loopback: $(cat /sys/class/video4linux/video3/name)"
 
-small=(--set camera.width_px=64 --set camera.height_px=48 --set bodies.0.shape.subdivisions=4
-       --set render.samples_per_pixel=1 --set serve.stats_interval_s=0 --set sensor.adc_bits=8
-       --set sensor.gain_e_per_dn=10 --set exposure.time_s=0.05 --set optics.transmission=0.002
-       --set serve.mode=trigger)
-# (50 ms exposures, so the strobe is easy to see, through an ND filter, so
-# that 8-bit frames are not saturated and every frame's noise differs)
 trig="{driver: gpio, chip: $chip, line: TRIG, activation: rising_edge, debounce_s: 0.002,
        strobe: {line: STROBE, active: high}}"
 

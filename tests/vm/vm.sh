@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # vm.sh - boot Debian's own kernel under qemu with the real v4l2loopback,
-# vivid and gpio-sim drivers, and run one script inside it.
+# vivid and gpio-sim drivers and the USB gadget stack (dummy_hcd,
+# libcomposite, FunctionFS), and run one script inside it.
 #
 #   vm.sh prepare              build (or find cached) kernel, modules, gpio-sim
 #   vm.sh run SCRIPT OUTDIR [TIMEOUT_S] [ARGS...]
@@ -105,7 +106,7 @@ prepare() {
     mkdir -p "$root/lib/modules/$kver"
     cp "$mods"/modules.builtin* "$mods"/modules.order "$root/lib/modules/$kver/"
     local m line path
-    for m in virtio_pci 9pnet_virtio 9p configfs videodev v4l2loopback vivid gpio-sim; do
+    for m in virtio_pci 9pnet_virtio 9p configfs videodev v4l2loopback vivid gpio-sim dummy_hcd libcomposite usb_f_fs; do
         while read -r line; do
             [[ $line == insmod* ]] || continue
             path=${line#insmod }; path=${path%% *}
