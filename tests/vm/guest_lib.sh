@@ -18,6 +18,18 @@ sim_chip() {
     sim=/sys/devices/platform/$(cat "$cfs/dev_name")/$chip
 }
 
+# listening PID LOG: wait until navcam serve (PID) says in LOG that it
+# listens (up to 60 s: the scene takes seconds to build under TCG); fails
+# if it exits first or never says so.
+listening() {
+    for _ in $(seq 600); do
+        grep -q "SIGINT or SIGTERM stops" "$2" 2>/dev/null && return 0
+        kill -0 "$1" 2>/dev/null || return 1
+        sleep 0.1
+    done
+    return 1
+}
+
 # The small scene every phase renders: 64x48 frames, 50 ms exposures (an
 # easy strobe to see) through an ND filter, so that 8-bit frames are not
 # saturated and every frame's noise differs; triggered.

@@ -97,11 +97,7 @@ start_serve() { # DIR ARGS...
     (cd "$w" && exec setpriv --reuid=65534 --regid=65534 --groups=46,44 -- "$navcam" serve -j 1 "${small[@]}" "$@" \
         >stats.json 2>serve.log) &
     serve_pid=$!
-    for _ in $(seq 600); do
-        grep -q "SIGINT or SIGTERM stops" "$w/serve.log" 2>/dev/null && return
-        kill -0 "$serve_pid" 2>/dev/null || break
-        sleep 0.1
-    done
+    listening "$serve_pid" "$w/serve.log" && return
     cp -r "$w/." "$d/"
     echo "navcam serve did not start"; cat "$d/serve.log"; return 1
 }

@@ -41,12 +41,7 @@ start_serve() { # DIR ARGS...
     serve_dir=$d
     (cd "$d" && exec "$navcam" serve -j 1 "${small[@]}" "$@" >stats.json 2>serve.log) &
     serve_pid=$!
-    # Listening once it says so (the scene takes seconds to build under TCG).
-    for _ in $(seq 600); do
-        grep -q "SIGINT or SIGTERM stops" "$d/serve.log" 2>/dev/null && return
-        kill -0 "$serve_pid" 2>/dev/null || break
-        sleep 0.1
-    done
+    listening "$serve_pid" "$d/serve.log" && return
     echo "navcam serve did not start"; cat "$d/serve.log"; return 1
 }
 stop_serve() { # DIR
