@@ -239,10 +239,10 @@ static void write_stats(struct nc__usb_trig *u, FILE *f)
     fprintf(f, "{\"connected\": %s, \"messages\": %lu, \"edges\": %lu, \"lost\": %lu, \"missed_by_adapter\": %lu, "
                "\"level_repeats\": %lu, "
                "\"other_lines\": %lu, \"unknown\": %lu, \"unplugged\": %lu, \"reopened\": %lu, \"strobes\": %lu, "
-               "\"strobes_skipped\": %lu, \"clock_exchanges\": %lu, \"clock_offset_s\": %.9f, \"clock_drift_ppm\": %.3f, "
+               "\"strobes_skipped\": %lu, \"clock_exchanges\": %lu, \"clock_exchanges_used\": %d, \"clock_offset_s\": %.9f, \"clock_drift_ppm\": %.3f, "
                "\"clock_bound_us\": %.3f, \"edge_bound_max_us\": %.3f}",
             u->state == NC__USB_READY ? "true" : "false", u->messages, u->edges, u->lost, u->missed, u->level_repeats, u->other_line, u->unknown,
-            u->unplugged, u->reopened, u->strobes, u->strobes_skipped, u->map.added, u->map.offset_ns * 1e-9,
+            u->unplugged, u->reopened, u->strobes, u->strobes_skipped, u->map.added, u->map.used, u->map.offset_ns * 1e-9,
             u->map.drift * 1e6, u->map.valid ? u->map.bound_ns * 1e-3 : -1.0, u->edge_bound_max_ns * 1e-3);
     pthread_mutex_unlock(&u->lock);
 }

@@ -87,7 +87,6 @@ static void on_message(struct nc__usb_trig *u, const struct nc_ut_msg *m, int64_
             return;
         u->next_seq = m->seq + 1;
         u->state = NC__USB_READY;
-        u->n_inputs = m->line, u->n_outputs = m->level;
         nc_log_info(LOG, "adapter %s: protocol %u, %d inputs, %d outputs; trigger on input %d%s", u->desc, m->arg,
                     m->line, m->level, u->input, u->strobe_out >= 0 ? ", strobe on an output" : "");
         if (m->arg != NC_UT_VERSION)

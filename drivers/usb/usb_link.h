@@ -59,7 +59,6 @@ struct nc__usb_trig {
     int nfire;
     unsigned long messages, edges, lost, missed, level_repeats, other_line, unknown, unplugged, reopened, strobes, strobes_skipped;
     double edge_bound_max_ns;
-    int n_inputs, n_outputs;
 };
 
 /* Queue one message to the adapter. Lock held. */
