@@ -15,7 +15,7 @@
 #include "app/cli.h"
 #include "camera/camsys.h"
 #include "camera/load.h"
-#include "camera/quality.h"
+#include "camera/shot.h"
 #include "core/error.h"
 #include "render/frame_io.h"
 #include "render/image_io.h"
@@ -51,6 +51,10 @@ static const char render_help[] =
     "                           --set render.samples_per_pixel=16\n"
     "  -j, --threads N        render threads (default: render.threads, else all\n"
     "                         cores); the image does not depend on N\n"
+    "      --sumfile X.SUM    the camera and pose of an SPC SUM file: replaces the\n"
+    "                         camera section with {sumfile: X.SUM}; the Sun's direction\n"
+    "                         comes from it too, give its distance with\n"
+    "                         --set sun={distance_au: D} (docs/sumfiles.md)\n"
     "      --fits-rows ORDER  .fits only: top_down (default: row 1 is the top image\n"
     "                         row, y = 0) or bottom_up (row 1 at the bottom, as FITS\n"
     "                         viewers and mission archives show it); the keyword\n"
@@ -69,32 +73,6 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-/* Electrons (float) or a digitised frame of a rendered radiance image (the
- * camera model's render size: the sensor plus the PSF's margin). */
-static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
-                              const struct nc_camsys *cs, double exposure, unsigned long long frame_no,
-                              const struct nc_image_attr *extra, int nextra, double *scale)
-{
-    const int W = cs->width_px, H = cs->height_px;
-    size_t n = (size_t)W * (size_t)H;
-    float *e = malloc(n * sizeof *e);
-    uint16_t *dn = malloc(n * sizeof *dn);
-    struct nc_image_attr attrs[32];
-    char text[32][200];
-    int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
-    int na = nc_frame_meta(s, q, attrs, text, 32);
-    na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 31 - na);
-    for (int i = 0; i < nextra && na < 32; i++)
-        attrs[na++] = extra[i];
-    if (rc >= 0 && q == NC_Q_ELECTRONS)
-        rc = nc_image_write(out, e, W, H, attrs, na, scale);
-    else if (rc >= 0 && (rc = nc_camsys_digitise(cs, e, exposure, frame_no, dn)) >= 0)
-        rc = nc_image_write_dn(out, dn, W, H, cs->sensor.adc_bits, attrs, na);
-    free(e);
-    free(dn);
-    return rc;
-}
-
 int main(int argc, char **argv)
 {
     nc_cli_init("render");
@@ -102,13 +80,14 @@ int main(int argc, char **argv)
         {"output", required_argument, NULL, 'o'}, {"quantity", required_argument, NULL, 'q'},
         {"set", required_argument, NULL, 's'},    {"threads", required_argument, NULL, 'j'},
         {"exposure", required_argument, NULL, 'e'}, {"frame", required_argument, NULL, 'f'},
-        {"fits-rows", required_argument, NULL, 'R'},
+        {"fits-rows", required_argument, NULL, 'R'}, {"sumfile", required_argument, NULL, 'S'},
         {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
     };
     const char *out = NULL, *scene_path = NULL, *rows = NULL;
     double exposure = -1;
     unsigned long long frame_no = 0;
-    const char **sets = calloc((size_t)argc, sizeof *sets);
+    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+    char sumset[4200];
     int nsets = 0, threads = 0, c;
     enum nc_quantity q = NC_Q_RADIANCE;
     if (!sets)
@@ -118,6 +97,12 @@ int main(int argc, char **argv)
         switch (c) {
         case 'o': out = optarg; break;
         case 'R': rows = optarg; break;
+        case 'S': /* first, so that --set camera.X=... can still add to it */
+            snprintf(sumset, sizeof sumset, "camera={sumfile: '%s'}", optarg);
+            memmove(sets + 1, sets, (size_t)nsets * sizeof *sets);
+            sets[0] = sumset;
+            nsets++;
+            break;
         case 'e':
         case 'f': {
             char *end;
@@ -198,7 +183,6 @@ int main(int argc, char **argv)
     if (exposure < 0)
         exposure = cs.exposure_s;
     struct nc_renderer r;
-    struct nc_frame f = {0};
     double t0 = now_ms();
     if ((rc = nc_renderer_init(&r, &scene, threads)) < 0) {
         nc_scene_free(&scene);
@@ -206,83 +190,14 @@ int main(int argc, char **argv)
         return nc_cli_fail();
     }
     double t1 = now_ms();
-    /* Electrons and DN go through the camera model, whose PSF needs the
-     * light from a margin around the field: render that larger image. */
-    struct nc_scene drawn = scene;
-    if (q > NC_Q_ROCK_ID)
-        nc_camsys_render_camera(&cs, &scene.camera, &drawn.camera);
-    rc = nc_frame_alloc(&f, drawn.camera.width_px, drawn.camera.height_px);
-    if (rc >= 0 && q == NC_Q_ROCK_ID &&
-        !(f.rock_id = malloc((size_t)f.width_px * (size_t)f.height_px * sizeof *f.rock_id)))
-        rc = nc_error(-ENOMEM, "out of memory");
-    /* Motion during the exposure (camera and body rates) and a rolling
-     * shutter are integrated over the exposure window. */
-    struct nc_exposure ex = {.exposure_s = exposure, .rolling = cs.sensor.shutter == NC_SHUTTER_ROLLING,
-                             .line_time_s = cs.sensor.line_time_s};
-    int tsamples = 1;
-    /* render.quality: auto picks the settings from the camera's noise, for
-     * the sensor's own render camera whatever the quantity */
-    char chosen[300] = "";
-    if (rc >= 0 && scene.render.quality_auto) {
-        struct nc_scene sensor = drawn;
-        struct nc_quality_choice qc;
-        nc_camsys_render_camera(&cs, &scene.camera, &sensor.camera);
-        if ((rc = nc_quality_auto(&r, &sensor, &cs, exposure, &qc)) >= 0) {
-            drawn.render = sensor.render;
-            scene.render = sensor.render; /* recorded in the file */
-            nc_quality_describe(&qc, chosen, sizeof chosen);
-        }
-    }
-    if (rc >= 0)
-        rc = nc_render_exposure(&r, &drawn, &ex, &f, &tsamples);
-    /* Stars (the `stars` section), drawn before the camera model's PSF. */
-    struct nc_sky_stats sst = {0};
-    char starinfo[120] = "";
-    double ts0 = now_ms();
-    if (rc >= 0 && sky.on && (rc = nc_sky_draw(&sky, &r, &cs, &drawn, 0, exposure, &f, &sst)) >= 0)
-        snprintf(starinfo, sizeof starinfo, "limit_mag=%.2f drawn=%ld hidden=%ld", sst.limit_mag, sst.drawn,
-                 sst.hidden);
-    /* The Sun: drawn when its disk reaches the frame; a warning in or near it. */
-    struct nc_sun_view sv = {0};
-    char sunwarn[80] = "", suninfo[200] = "";
-    if (rc >= 0 && (rc = nc_render_sun(&r, &drawn, NC_SUN_NEAR_DEG, &f, &sv)) >= 0) {
-        nc_sun_view_warning(&sv, sunwarn, sizeof sunwarn);
-        snprintf(suninfo, sizeof suninfo, "off_axis_deg=%.4f edge_deg=%.4f in_field=%d hidden=%d%s%s", sv.off_axis_deg,
-                 sv.edge_deg, sv.in_field, sv.hidden, sunwarn[0] ? " warning=" : "", sunwarn);
-    }
-    double t2 = now_ms(), scale = 0;
-    /* Levels of detail and the smallest boulder traced (0: every rock). */
-    char lod[40], rocks[40];
-    snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r.rt));
-    snprintf(rocks, sizeof rocks, "%.17g", nc_rt_boulder_min_m(r.rt));
-    /* How each mesh is shaded: name=flat or name=smooth, comma-separated. */
-    char normals[NC_MAX_BODIES * 72] = "";
-    for (int i = 0, o = 0; i < scene.nbodies; i++)
-        if (scene.body[i].shape == NC_SHAPE_MESH || scene.body[i].shape == NC_SHAPE_ASTEROID)
-            o += snprintf(normals + o, sizeof normals - (size_t)o, "%s%s=%s", o ? "," : "", scene.body[i].name,
-                          scene.body[i].smooth_normals ? "smooth" : "flat");
-    /* The roughness each body's rocks not traced were folded into. */
-    char fold[NC_MAX_BODIES * 80] = "";
-    for (int i = 0, o = 0; i < scene.nbodies; i++)
-        if (r.fold_theta_bar_deg[i] >= 0)
-            o += snprintf(fold + o, sizeof fold - (size_t)o, "%s%s=%.6g", o ? "," : "", scene.body[i].name,
-                          r.fold_theta_bar_deg[i]);
-    struct nc_image_attr extra[7] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {0}, {0}, {0}, {0}, {0}};
-    int nextra = 2;
-    if (suninfo[0])
-        extra[nextra++] = (struct nc_image_attr){"navcam:sun_view", suninfo};
-    if (starinfo[0])
-        extra[nextra++] = (struct nc_image_attr){"navcam:stars", starinfo};
-    if (normals[0])
-        extra[nextra++] = (struct nc_image_attr){"navcam:normals", normals};
-    if (fold[0])
-        extra[nextra++] = (struct nc_image_attr){"navcam:rock_fold_theta_bar_deg", fold};
-    if (rows)
-        extra[nextra++] = row_attr;
-    if (rc >= 0 && q <= NC_Q_ROCK_ID)
-        rc = nc_frame_write(out, &f, q, &scene, extra, nextra, &scale);
-    else if (rc >= 0)
-        rc = write_sensor_frame(out, &f, q, &scene, &cs, exposure, frame_no, extra, nextra, &scale);
+    struct nc_shot_info info;
+    const struct nc_image_attr *extra = rows ? &row_attr : NULL;
+    rc = nc_shot(&r, &scene, &cs, &sky, q, exposure, frame_no, out, extra, rows ? 1 : 0, &info);
+    double t2 = t1 + info.render_ms + info.stars_ms, scale = info.preview_scale;
+    const int tsamples = info.time_samples;
+    const char *chosen = info.quality, *sunwarn = info.sun_warning;
+    const struct nc_sky_stats sst = info.stars;
+    const struct nc_sun_view sv = info.sun;
     if (rc >= 0) {
         printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene setup %.1f ms, "
                "render %.1f ms\n",
@@ -294,7 +209,7 @@ int main(int argc, char **argv)
             printf("  WARNING: %s (its centre %.2f deg off axis)\n", sunwarn, sv.off_axis_deg);
         if (sky.on)
             printf("  stars: to V %.2f, %ld in the frame, %ld hidden by bodies (%.1f ms)\n", sst.limit_mag, sst.drawn,
-                   sst.hidden, t2 - ts0);
+                   sst.hidden, info.stars_ms);
         if (scene.render.lod_error_px > 0)
             printf("  levels of detail: surface error bound %.3g m (render.lod_error_px %g)\n", nc_rt_lod_error_m(r.rt),
                    scene.render.lod_error_px);
@@ -318,7 +233,6 @@ int main(int argc, char **argv)
         if (scale > 0)
             printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));
     }
-    nc_frame_free(&f);
     nc_renderer_free(&r);
     nc_scene_free(&scene);
     nc_camsys_free(&cs);

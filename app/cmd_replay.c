@@ -12,90 +12,9 @@
 
 #include "app/cli.h"
 #include "core/error.h"
+#include "core/traj.h"
 #include "core/vec.h"
 #include "navcam/client.h"
-
-struct traj_row {
-    double t_s;
-    struct nc_vec3 p, sun;
-    struct nc_quat q;
-    int capture;
-};
-
-/* The built-in approach to the default scene's asteroid (as `make demo`):
- * 8 poses, 16 km to 3 km, one per second, looking at the body. */
-static int builtin_approach(struct traj_row **out)
-{
-    const int n = 8;
-    struct traj_row *r = calloc(n, sizeof *r);
-    if (!r)
-        return -ENOMEM;
-    for (int i = 0; i < n; i++) {
-        double d = 16000 * exp(log(3000.0 / 16000) * i / (n - 1));
-        r[i].t_s = i;
-        r[i].p = nc_v3(0.08 * d, -d, 0.03 * d);
-        nc_quat_look_at(r[i].p, nc_v3(0, 0, 0), nc_v3(0, 0, 1), &r[i].q);
-        r[i].sun = nc_v3(0.643, -0.766, 0);
-        r[i].capture = 1;
-    }
-    *out = r;
-    return n;
-}
-
-/* CSV: t_s, cam_x_m, cam_y_m, cam_z_m, q_w, q_x, q_y, q_z, sun_x, sun_y, sun_z[, capture]. */
-static int read_traj(const char *path, struct traj_row **out)
-{
-    if (!strcmp(path, "builtin:approach"))
-        return builtin_approach(out);
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return nc_error(-errno, "%s: %s", path, strerror(errno));
-    struct traj_row *rows = NULL;
-    size_t n = 0, cap = 0, lineno = 0;
-    char line[1024];
-    int rc = 0;
-    while (fgets(line, sizeof line, f)) {
-        lineno++;
-        if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
-            continue;
-        double v[12];
-        int k = 0;
-        char *s = line, *end;
-        for (; k < 12; k++) {
-            v[k] = strtod(s, &end);
-            if (end == s)
-                break;
-            s = end + strspn(end, " \t");
-            if (*s == ',')
-                s++;
-        }
-        if (k < 11 || (k == 11 && *s && *s != '\n' && *s != '\r')) {
-            if (lineno == 1 && n == 0)
-                continue; /* a header */
-            rc = nc_error(NC_EUSAGE, "%s:%zu: expected t_s,cam_x_m,cam_y_m,cam_z_m,q_w,q_x,q_y,q_z,sun_x,sun_y,sun_z[,capture]",
-                          path, lineno);
-            break;
-        }
-        if (n == cap) {
-            cap = cap ? 2 * cap : 256;
-            struct traj_row *r2 = realloc(rows, cap * sizeof *rows);
-            if (!r2) {
-                rc = -ENOMEM;
-                break;
-            }
-            rows = r2;
-        }
-        rows[n++] = (struct traj_row){v[0], nc_v3(v[1], v[2], v[3]), nc_v3(v[8], v[9], v[10]), {v[4], v[5], v[6], v[7]},
-                                      k == 12 ? v[11] != 0 : 1};
-    }
-    fclose(f);
-    if (rc < 0) {
-        free(rows);
-        return rc;
-    }
-    *out = rows;
-    return (int)n;
-}
 
 static const char replay_help[] =
     "Usage: navcam replay TRAJ.csv|builtin:approach [--lockstep] [--speed X] [options]\n"
@@ -105,6 +24,11 @@ static const char replay_help[] =
     "times in seconds of simulation time, the camera pose in the scene frame\n"
     "(quaternion camera -> scene), the Sun direction in the body frame; capture 1\n"
     "(the default) asks for a frame. builtin:approach is the default scene's approach.\n"
+    "Or SPC SUM-like rows, after the header t_s,scobj_x_km,...:\n"
+    "  t_s, scobj_x_km, scobj_y_km, scobj_z_km, cx_x, cx_y, cx_z, cy_x, cy_y, cy_z,\n"
+    "  cz_x, cz_y, cz_z, sz_x, sz_y, sz_z[, capture]\n"
+    "SCOBJ (spacecraft -> body, km), camera axes and Sun in the body-fixed frame,\n"
+    "the scene frame when bodies[0] sits at the origin unturned (docs/sumfiles.md).\n"
     "\n"
     "  -l, --lockstep        TCP; send each pose and wait for its frame before the next\n"
     "  -x, --speed X         pace rows at X times real time (default 1; 0 = as fast as\n"
@@ -142,8 +66,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "navcam replay: give one trajectory (a CSV file or builtin:approach)\n");
         return 2;
     }
-    struct traj_row *rows = NULL;
-    int n = read_traj(argv[optind], &rows);
+    struct nc_traj_row *rows = NULL;
+    int n = nc_traj_read(argv[optind], &rows);
     if (n < 0) {
         fprintf(stderr, "navcam replay: %s\n", nc_errmsg());
         return 1;

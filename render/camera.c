@@ -6,12 +6,56 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/sumfile.h"
 
-int nc_camera_intrinsics_from_config(struct nc_cfg_node *map, struct nc_camera *c)
+/* camera.sumfile: intrinsics from an SPC SUM file (core/sumfile.h). The
+ * natural view is rendered with +X along CX and +Y along CY; a negative K11
+ * or K22 mirrors the stored image, which the writers apply (flip_*). */
+static int sumfile_intrinsics(struct nc_cfg_node *map, struct nc_camera *c, struct nc_sumfile *sum)
+{
+    static const char *const own[] = {"width_px", "height_px", "focal_length_m", "pixel_pitch_m", "fx_px",
+                                      "fy_px", "cx_px", "cy_px", "position_m", "attitude_q", "look_at_m", "up"};
+    for (size_t i = 0; i < sizeof own / sizeof own[0]; i++)
+        if (nc_cfg_get(map, own[i]))
+            return nc_cfg_error(nc_cfg_get(map, own[i]), "the SUM file (camera.sumfile) sets the size, intrinsics "
+                                                         "and pose: remove %s", own[i]);
+    const struct nc_cfg_node *node = nc_cfg_get(map, "sumfile");
+    char path[4096], why[600];
+    nc_cfg_resolve_path(node, node->value, path, sizeof path);
+    if (nc_sumfile_read(path, sum) < 0) {
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_cfg_error(node, "%s", why);
+    }
+    const double *k = sum->k;
+    if (fabs(k[1]) > 1e-6 * fabs(k[0]) || fabs(k[3]) > 1e-6 * fabs(k[4]))
+        return nc_cfg_error(node, "%s: K-MATRIX K12 = %g, K21 = %g: a skewed pixel grid, which NavCam's camera "
+                                  "does not model (it needs K12 = K21 = 0)", path, k[1], k[3]);
+    c->width_px = sum->npx;
+    c->height_px = sum->nln;
+    c->fx_px = sum->mmfl_mm * fabs(k[0]);
+    c->fy_px = sum->mmfl_mm * fabs(k[4]);
+    c->focal_length_m = sum->mmfl_mm * 1e-3;
+    c->flip_cols = k[0] < 0;
+    c->flip_rows = k[4] < 0;
+    /* 1-based centres to 0-based; mirrored: x_stored = W - 1 - x_rendered. */
+    c->cx_px = c->flip_cols ? sum->npx - sum->ctr[0] : sum->ctr[0] - 1;
+    c->cy_px = c->flip_rows ? sum->nln - sum->ctr[1] : sum->ctr[1] - 1;
+    c->from_sumfile = 1;
+    c->sumfile_sun = nc_v3_unit(nc_v3(sum->sz[0], sum->sz[1], sum->sz[2]));
+    snprintf(c->sumfile_utc, sizeof c->sumfile_utc, "%s", sum->utc);
+    return 0;
+}
+
+static int camera_read(struct nc_cfg_node *map, struct nc_camera *c, struct nc_sumfile *sum)
 {
     int rc;
     memset(c, 0, sizeof *c);
     long w = 0, h = 0;
+    if (nc_cfg_get(map, "sumfile")) {
+        if ((rc = sumfile_intrinsics(map, c, sum)) < 0)
+            return rc;
+        goto distortion;
+    }
     if ((rc = nc_cfg_int(map, "width_px", 1, 16384, &w)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "width_px", "image width in pixels");
     if ((rc = nc_cfg_int(map, "height_px", 1, 16384, &h)) <= 0)
@@ -49,6 +93,7 @@ int nc_camera_intrinsics_from_config(struct nc_cfg_node *map, struct nc_camera *
         (rc = nc_cfg_double(map, "cy_px", -1e6, 1e6, &c->cy_px)) < 0)
         return rc;
 
+distortion:;
     struct nc_cfg_node *dist;
     if ((rc = nc_cfg_map(map, "distortion", &dist)) < 0)
         return rc;
@@ -75,14 +120,32 @@ int nc_camera_intrinsics_from_config(struct nc_cfg_node *map, struct nc_camera *
     return 0;
 }
 
+int nc_camera_intrinsics_from_config(struct nc_cfg_node *map, struct nc_camera *c)
+{
+    struct nc_sumfile sum;
+    return camera_read(map, c, &sum);
+}
+
 int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
 {
-    int rc = nc_camera_intrinsics_from_config(map, c);
+    struct nc_sumfile sum;
+    int rc = camera_read(map, c, &sum);
     if (rc < 0)
         return rc;
     if ((rc = nc_cfg_vec3(map, "velocity_m_s", &c->velocity_m_s)) < 0 ||
         (rc = nc_cfg_vec3(map, "angular_velocity_rad_s", &c->angular_velocity_rad_s)) < 0)
         return rc;
+    if (c->from_sumfile) { /* the pose in bodies[0]'s frame (the scene moves it with that body) */
+        c->position_m = nc_v3(-1e3 * sum.scobj_km[0], -1e3 * sum.scobj_km[1], -1e3 * sum.scobj_km[2]);
+        struct nc_mat3 r; /* columns: the camera axes in the body frame */
+        for (int i = 0; i < 3; i++) {
+            r.m[i][0] = sum.cx[i];
+            r.m[i][1] = sum.cy[i];
+            r.m[i][2] = sum.cz[i];
+        }
+        c->attitude_q = nc_quat_from_mat(&r);
+        return 0;
+    }
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
     struct nc_vec3 target, up = nc_v3(0, 0, 1);

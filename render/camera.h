@@ -29,6 +29,15 @@ struct nc_camera {
     struct nc_quat attitude_q; /* camera -> scene */
     struct nc_vec3 velocity_m_s;         /* scene frame */
     struct nc_vec3 angular_velocity_rad_s; /* camera frame (as gyros report) */
+    /* The image as stored is the rendered view mirrored top to bottom
+     * (flip_rows) and/or left to right (flip_cols): a SUM file's pixel grid
+     * with K22 < 0 or K11 < 0 (docs/sumfiles.md). Writers apply it. */
+    int flip_rows, flip_cols;
+    /* camera.sumfile: the SUM file's Sun direction (body-fixed, unit) and
+     * picture time; from_sumfile 0 otherwise. */
+    int from_sumfile;
+    struct nc_vec3 sumfile_sun;
+    char sumfile_utc[64];
 };
 
 /* Unnormalised direction, camera frame, through pixel coordinates (x, y) of

@@ -205,6 +205,36 @@ int nc_image_write_dn_cube(const char *path, const uint16_t *dn, int w, int h, i
     return rc;
 }
 
+int nc_image_write_planes(const char *path, const float *planes, int w, int h, int nplanes, const char *const *names,
+                          const struct nc_image_attr *attrs, int nattrs)
+{
+    if (format_of(path) != FMT_FITS)
+        return nc_error(NC_EIMAGE, "%s: planes are written to FITS files (.fits) only", path);
+    size_t n = (size_t)w * (size_t)h * (size_t)nplanes;
+    float *clean = malloc((n ? n : 1) * sizeof *clean);
+    struct nc_image_attr *all = malloc((size_t)(nattrs + nplanes) * sizeof *all);
+    char (*key)[16] = malloc((size_t)nplanes * sizeof *key);
+    int rc;
+    if (!clean || !all || !key) {
+        rc = nc_error(-ENOMEM, "%s: out of memory", path);
+        goto out;
+    }
+    for (size_t i = 0; i < n; i++)
+        clean[i] = isfinite(planes[i]) ? planes[i] : 0.0f;
+    if (nattrs > 0)
+        memcpy(all, attrs, (size_t)nattrs * sizeof *all);
+    for (int k = 0; k < nplanes; k++) {
+        snprintf(key[k], sizeof key[k], "PLANE%d", k + 1);
+        all[nattrs + k] = (struct nc_image_attr){key[k], names[k]};
+    }
+    rc = nc__fits_write(path, clean, NC__PX_FLOAT, w, h, nplanes, all, nattrs + nplanes);
+out:
+    free(clean);
+    free(all);
+    free(key);
+    return rc;
+}
+
 int nc_image_read(const char *path, float **px, int *w, int *h)
 {
     return format_of(path) == FMT_FITS ? nc__fits_read(path, px, w, h) : nc__oiio_read(path, px, w, h);

@@ -44,6 +44,11 @@ int nc_image_write_dn(const char *path, const uint16_t *dn, int width, int heigh
 /* A FITS cube of nframes DN images (NAXIS3 = nframes). */
 int nc_image_write_dn_cube(const char *path, const uint16_t *dn, int width, int height, int nframes, int bits,
                            const struct nc_image_attr *attrs, int nattrs);
+/* Float32 planes (plane after plane, width x height each) in one FITS file
+ * (.fits): a cube of nplanes planes whose keywords PLANE1 .. PLANEn name
+ * them. Non-finite values are written as 0. */
+int nc_image_write_planes(const char *path, const float *planes, int width, int height, int nplanes,
+                          const char *const *names, const struct nc_image_attr *attrs, int nattrs);
 /* Read the first channel (first plane of a cube) as float (caller frees *px). */
 int nc_image_read(const char *path, float **px, int *width, int *height);
 /* Read one string attribute; 0 on success, negative if absent. */

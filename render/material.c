@@ -9,6 +9,7 @@
 
 #include "render/albedo_map.h"
 #include "core/error.h"
+#include "core/log.h"
 
 extern const struct nc_brdf_model nc_brdf_lambert, nc_brdf_lommel_seeliger, nc_brdf_hapke, nc_brdf_mcewen;
 
@@ -172,7 +173,30 @@ int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
         snprintf(why, sizeof why, "%s", nc_errmsg());
         return nc_cfg_error(map, "%s", why);
     }
+    if (!strcmp(m->model->name, "lommel_seeliger") && m->p[0] < NC_LS_W_SUSPECT) {
+        const struct nc_cfg_node *w = nc_cfg_get(map, "w");
+        char path[256];
+        nc_cfg_path(w ? w : map, path, sizeof path);
+        nc_log_warn("scene",
+                    "%s:%d: %s = %g (lommel_seeliger) gives a geometric albedo of %.4f, darker than any measured "
+                    "small body: Lommel-Seeliger's w is not a single-scattering albedo. For a body of geometric "
+                    "albedo p use w = 8 p (Bennu, p = 0.044: w = 0.35), or Hapke with its w (docs/reflectance.md)",
+                    (w ? w : map)->origin, (w ? w : map)->line, path, m->p[0], m->p[0] / 8);
+    }
     return 0;
+}
+
+double nc_material_geometric_albedo(const struct nc_material *m)
+{
+    enum { N = 4000 };
+    double sum = 0;
+    for (int k = 0; k < N; k++) {
+        double mu = (k + 0.5) / N, r;
+        struct nc_photometry g = {mu, mu, 1.0, 1.0};
+        nc_material_eval(m, 1, &g, &r);
+        sum += M_PI * r * mu;
+    }
+    return 2 * sum / N;
 }
 
 void nc_material_free(struct nc_material *m)

@@ -109,6 +109,16 @@ double nc_material_fold_rocks(const struct nc_material *m, double cover, struct 
  * g outside |i - e| .. min(i + e, 360 - i - e) (1e-6 deg tolerance). */
 int nc_material_eval_deg(const struct nc_material *m, double i_deg, double e_deg, double g_deg, double out[4]);
 
+/* Geometric albedo: the zero-phase I/F of a sphere of this material seen
+ * from afar over that of a Lambert disk, p = 2 int_0^1 RADF(mu, mu, 0) mu dmu
+ * (disk area 2 mu dmu where i = e = acos mu); 4000-point midpoint rule.
+ * Lambert A gives 2A/3, Lommel-Seeliger w gives w/8. */
+double nc_material_geometric_albedo(const struct nc_material *m);
+/* Lommel-Seeliger w below this gives a geometric albedo w/8 darker than any
+ * measured small body (the darkest comet nuclei and asteroids, ~0.02): a
+ * sign that a single-scattering albedo was given (docs/reflectance.md). */
+#define NC_LS_W_SUSPECT 0.16
+
 /* r (1/sr) of the material for n geometries. */
 static inline void nc_material_eval(const struct nc_material *m, size_t n, const struct nc_photometry *geo, double *r)
 {

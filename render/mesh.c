@@ -68,7 +68,10 @@ int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out)
         return nc_mesh_load_obj(path, scale_to_m, out);
     if (strcasecmp(ext, "ply") == 0)
         return nc_mesh_load_ply(path, scale_to_m, out);
-    return nc_error(NC_EMESH, "%s: unknown mesh format '.%s' (expected .obj or .ply)", path, ext);
+    if (strcasecmp(ext, "icq") == 0 || strcasecmp(ext, "txt") == 0) /* SPC's SHAPE.TXT */
+        return nc_mesh_load_icq(path, scale_to_m, out);
+    return nc_error(NC_EMESH, "%s: unknown mesh format '.%s' (expected .obj, .ply, or .icq/.txt for SPC's ICQ)", path,
+                    ext);
 }
 
 /* ---- OBJ -------------------------------------------------------------- */

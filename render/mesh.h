@@ -1,6 +1,6 @@
 /* mesh.h - triangle meshes in the body-fixed frame, in metres (double).
  *
- * Loaders for Wavefront OBJ and PLY (ASCII and binary), and a procedural
+ * Loaders for Wavefront OBJ, PLY (ASCII and binary) and SPC's ICQ, and a procedural
  * cratered asteroid. Loaders validate everything a renderer would trip on
  * (non-triangles, indices out of range, non-finite coordinates, empty meshes)
  * and report file and line; they never touch Embree.
@@ -24,6 +24,9 @@ void nc_mesh_free(struct nc_mesh *m);
 int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out);
 int nc_mesh_load_obj(const char *path, double scale_to_m, struct nc_mesh *out);
 int nc_mesh_load_ply(const char *path, double scale_to_m, struct nc_mesh *out);
+/* SPC's ICQ (implicitly connected quadrilateral) shape, SHAPE.TXT
+ * (mesh_icq.c): 12 Q^2 triangles, edge copies welded. */
+int nc_mesh_load_icq(const char *path, double scale_to_m, struct nc_mesh *out);
 
 /* Procedural cratered asteroid: an icosphere (20 * 4^subdivisions triangles)
  * on a triaxial ellipsoid, with smooth lumps, then craters (craters.h).

@@ -41,6 +41,7 @@ void nc_frame_free(struct nc_frame *f)
     free(f->range_m);
     free(f->coverage);
     free(f->rock_id);
+    free(f->geom);
     memset(f, 0, sizeof *f);
 }
 
@@ -447,6 +448,38 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
     }
 }
 
+const char *const nc_geom_plane_names[NC_GEOM_PLANES] = {"range_m", "x_m", "y_m", "z_m", "nx", "ny", "nz",
+                                                           "incidence_deg", "emission_deg", "phase_deg", "body"};
+
+/* The geometry planes of a packet's camera rays (nc_frame.geom). */
+static void record_geom(const struct job *j, const struct surf *sf, int px0, int py0)
+{
+    const size_t W = (size_t)j->s->camera.width_px, H = (size_t)j->s->camera.height_px, plane = W * H;
+    const double deg = 180 / M_PI;
+    for (int i = 0; i < NC_PACKET; i++) {
+        size_t x = (size_t)(px0 + (i & 3)), y = (size_t)(py0 + (i >> 2));
+        if (x >= W || y >= H)
+            continue;
+        float *g = j->f->geom + y * W + x, v[NC_GEOM_PLANES] = {0};
+        v[NC_GEOM_BODY] = -1;
+        int b = sf->body[i];
+        if (b >= 0) {
+            struct nc_vec3 p = nc_mat_tmul_v(&j->body_R[b], nc_v3_sub(sf->p[i], j->body_rel[b]));
+            struct nc_vec3 n = nc_mat_tmul_v(&j->body_R[b], sf->n[i]);
+            double c[3] = {nc_v3_dot(sf->n[i], sf->sdir[i]), -nc_v3_dot(sf->n[i], sf->d[i]),
+                           -nc_v3_dot(sf->d[i], sf->sdir[i])};
+            v[NC_GEOM_RANGE] = (float)sf->t[i];
+            v[NC_GEOM_X] = (float)p.x, v[NC_GEOM_Y] = (float)p.y, v[NC_GEOM_Z] = (float)p.z;
+            v[NC_GEOM_NX] = (float)n.x, v[NC_GEOM_NY] = (float)n.y, v[NC_GEOM_NZ] = (float)n.z;
+            for (int k = 0; k < 3; k++)
+                v[NC_GEOM_INCIDENCE + k] = (float)(acos(fmax(-1.0, fmin(1.0, c[k]))) * deg);
+            v[NC_GEOM_BODY] = (float)b;
+        }
+        for (int k = 0; k < NC_GEOM_PLANES; k++)
+            g[(size_t)k * plane] = v[k];
+    }
+}
+
 static void shade_tile(struct job *j, int tile)
 {
     const struct nc_scene *s = j->s;
@@ -523,6 +556,8 @@ static void shade_tile(struct job *j, int tile)
                             j->f->rock_id[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
                                 hit.body[i] >= 0 ? hit.rock[i] : -1;
                 surface16(j, &hit, orig, dir, &sf);
+                if (slot == 0 && j->f->geom)
+                    record_geom(j, &sf, x0 + bx, y0 + by);
                 int any = 0;
                 for (int i = 0; i < NC_PACKET; i++) {
                     if (sf.body[i] < 0)

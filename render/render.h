@@ -28,7 +28,23 @@ struct nc_frame {
      * list (boulders.h), -1 for ground, sky or no rock (an exposure with
      * time samples: at the middle one). */
     int32_t *rock_id;
+    /* Optional (the caller allocates NC_GEOM_PLANES x w x h floats;
+     * nc_frame_free frees it): the geometry the pixel's first sample saw,
+     * plane after plane (enum nc_geom_plane). At one sample a pixel
+     * (render.samples_per_pixel 1, no time samples) that is the ray through
+     * the pixel's centre. Where the sample hit nothing, body is -1 and
+     * every other plane 0. */
+    float *geom;
 };
+
+/* The planes of nc_frame.geom: range (m) along the ray; the point hit in
+ * the body-fixed frame of the body hit (m); the surface's unit normal there
+ * (body-fixed, turned toward the camera: the facet's, or the interpolated
+ * one of smooth shading); the angles of incidence, emission and phase (deg)
+ * at that point; the body's index in the scene. */
+enum nc_geom_plane { NC_GEOM_RANGE, NC_GEOM_X, NC_GEOM_Y, NC_GEOM_Z, NC_GEOM_NX, NC_GEOM_NY, NC_GEOM_NZ,
+                     NC_GEOM_INCIDENCE, NC_GEOM_EMISSION, NC_GEOM_PHASE, NC_GEOM_BODY, NC_GEOM_PLANES };
+extern const char *const nc_geom_plane_names[NC_GEOM_PLANES];
 
 struct nc_renderer {
     struct nc_rt *rt;

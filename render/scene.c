@@ -168,12 +168,16 @@ static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body 
     return 0;
 }
 
-static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun)
+/* sum_dir: the camera's SUM file gives the direction (NULL: it does not). */
+static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const struct nc_vec3 *sum_dir)
 {
     int rc, hd, hp, hdist;
     double dist_au = 1.0;
     if ((hd = nc_cfg_vec3(map, "direction", &sun->direction)) < 0)
         return hd;
+    if (sum_dir && hd)
+        return nc_cfg_error(nc_cfg_get(map, "direction"), "camera.sumfile gives the Sun's direction (SZ): remove "
+                                                          "sun.direction");
     if ((hp = nc_cfg_vec3(map, "position_m", &sun->position_m)) < 0)
         return hp;
     if ((hdist = nc_cfg_double(map, "distance_au", 1e-3, 1e4, &dist_au)) < 0)
@@ -183,6 +187,13 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun)
     sun->irradiance_override = rc;
     if (hd && hp)
         return nc_cfg_error(nc_cfg_get(map, "position_m"), "give either direction or position_m, not both");
+    if (sum_dir && !hp && !hdist && !sun->irradiance_override)
+        return nc_cfg_missing(map, "distance_au", "the heliocentric distance in au (camera.sumfile gives the Sun's "
+                                                  "direction only)");
+    if (sum_dir && !hp) {
+        sun->direction = *sum_dir;
+        hd = 1;
+    }
     if (!hd && !hp)
         return nc_cfg_missing(map, "direction", "a vector toward the Sun in the body-fixed frame, or position_m");
     if (hp && hdist)
@@ -284,17 +295,24 @@ int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s)
         if ((rc = body_from_config(bodies->child[i], (int)i, &s->body[i])) < 0)
             goto fail;
     }
-    if ((rc = nc_cfg_map(root, "sun", &sun)) <= 0) {
-        rc = rc ? rc : nc_cfg_missing(root, "sun", "a map with direction or position_m");
-        goto fail;
-    }
-    if ((rc = sun_from_config(sun, &s->sun)) < 0)
-        goto fail;
     if ((rc = nc_cfg_map(root, "camera", &cam)) <= 0) {
         rc = rc ? rc : nc_cfg_missing(root, "camera", "a map with pose and intrinsics");
         goto fail;
     }
     if ((rc = nc_camera_from_config(cam, &s->camera)) < 0)
+        goto fail;
+    if (s->camera.from_sumfile) { /* its pose is in bodies[0]'s body-fixed frame */
+        const struct nc_body *b0 = &s->body[0];
+        s->camera.position_m = nc_v3_add(b0->position_m, nc_quat_rotate(b0->attitude_q, s->camera.position_m));
+        s->camera.attitude_q = nc_quat_mul(b0->attitude_q, s->camera.attitude_q);
+    }
+    if ((rc = nc_cfg_map(root, "sun", &sun)) <= 0) {
+        rc = rc ? rc : nc_cfg_missing(root, "sun", s->camera.from_sumfile ? "a map with distance_au (the SUM file "
+                                                                            "gives the direction)"
+                                                                          : "a map with direction or position_m");
+        goto fail;
+    }
+    if ((rc = sun_from_config(sun, &s->sun, s->camera.from_sumfile ? &s->camera.sumfile_sun : NULL)) < 0)
         goto fail;
     if ((rc = nc_cfg_map(root, "render", &rnd)) < 0 || (rc = render_from_config(rnd, &s->render)) < 0)
         goto fail;
@@ -344,6 +362,7 @@ void nc_scene_free(struct nc_scene *s)
     for (int i = 0; i < s->nbodies; i++) {
         nc_mesh_free(&s->body[i].mesh);
         nc_boulders_free(&s->body[i].boulders);
+        nc_craters_free(&s->body[i].craters);
         free(s->body[i].albedo_vertex);
         s->body[i].albedo_vertex = NULL;
         nc_material_free(&s->body[i].material);

@@ -16,6 +16,7 @@
 #include "render/albedo_var.h"
 #include "render/boulders.h"
 #include "render/camera.h"
+#include "render/craters.h"
 #include "render/material.h"
 #include "render/mesh.h"
 
@@ -33,6 +34,7 @@ struct nc_body {
     struct nc_mesh mesh;    /* mesh and asteroid */
     int smooth_normals;     /* mesh and asteroid: shade with normals interpolated from the vertices' */
     struct nc_boulder_field boulders; /* none when boulders.n == 0 (meshes only) */
+    struct nc_crater_field craters;   /* carved into the mesh (oldest first); none when craters.n == 0 */
     /* Procedural albedo variation (meshes only): its parameters, and the
      * ground's factor per mesh vertex (NULL: none). */
     struct nc_albedo_var_params albedo_var;

@@ -89,7 +89,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         nc_log_info("scene", "body '%s': %zu craters of %.3g to %.3g m (N(>1 m) = %.4g per km^2, slope %g, seed %llu), "
                     "%zu resolved by the mesh", b->name, f.n, p.d_min_m, p.d_max_m, p.c_per_km2, p.slope,
                     (unsigned long long)p.seed, f.applied);
-    nc_craters_free(&f);
+    b->craters = f; /* kept: `navcam batch` lists the craters in view */
     b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
     return 0;
 }

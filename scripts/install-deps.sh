@@ -7,7 +7,8 @@
 #                            built by dkms, qemu, busybox), the plate solver
 #                            (astrometry.net with its Tycho-2 index files for
 #                            fields of 1 to 33 degrees' quads) and the star
-#                            catalogue below
+#                            catalogue below, and a single-node Slurm
+#                            (slurmctld, slurmd, munge) for navcam batch
 #   install-deps.sh --stars  also the star catalogue: KStars' stars.dat
 #                            (Hipparcos and Tycho, V <= 8.99, J2000, GPL-2+ as
 #                            Debian ships it) taken out of the kstars-data
@@ -22,7 +23,7 @@ pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev
 case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
 if [ "${1:-}" = --test ]; then
   pkgs+=(clang libclang-rt-14-dev aravis-tools-cli gpiod v4l-utils astrometry.net
-         astrometry-data-tycho2-10-19-littleendian)
+         astrometry-data-tycho2-10-19-littleendian slurmctld slurmd slurm-client munge)
   case "$(uname -m)" in
     x86_64) pkgs+=(qemu-system-x86 busybox-static cpio kmod xz-utils dkms linux-headers-amd64 v4l2loopback-dkms udev) ;;
   esac

@@ -1,0 +1,403 @@
+/* cmd_batch.c - `navcam batch TRAJ.csv -o DIR`: a trajectory rendered to a
+ * dataset, one frame per row with its ground truth; deterministic per
+ * frame, resumable, and shardable over processes (Slurm job arrays,
+ * docs/batch.md). Argument parsing and files; the frame is camera/shot.h's. */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "app/cli.h"
+#include "camera/load.h"
+#include "camera/shot.h"
+#include "core/error.h"
+#include "core/traj.h"
+
+static const char batch_help[] =
+    "Usage: navcam batch TRAJ.csv -o DIR [--scene SCENE.yaml] [--set KEY=VALUE]... [options]\n"
+    "\n"
+    "Render every row of TRAJ.csv (the layouts of `navcam replay --help`: pose rows,\n"
+    "or SPC SUM-like rows) with SCENE.yaml (default: the built-in scene) into DIR.\n"
+    "Row i (0-based, counting data rows; rows with capture 0 are skipped) gives:\n"
+    "  DIR/frame_NNNNNN.EXT            the frame (--quantity, --format); the camera\n"
+    "                                  model's noise is keyed by i, so a frame's\n"
+    "                                  bytes depend only on the scene and its row\n"
+    "  DIR/frame_NNNNNN_geometry.fits  ground-truth planes at pixel centres: range_m,\n"
+    "                                  x_m y_m z_m (the point seen, body-fixed), nx ny nz\n"
+    "                                  (its normal), incidence_deg emission_deg\n"
+    "                                  phase_deg, body (-1: sky; other planes 0 there)\n"
+    "  DIR/frame_NNNNNN_boulders.csv   the boulders seen (bodies with boulders)\n"
+    "  DIR/frame_NNNNNN_craters.csv    the craters whose centre is seen (bodies with\n"
+    "                                  craters)\n"
+    "  DIR/frame_NNNNNN.json           the row's pose, Sun, bodies, camera and render\n"
+    "                                  settings and the files above; written last\n"
+    "A row whose .json exists is done and skipped: rerun the same command after a\n"
+    "crash to finish. Files are written under temporary names and renamed.\n"
+    "\n"
+    "  -o, --output DIR      the dataset directory (made if missing)\n"
+    "      --scene FILE      the scene (default: the built-in default scene)\n"
+    "  -s, --set KEY=VALUE   override a scene key (as navcam render); repeatable\n"
+    "  -q, --quantity Q      dn (default), electrons, radiance, iof, range or rock_id\n"
+    "  -F, --format EXT      fits (default), tif, exr or png\n"
+    "  -e, --exposure T      exposure time, s (default: exposure.time_s)\n"
+    "      --shard K/N       render only rows i with i mod N = K (0 <= K < N): N\n"
+    "                        processes, e.g. a Slurm job array with\n"
+    "                        --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT,\n"
+    "                        write the same files as one\n"
+    "      --no-geometry     skip the geometry planes and the lists\n"
+    "  -j, --threads N       render threads (default: render.threads, else all cores)\n"
+    "  -h, --help            this help\n";
+
+static void json_vec(FILE *f, const char *key, const double *v, int n, const char *sep)
+{
+    fprintf(f, "\"%s\": [", key);
+    for (int i = 0; i < n; i++)
+        fprintf(f, "%.17g%s", v[i], i + 1 < n ? ", " : "");
+    fprintf(f, "]%s", sep);
+}
+
+/* Write through a temporary name, renamed when complete. */
+static int finish(const char *tmp, const char *path)
+{
+    if (rename(tmp, path) < 0)
+        return nc_error(-errno, "%s: rename to %s: %s", tmp, path, strerror(errno));
+    return 0;
+}
+
+/* The boulders and craters seen in a geometry render, as CSV files. */
+static int lists(const char *dir, const char *stem, const struct nc_scene *s, const float *geom,
+                 const int32_t *rock, int *nrocks, int *ncraters)
+{
+    const struct nc_camera *c = &s->camera;
+    const size_t plane = (size_t)c->width_px * (size_t)c->height_px;
+    char tmp[4200], path[4200];
+    int rc = 0;
+    *nrocks = *ncraters = -1;
+    int any_rocks = 0, any_craters = 0;
+    for (int b = 0; b < s->nbodies; b++) {
+        any_rocks |= s->body[b].boulders.n > 0;
+        any_craters |= s->body[b].craters.n > 0;
+    }
+    if (any_rocks) {
+        snprintf(tmp, sizeof tmp, "%s/.%s_boulders.csv.tmp", dir, stem);
+        FILE *f = fopen(tmp, "w");
+        if (!f)
+            return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+        fprintf(f, "body,index,x_m,y_m,z_m,diameter_m,pixels\n");
+        *nrocks = 0;
+        for (int b = 0; b < s->nbodies && rc == 0; b++) {
+            const struct nc_boulder_field *bf = &s->body[b].boulders;
+            if (!bf->n)
+                continue;
+            uint32_t *px = calloc(bf->n, sizeof *px);
+            if (!px) {
+                rc = nc_error(-ENOMEM, "out of memory");
+                break;
+            }
+            for (size_t i = 0; i < plane; i++)
+                if (rock[i] >= 0 && geom[NC_GEOM_BODY * plane + i] == b && (size_t)rock[i] < bf->n)
+                    px[rock[i]]++;
+            for (size_t k = 0; k < bf->n; k++)
+                if (px[k]) {
+                    const struct nc_boulder *r = &bf->rock[k];
+                    fprintf(f, "%d,%zu,%.9g,%.9g,%.9g,%.6g,%u\n", b, k, r->centre_m[0], r->centre_m[1], r->centre_m[2],
+                            2.0 * r->half_m, px[k]);
+                    (*nrocks)++;
+                }
+            free(px);
+        }
+        if (fclose(f) != 0 && rc == 0)
+            rc = nc_error(-EIO, "%s: write failed", tmp);
+        snprintf(path, sizeof path, "%s/%s_boulders.csv", dir, stem);
+        if (rc < 0 || (rc = finish(tmp, path)) < 0)
+            return rc;
+    }
+    if (any_craters) {
+        snprintf(tmp, sizeof tmp, "%s/.%s_craters.csv.tmp", dir, stem);
+        FILE *f = fopen(tmp, "w");
+        if (!f)
+            return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+        fprintf(f, "body,index,x_m,y_m,z_m,diameter_m,age,sample_px,line_px\n");
+        *ncraters = 0;
+        struct nc_mat3 cam = nc_quat_to_mat(c->attitude_q);
+        for (int b = 0; b < s->nbodies; b++) {
+            const struct nc_body *body = &s->body[b];
+            struct nc_mat3 R = nc_quat_to_mat(body->attitude_q);
+            for (size_t k = 0; k < body->craters.n; k++) {
+                const struct nc_crater *cr = &body->craters.crater[k];
+                struct nc_vec3 cb = nc_v3(cr->centre_m[0], cr->centre_m[1], cr->centre_m[2]);
+                struct nc_vec3 w = nc_v3_add(body->position_m, nc_mat_mul_v(&R, cb));
+                struct nc_vec3 v = nc_mat_tmul_v(&cam, nc_v3_sub(w, c->position_m));
+                double x, y;
+                if (!(v.z > 0) || nc_camera_project(c, v, &x, &y) < 0)
+                    continue;
+                if (c->flip_cols)
+                    x = c->width_px - 1 - x;
+                if (c->flip_rows)
+                    y = c->height_px - 1 - y;
+                long ix = lround(x), iy = lround(y);
+                if (ix < 0 || iy < 0 || ix >= c->width_px || iy >= c->height_px)
+                    continue;
+                size_t o = (size_t)iy * (size_t)c->width_px + (size_t)ix;
+                /* seen: the surface at that pixel is this body, within half a diameter of the centre */
+                double dx = geom[NC_GEOM_X * plane + o] - cb.x, dy = geom[NC_GEOM_Y * plane + o] - cb.y,
+                       dz = geom[NC_GEOM_Z * plane + o] - cb.z;
+                if (geom[NC_GEOM_BODY * plane + o] != b || sqrt(dx * dx + dy * dy + dz * dz) > 0.5 * cr->d_m)
+                    continue;
+                fprintf(f, "%d,%zu,%.9g,%.9g,%.9g,%.6g,%.6g,%.3f,%.3f\n", b, k, cb.x, cb.y, cb.z, cr->d_m, cr->age, x,
+                        y);
+                (*ncraters)++;
+            }
+        }
+        if (fclose(f) != 0)
+            return nc_error(-EIO, "%s: write failed", tmp);
+        snprintf(path, sizeof path, "%s/%s_craters.csv", dir, stem);
+        if ((rc = finish(tmp, path)) < 0)
+            return rc;
+    }
+    return 0;
+}
+
+static int truth(const char *dir, const char *stem, const char *ext, int geometry, long row,
+                 const struct nc_traj_row *tr, const struct nc_scene *s, enum nc_quantity q, double exposure,
+                 const char *quality, int nrocks, int ncraters)
+{
+    char tmp[4200], path[4200];
+    snprintf(tmp, sizeof tmp, "%s/.%s.json.tmp", dir, stem);
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+    const struct nc_camera *c = &s->camera;
+    fprintf(f, "{\"row\": %ld, \"line\": %d, \"t_s\": %.17g,\n", row, tr->line, tr->t_s);
+    fprintf(f, " \"image\": \"%s.%s\", \"quantity\": \"%s\", \"units\": \"%s\", \"exposure_s\": %.17g, "
+               "\"frame_number\": %ld,\n",
+            stem, ext, nc_quantity_names[q], nc_quantity_units(q), exposure, row);
+    if (geometry) {
+        fprintf(f, " \"geometry\": \"%s_geometry.fits\", \"geometry_planes\": [", stem);
+        for (int k = 0; k < NC_GEOM_PLANES; k++)
+            fprintf(f, "\"%s\"%s", nc_geom_plane_names[k], k + 1 < NC_GEOM_PLANES ? ", " : "],\n");
+        if (nrocks >= 0)
+            fprintf(f, " \"boulders\": \"%s_boulders.csv\", \"boulders_in_view\": %d,\n", stem, nrocks);
+        if (ncraters >= 0)
+            fprintf(f, " \"craters\": \"%s_craters.csv\", \"craters_in_view\": %d,\n", stem, ncraters);
+    }
+    double v[4];
+    fprintf(f, " \"camera\": {");
+    v[0] = c->position_m.x, v[1] = c->position_m.y, v[2] = c->position_m.z;
+    json_vec(f, "position_m", v, 3, ", ");
+    v[0] = c->attitude_q.w, v[1] = c->attitude_q.x, v[2] = c->attitude_q.y, v[3] = c->attitude_q.z;
+    json_vec(f, "attitude_q", v, 4, ", ");
+    fprintf(f, "\"width_px\": %d, \"height_px\": %d, ", c->width_px, c->height_px);
+    v[0] = c->fx_px, v[1] = c->fy_px, v[2] = c->cx_px, v[3] = c->cy_px;
+    json_vec(f, "fx_fy_cx_cy_px", v, 4, ", ");
+    fprintf(f, "\"mirrored_rows\": %d, \"mirrored_columns\": %d},\n", c->flip_rows, c->flip_cols);
+    struct nc_vec3 sd;
+    double irr;
+    nc_scene_sun_at(s, s->body[0].position_m, &sd, &irr);
+    fprintf(f, " \"sun\": {");
+    v[0] = s->sun.direction.x, v[1] = s->sun.direction.y, v[2] = s->sun.direction.z;
+    if (!s->sun.has_position)
+        json_vec(f, "direction_body0", v, 3, ", ");
+    v[0] = sd.x, v[1] = sd.y, v[2] = sd.z;
+    json_vec(f, "direction_scene", v, 3, ", ");
+    fprintf(f, "\"distance_m\": %.17g, \"irradiance_w_m2\": %.17g},\n \"bodies\": [", s->sun.distance_m, irr);
+    for (int b = 0; b < s->nbodies; b++) {
+        const struct nc_body *bd = &s->body[b];
+        fprintf(f, "{\"name\": \"%s\", ", bd->name);
+        v[0] = bd->position_m.x, v[1] = bd->position_m.y, v[2] = bd->position_m.z;
+        json_vec(f, "position_m", v, 3, ", ");
+        v[0] = bd->attitude_q.w, v[1] = bd->attitude_q.x, v[2] = bd->attitude_q.y, v[3] = bd->attitude_q.z;
+        json_vec(f, "attitude_q", v, 4, "}");
+        fprintf(f, "%s", b + 1 < s->nbodies ? ", " : "],\n");
+    }
+    fprintf(f, " \"render\": {\"samples_per_pixel\": %d, \"seed\": %llu, \"bounces\": %d, \"soft_shadows\": %d, "
+               "\"quality\": \"%s\"}}\n",
+            s->render.samples_per_pixel, (unsigned long long)s->render.seed, s->render.bounces, s->render.soft_shadows,
+            quality[0] ? quality : "manual");
+    if (fclose(f) != 0)
+        return nc_error(-EIO, "%s: write failed", tmp);
+    snprintf(path, sizeof path, "%s/%s.json", dir, stem);
+    return finish(tmp, path);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+int main(int argc, char **argv)
+{
+    nc_cli_init("batch");
+    static const struct option opts[] = {
+        {"output", required_argument, NULL, 'o'},  {"scene", required_argument, NULL, 'S'},
+        {"set", required_argument, NULL, 's'},     {"quantity", required_argument, NULL, 'q'},
+        {"format", required_argument, NULL, 'F'},  {"exposure", required_argument, NULL, 'e'},
+        {"shard", required_argument, NULL, 'K'},   {"no-geometry", no_argument, NULL, 'G'},
+        {"threads", required_argument, NULL, 'j'}, {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+    };
+    const char *dir = NULL, *scene_path = NULL, *ext = "fits";
+    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+    int nsets = 0, threads = 0, geometry = 1, c;
+    long shard_k = 0, shard_n = 1;
+    double exposure = -1;
+    enum nc_quantity q = NC_Q_DN;
+    if (!sets)
+        return 1;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "o:s:q:F:e:j:h", opts, NULL)) != -1) {
+        char *end;
+        switch (c) {
+        case 'o': dir = optarg; break;
+        case 'S': scene_path = optarg; break;
+        case 's': sets[nsets++] = optarg; break;
+        case 'G': geometry = 0; break;
+        case 'F':
+            ext = optarg;
+            if (strcmp(ext, "fits") && strcmp(ext, "tif") && strcmp(ext, "exr") && strcmp(ext, "png")) {
+                fprintf(stderr, "navcam batch: --format expects fits, tif, exr or png, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case 'q':
+            if (nc_quantity_parse(optarg, &q) < 0) {
+                fprintf(stderr, "navcam batch: %s\n", nc_errmsg());
+                return 2;
+            }
+            break;
+        case 'e':
+            exposure = strtod(optarg, &end);
+            if (*end || !(exposure >= 0 && exposure <= 3600)) {
+                fprintf(stderr, "navcam batch: --exposure expects seconds in 0..3600, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case 'K':
+            shard_k = strtol(optarg, &end, 10);
+            if (*end == '/')
+                shard_n = strtol(end + 1, &end, 10);
+            if (*end || optarg[0] == '/' || !strchr(optarg, '/') || shard_n < 1 || shard_n > 1000000 ||
+                shard_k < 0 || shard_k >= shard_n) {
+                fprintf(stderr, "navcam batch: --shard expects K/N with 0 <= K < N, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case 'j':
+            threads = (int)strtol(optarg, &end, 10);
+            if (*end || threads < 1 || threads > 1024) {
+                fprintf(stderr, "navcam batch: --threads expects 1..1024, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case 'h': fputs(batch_help, stdout); return 0;
+        default: fputs("Try 'navcam batch --help'.\n", stderr); return 2;
+        }
+    }
+    if (argc - optind != 1 || !dir) {
+        fprintf(stderr, "navcam batch: %s\nTry 'navcam batch --help'.\n",
+                !dir ? "missing -o DIR" : "give one trajectory (TRAJ.csv or builtin:approach)");
+        return 2;
+    }
+    struct nc_traj_row *rows = NULL;
+    int nrows = nc_traj_read(argv[optind], &rows);
+    if (nrows < 0)
+        return nc_cli_fail();
+    if (mkdir(dir, 0777) < 0 && errno != EEXIST) {
+        fprintf(stderr, "navcam batch: %s: %s\n", dir, strerror(errno));
+        return 1;
+    }
+    struct nc_scene base;
+    struct nc_camsys cs;
+    struct nc_sky sky;
+    int rc = nc_setup_load(scene_path, sets, nsets, &base, &cs);
+    if (rc >= 0 && (rc = nc_sky_load(scene_path, sets, nsets, &sky)) >= 0 &&
+        (rc = nc_sky_prepare(&sky, &cs, &base.camera)) < 0)
+        nc_sky_free(&sky);
+    free(sets);
+    if (rc < 0) {
+        free(rows);
+        return nc_cli_fail();
+    }
+    if (exposure < 0)
+        exposure = cs.exposure_s;
+    struct nc_renderer r;
+    if ((rc = nc_renderer_init(&r, &base, threads)) < 0) {
+        nc_scene_free(&base);
+        nc_sky_free(&sky);
+        free(rows);
+        return nc_cli_fail();
+    }
+    const size_t plane = (size_t)base.camera.width_px * (size_t)base.camera.height_px;
+    float *geom = geometry ? malloc(NC_GEOM_PLANES * plane * sizeof *geom) : NULL;
+    int32_t *rock = geometry ? malloc(plane * sizeof *rock) : NULL;
+    if (geometry && (!geom || !rock))
+        rc = nc_error(-ENOMEM, "out of memory for the geometry planes");
+    long done = 0, skipped = 0, mine = 0;
+    double t_all = now_s();
+    for (long i = 0; i < nrows && rc >= 0; i++) {
+        if (i % shard_n != shard_k || !rows[i].capture)
+            continue;
+        mine++;
+        char stem[32], path[4200], tmp[4200];
+        snprintf(stem, sizeof stem, "frame_%06ld", i);
+        snprintf(path, sizeof path, "%s/%s.json", dir, stem);
+        if (access(path, F_OK) == 0) {
+            skipped++;
+            continue;
+        }
+        double t0 = now_s();
+        struct nc_scene s = base; /* shares the meshes; render settings fresh per row */
+        struct nc_pose pose;
+        nc_scene_pose(&base, 0, &pose);
+        pose.cam_position_m = rows[i].p;
+        pose.cam_attitude_q = rows[i].q;
+        pose.sun = nc_v3_unit(rows[i].sun);
+        pose.sun_is_position = 0;
+        nc_scene_apply_pose(&s, &pose);
+        struct nc_shot_info info;
+        snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%s", dir, stem, ext);
+        snprintf(path, sizeof path, "%s/%s.%s", dir, stem, ext);
+        char rowtxt[32];
+        snprintf(rowtxt, sizeof rowtxt, "%ld", i);
+        const struct nc_image_attr extra[] = {{"navcam:batch_row", rowtxt}};
+        if ((rc = nc_shot(&r, &s, &cs, &sky, q, exposure, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
+            (rc = finish(tmp, path)) < 0)
+            break;
+        int nrocks = -1, ncraters = -1;
+        if (geometry) {
+            snprintf(tmp, sizeof tmp, "%s/.%s_geometry.tmp.fits", dir, stem);
+            snprintf(path, sizeof path, "%s/%s_geometry.fits", dir, stem);
+            if ((rc = nc_shot_geometry(&r, &s, geom, rock)) < 0 ||
+                (rc = nc_image_write_planes(tmp, geom, s.camera.width_px, s.camera.height_px, NC_GEOM_PLANES,
+                                            nc_geom_plane_names, extra, 1)) < 0 ||
+                (rc = finish(tmp, path)) < 0 || (rc = lists(dir, stem, &s, geom, rock, &nrocks, &ncraters)) < 0)
+                break;
+        }
+        if ((rc = truth(dir, stem, ext, geometry, i, &rows[i], &s, q, exposure, info.quality, nrocks, ncraters)) < 0)
+            break;
+        done++;
+        printf("%s (row %ld, t = %.6g s): %.0f ms\n", stem, i, rows[i].t_s, 1e3 * (now_s() - t0));
+        fflush(stdout);
+    }
+    double el = now_s() - t_all;
+    if (rc >= 0)
+        printf("navcam batch: shard %ld/%ld: %ld of %d rows are this shard's; %ld rendered, %ld already done; %.1f s "
+               "(%.0f frames per hour)\n",
+               shard_k, shard_n, mine, nrows, done, skipped, el, el > 0 ? done * 3600 / el : 0.0);
+    free(geom);
+    free(rock);
+    free(rows);
+    nc_renderer_free(&r);
+    nc_scene_free(&base);
+    nc_camsys_free(&cs);
+    nc_sky_free(&sky);
+    return rc < 0 ? nc_cli_fail() : 0;
+}

@@ -1,0 +1,218 @@
+/* cmd_compare.c - `navcam compare REAL RENDER`: a real image against a
+ * rendered one, the seed paper's procedure (core/imgcmp.h), as JSON and
+ * plots. Argument parsing, files and plotting only. */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "app/cli.h"
+#include "core/error.h"
+#include "core/imgcmp.h"
+#include "render/image_io.h"
+
+static const char compare_help[] =
+    "Usage: navcam compare REAL RENDER [-o DIR] [--fit F] [--register R] [--json FILE]\n"
+    "\n"
+    "Compare a real image with a rendered one of the same size (any format\n"
+    "navcam reads: FITS, TIFF, EXR, PNG; the first channel):\n"
+    "  1. Otsu's threshold on REAL splits foreground (the body) from background;\n"
+    "     only the foreground is compared (the background is not simulated).\n"
+    "  2. --register R: RENDER is moved by the shift, found to 1/64 px within\n"
+    "     +-R px, that maximises its correlation with REAL (cubic interpolation).\n"
+    "  3. --fit: the render's intensities are matched to REAL's foreground:\n"
+    "       scale      (default) one factor k, least squares: REAL ~ k RENDER\n"
+    "       histogram  the render's foreground values replaced by REAL's, by rank\n"
+    "       none       compared as they are (both in the same units)\n"
+    "  4. Measured over the foreground: the relative error (RENDER' - REAL)/REAL,\n"
+    "     its mean, median, RMS, 95th percentile of |error| and mean (bias);\n"
+    "     the correlation (NCC) at full resolution and of 2, 4, 8 and 16 px block\n"
+    "     means; the limb IoU: overlap of the two silhouettes, each by its own\n"
+    "     Otsu threshold, |A and B| / |A or B|.\n"
+    "\n"
+    "  -o, --output DIR     also write DIR/relative_error.fits (the signed map,\n"
+    "                       float32, 0 off the foreground), DIR/relative_error.png\n"
+    "                       (the map), DIR/error_histogram.png and .csv (gnuplot)\n"
+    "  -f, --fit F          scale, histogram or none (default scale)\n"
+    "  -r, --register R     search shifts within R px (default 0: no registration)\n"
+    "  -j, --json FILE      the results as JSON in FILE (default: standard output)\n"
+    "  -h, --help           this help\n"
+    "\n"
+    "The JSON: real, render, width, height, fit, scale, shift_px [dx, dy]\n"
+    "(RENDER moved right and down), threshold_real, threshold_render,\n"
+    "foreground_px, relative_error {mean, median, rms, p95, bias}, ncc {1, 2, 4,\n"
+    "8, 16: NCC of block means, null when undefined}, limb_iou.\n";
+
+static int plots(const char *dir, const float *rel, int w, int h, const struct nc_imgcmp_result *res)
+{
+    char path[4096];
+    size_t n = (size_t)w * (size_t)h;
+    double hi = fmax(3 * res->rel_p95, 1e-6);
+    enum { NB = 100 };
+    size_t count[NB];
+    nc_imgcmp_histogram(rel, n, -hi, hi, NB, count);
+    snprintf(path, sizeof path, "%s/error_histogram.csv", dir);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    fprintf(f, "bin_centre,pixels\n");
+    for (int b = 0; b < NB; b++)
+        fprintf(f, "%.6g,%zu\n", -hi + (b + 0.5) * 2 * hi / NB, count[b]);
+    fclose(f);
+    /* The map as raw float32 for gnuplot, rows top first. */
+    snprintf(path, sizeof path, "%s/.relative_error.f32", dir);
+    if (!(f = fopen(path, "wb")))
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    fwrite(rel, sizeof *rel, n, f);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/.compare.gp", dir);
+    if (!(f = fopen(path, "w")))
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    fprintf(f,
+            "set terminal pngcairo size 900,800 font ',10'\nset output 'relative_error.png'\n"
+            "set title 'relative error (render - real) / real over the foreground: mean |e| %.4g, p95 %.4g'\n"
+            "set size ratio -1\nset yrange [%d:-0.5] reverse\nset xrange [-0.5:%d]\nset xlabel 'x, px'\n"
+            "set ylabel 'y, px'\nset palette defined (-1 'blue', 0 'white', 1 'red')\nset cbrange [%g:%g]\n"
+            "set datafile missing NaN\nplot '.relative_error.f32' binary array=(%d,%d) format='%%float' "
+            "with image notitle\n"
+            "set terminal pngcairo size 900,600 font ',10'\nset output 'error_histogram.png'\nunset size\n"
+            "set autoscale\nset yrange [0:*]\nset title 'foreground pixels by relative error'\n"
+            "set xlabel '(render - real) / real'\nset ylabel 'pixels'\nset datafile separator ','\nset grid\n"
+            "plot 'error_histogram.csv' using 1:2 skip 1 with boxes fill solid 0.5 notitle\n",
+            res->rel_mean, res->rel_p95, h - 1, w - 1, -hi, hi, w, h);
+    fclose(f);
+    char cmd[4300];
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot .compare.gp 2>&1 && rm -f .compare.gp .relative_error.f32", dir);
+    if (system(cmd) != 0)
+        return nc_error(NC_EIMAGE, "%s: gnuplot failed to draw the plots (is gnuplot installed?)", dir);
+    snprintf(path, sizeof path, "%s/relative_error.fits", dir);
+    return nc_image_write(path, rel, w, h, NULL, 0, NULL);
+}
+
+static void json_num(FILE *f, const char *key, double v, const char *sep)
+{
+    if (isfinite(v))
+        fprintf(f, "\"%s\": %.9g%s", key, v, sep);
+    else
+        fprintf(f, "\"%s\": null%s", key, sep);
+}
+
+static void json_str(FILE *f, const char *key, const char *v)
+{
+    fprintf(f, "\"%s\": \"", key);
+    for (; *v; v++)
+        fprintf(f, *v == '"' || *v == '\\' ? "\\%c" : (unsigned char)*v < 32 ? "?" : "%c", *v);
+    fprintf(f, "\", ");
+}
+
+int main(int argc, char **argv)
+{
+    nc_cli_init("compare");
+    static const struct option opts[] = {
+        {"output", required_argument, NULL, 'o'}, {"fit", required_argument, NULL, 'f'},
+        {"register", required_argument, NULL, 'r'}, {"json", required_argument, NULL, 'j'},
+        {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+    };
+    static const char *const fits[] = {"none", "scale", "histogram", NULL};
+    const char *dir = NULL, *json = NULL;
+    int fit = NC_FIT_SCALE, radius = 0, c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "o:f:r:j:h", opts, NULL)) != -1) {
+        switch (c) {
+        case 'o': dir = optarg; break;
+        case 'j': json = optarg; break;
+        case 'f':
+            for (fit = 0; fits[fit] && strcmp(fits[fit], optarg); fit++)
+                ;
+            if (!fits[fit]) {
+                fprintf(stderr, "navcam compare: --fit expects scale, histogram or none, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case 'r': {
+            char *end;
+            long v = strtol(optarg, &end, 10);
+            if (*end || v < 0 || v > 256) {
+                fprintf(stderr, "navcam compare: --register expects a radius of 0..256 px, got '%s'\n", optarg);
+                return 2;
+            }
+            radius = (int)v;
+            break;
+        }
+        case 'h': fputs(compare_help, stdout); return 0;
+        default: fputs("Try 'navcam compare --help'.\n", stderr); return 2;
+        }
+    }
+    if (argc - optind != 2) {
+        fprintf(stderr, "navcam compare: give two images, REAL and RENDER\nTry 'navcam compare --help'.\n");
+        return 2;
+    }
+    const char *real_path = argv[optind], *render_path = argv[optind + 1];
+    float *real = NULL, *render = NULL, *moved = NULL, *rel = NULL;
+    int w, h, w2, h2, rc;
+    double dx = 0, dy = 0;
+    struct nc_imgcmp_result res;
+    if ((rc = nc_image_read(real_path, &real, &w, &h)) < 0 || (rc = nc_image_read(render_path, &render, &w2, &h2)) < 0)
+        goto done;
+    if (w != w2 || h != h2) {
+        rc = nc_error(NC_ERANGE, "%s is %dx%d but %s is %dx%d: the images must have the same size", real_path, w, h,
+                      render_path, w2, h2);
+        goto done;
+    }
+    if (dir && mkdir(dir, 0777) < 0 && errno != EEXIST) {
+        rc = nc_error(-errno, "%s: %s", dir, strerror(errno));
+        goto done;
+    }
+    size_t n = (size_t)w * (size_t)h;
+    if (!(rel = malloc(n * sizeof *rel)) || !(moved = malloc(n * sizeof *moved))) {
+        rc = nc_error(-ENOMEM, "out of memory");
+        goto done;
+    }
+    memcpy(moved, render, n * sizeof *moved);
+    if (radius > 0) {
+        if ((rc = nc_imgcmp_register(real, render, w, h, radius, &dx, &dy)) < 0)
+            goto done;
+        nc_imgcmp_shift(render, w, h, dx, dy, moved);
+    }
+    if ((rc = nc_imgcmp(real, moved, w, h, (enum nc_imgcmp_fit)fit, &res, rel)) < 0)
+        goto done;
+    if (dir && (rc = plots(dir, rel, w, h, &res)) < 0)
+        goto done;
+    FILE *out = json ? fopen(json, "w") : stdout;
+    if (!out) {
+        rc = nc_error(-errno, "%s: %s", json, strerror(errno));
+        goto done;
+    }
+    fprintf(out, "{");
+    json_str(out, "real", real_path);
+    json_str(out, "render", render_path);
+    fprintf(out, "\"width\": %d, \"height\": %d, ", w, h);
+    json_str(out, "fit", fits[fit]);
+    json_num(out, "scale", res.scale, ", ");
+    fprintf(out, "\"shift_px\": [%.6f, %.6f], ", dx, dy);
+    json_num(out, "threshold_real", res.threshold_real, ", ");
+    json_num(out, "threshold_render", res.threshold_render, ", ");
+    fprintf(out, "\"foreground_px\": %zu, \"relative_error\": {", res.foreground_px);
+    json_num(out, "mean", res.rel_mean, ", ");
+    json_num(out, "median", res.rel_median, ", ");
+    json_num(out, "rms", res.rel_rms, ", ");
+    json_num(out, "p95", res.rel_p95, ", ");
+    json_num(out, "bias", res.rel_bias, "}, \"ncc\": {");
+    for (int k = 0; k < 5; k++) {
+        char key[8];
+        snprintf(key, sizeof key, "%d", nc_imgcmp_blocks[k]);
+        json_num(out, key, res.ncc[k], k < 4 ? ", " : "}, ");
+    }
+    json_num(out, "limb_iou", res.limb_iou, "}\n");
+    if (json)
+        fclose(out);
+done:
+    free(real);
+    free(render);
+    free(moved);
+    free(rel);
+    return rc < 0 ? nc_cli_fail() : 0;
+}

@@ -1,0 +1,198 @@
+/* shot.c - one frame of a scene to an image file (shot.h). */
+#include "camera/shot.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "camera/load.h"
+#include "camera/quality.h"
+#include "core/error.h"
+#include "render/image_io.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static void flip_plane(void *px, size_t elem, int w, int h, int rows, int cols)
+{
+    unsigned char *p = px, tmp[8];
+    const size_t W = (size_t)w, H = (size_t)h;
+    if (rows)
+        for (size_t y = 0; y < H / 2; y++)
+            for (size_t x = 0; x < W; x++) {
+                unsigned char *a = p + (y * W + x) * elem, *b = p + ((H - 1 - y) * W + x) * elem;
+                memcpy(tmp, a, elem);
+                memcpy(a, b, elem);
+                memcpy(b, tmp, elem);
+            }
+    if (cols)
+        for (size_t y = 0; y < H; y++)
+            for (size_t x = 0; x < W / 2; x++) {
+                unsigned char *a = p + (y * W + x) * elem, *b = p + (y * W + W - 1 - x) * elem;
+                memcpy(tmp, a, elem);
+                memcpy(a, b, elem);
+                memcpy(b, tmp, elem);
+            }
+}
+
+void nc_frame_flip(struct nc_frame *f, int rows, int cols)
+{
+    if (!rows && !cols)
+        return;
+    float *planes[] = {f->radiance, f->iof, f->range_m, f->coverage};
+    for (int i = 0; i < 4; i++)
+        if (planes[i])
+            flip_plane(planes[i], sizeof(float), f->width_px, f->height_px, rows, cols);
+    if (f->rock_id)
+        flip_plane(f->rock_id, sizeof *f->rock_id, f->width_px, f->height_px, rows, cols);
+    for (int k = 0; f->geom && k < NC_GEOM_PLANES; k++)
+        flip_plane(f->geom + (size_t)k * (size_t)f->width_px * (size_t)f->height_px, sizeof(float), f->width_px,
+                   f->height_px, rows, cols);
+}
+
+/* Electrons (float) or a digitised frame of a rendered radiance image (the
+ * camera model's render size: the sensor plus the PSF's margin). */
+static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
+                              const struct nc_camsys *cs, double exposure, unsigned long long frame_no,
+                              const struct nc_image_attr *extra, int nextra, double *scale)
+{
+    const int W = cs->width_px, H = cs->height_px;
+    size_t n = (size_t)W * (size_t)H;
+    float *e = malloc(n * sizeof *e);
+    uint16_t *dn = malloc(n * sizeof *dn);
+    struct nc_image_attr attrs[40];
+    char text[32][200];
+    int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
+    int na = nc_frame_meta(s, q, attrs, text, 32);
+    na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 31 - na);
+    for (int i = 0; i < nextra && na < 40; i++)
+        attrs[na++] = extra[i];
+    if (rc >= 0 && q == NC_Q_ELECTRONS)
+        rc = nc_image_write(out, e, W, H, attrs, na, scale);
+    else if (rc >= 0 && (rc = nc_camsys_digitise(cs, e, exposure, frame_no, dn)) >= 0)
+        rc = nc_image_write_dn(out, dn, W, H, cs->sensor.adc_bits, attrs, na);
+    free(e);
+    free(dn);
+    return rc;
+}
+
+int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsys *cs, struct nc_sky *sky,
+            enum nc_quantity q, double exposure, uint64_t frame_no, const char *out,
+            const struct nc_image_attr *extra_in, int nextra_in, struct nc_shot_info *info)
+{
+    memset(info, 0, sizeof *info);
+    struct nc_frame f = {0};
+    double t1 = now_ms();
+    /* Electrons and DN go through the camera model, whose PSF needs the
+     * light from a margin around the field: render that larger image. */
+    struct nc_scene drawn = *scene;
+    if (q > NC_Q_ROCK_ID)
+        nc_camsys_render_camera(cs, &scene->camera, &drawn.camera);
+    int rc = nc_frame_alloc(&f, drawn.camera.width_px, drawn.camera.height_px);
+    if (rc >= 0 && q == NC_Q_ROCK_ID &&
+        !(f.rock_id = malloc((size_t)f.width_px * (size_t)f.height_px * sizeof *f.rock_id)))
+        rc = nc_error(-ENOMEM, "out of memory");
+    /* Motion during the exposure (camera and body rates) and a rolling
+     * shutter are integrated over the exposure window. */
+    struct nc_exposure ex = {.exposure_s = exposure, .rolling = cs->sensor.shutter == NC_SHUTTER_ROLLING,
+                             .line_time_s = cs->sensor.line_time_s};
+    info->time_samples = 1;
+    /* render.quality: auto picks the settings from the camera's noise, for
+     * the sensor's own render camera whatever the quantity */
+    if (rc >= 0 && scene->render.quality_auto) {
+        struct nc_scene sensor = drawn;
+        struct nc_quality_choice qc;
+        nc_camsys_render_camera(cs, &scene->camera, &sensor.camera);
+        if ((rc = nc_quality_auto(r, &sensor, cs, exposure, &qc)) >= 0) {
+            drawn.render = sensor.render;
+            scene->render = sensor.render; /* recorded in the file */
+            nc_quality_describe(&qc, info->quality, sizeof info->quality);
+        }
+    }
+    if (rc >= 0)
+        rc = nc_render_exposure(r, &drawn, &ex, &f, &info->time_samples);
+    /* Stars (the `stars` section), drawn before the camera model's PSF. */
+    char starinfo[120] = "";
+    double ts0 = now_ms();
+    if (rc >= 0 && sky->on && (rc = nc_sky_draw(sky, r, cs, &drawn, 0, exposure, &f, &info->stars)) >= 0)
+        snprintf(starinfo, sizeof starinfo, "limit_mag=%.2f drawn=%ld hidden=%ld", info->stars.limit_mag,
+                 info->stars.drawn, info->stars.hidden);
+    /* The Sun: drawn when its disk reaches the frame; a warning in or near it. */
+    char suninfo[200] = "";
+    struct nc_sun_view *sv = &info->sun;
+    if (rc >= 0 && (rc = nc_render_sun(r, &drawn, NC_SUN_NEAR_DEG, &f, sv)) >= 0) {
+        nc_sun_view_warning(sv, info->sun_warning, sizeof info->sun_warning);
+        snprintf(suninfo, sizeof suninfo, "off_axis_deg=%.4f edge_deg=%.4f in_field=%d hidden=%d%s%s", sv->off_axis_deg,
+                 sv->edge_deg, sv->in_field, sv->hidden, info->sun_warning[0] ? " warning=" : "", info->sun_warning);
+    }
+    double t2 = now_ms();
+    info->render_ms = ts0 - t1;
+    info->stars_ms = t2 - ts0;
+    nc_frame_flip(&f, scene->camera.flip_rows, scene->camera.flip_cols);
+    /* Levels of detail and the smallest boulder traced (0: every rock). */
+    char lod[40], rocks[40];
+    snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r->rt));
+    snprintf(rocks, sizeof rocks, "%.17g", nc_rt_boulder_min_m(r->rt));
+    /* How each mesh is shaded: name=flat or name=smooth, comma-separated. */
+    char normals[NC_MAX_BODIES * 72] = "";
+    for (int i = 0, o = 0; i < scene->nbodies; i++)
+        if (scene->body[i].shape == NC_SHAPE_MESH || scene->body[i].shape == NC_SHAPE_ASTEROID)
+            o += snprintf(normals + o, sizeof normals - (size_t)o, "%s%s=%s", o ? "," : "", scene->body[i].name,
+                          scene->body[i].smooth_normals ? "smooth" : "flat");
+    /* The roughness each body's rocks not traced were folded into. */
+    char fold[NC_MAX_BODIES * 80] = "";
+    for (int i = 0, o = 0; i < scene->nbodies; i++)
+        if (r->fold_theta_bar_deg[i] >= 0)
+            o += snprintf(fold + o, sizeof fold - (size_t)o, "%s%s=%.6g", o ? "," : "", scene->body[i].name,
+                          r->fold_theta_bar_deg[i]);
+    char flip[40];
+    snprintf(flip, sizeof flip, "rows=%d columns=%d", scene->camera.flip_rows, scene->camera.flip_cols);
+    struct nc_image_attr extra[24] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}};
+    int nextra = 2;
+    if (suninfo[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:sun_view", suninfo};
+    if (starinfo[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:stars", starinfo};
+    if (normals[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:normals", normals};
+    if (fold[0])
+        extra[nextra++] = (struct nc_image_attr){"navcam:rock_fold_theta_bar_deg", fold};
+    if (scene->camera.flip_rows || scene->camera.flip_cols)
+        extra[nextra++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
+    if (scene->camera.from_sumfile)
+        extra[nextra++] = (struct nc_image_attr){"navcam:sumfile_utc", scene->camera.sumfile_utc};
+    for (int i = 0; i < nextra_in && nextra < 24; i++)
+        extra[nextra++] = extra_in[i];
+    if (rc >= 0 && q <= NC_Q_ROCK_ID)
+        rc = nc_frame_write(out, &f, q, scene, extra, nextra, &info->preview_scale);
+    else if (rc >= 0)
+        rc = write_sensor_frame(out, &f, q, scene, cs, exposure, frame_no, extra, nextra, &info->preview_scale);
+    nc_frame_free(&f);
+    return rc;
+}
+
+int nc_shot_geometry(struct nc_renderer *r, const struct nc_scene *scene, float *geom, int32_t *rock_id)
+{
+    struct nc_scene s = *scene;
+    s.render.samples_per_pixel = 1;
+    s.render.bounces = 0;
+    s.render.soft_shadows = 0;
+    struct nc_frame f = {0};
+    int rc = nc_frame_alloc(&f, s.camera.width_px, s.camera.height_px);
+    if (rc < 0)
+        return rc;
+    f.geom = geom;
+    f.rock_id = rock_id;
+    rc = nc_render_frame(r, &s, &f);
+    nc_frame_flip(&f, s.camera.flip_rows, s.camera.flip_cols);
+    f.geom = NULL; /* the caller's */
+    f.rock_id = NULL;
+    nc_frame_free(&f);
+    return rc;
+}

@@ -1,0 +1,44 @@
+/* shot.h - one frame of a scene to an image file: render (with the
+ * exposure's motion and render.quality auto), stars, the Sun, the stored
+ * image's mirroring, then the camera model for electrons and DN, and the
+ * file with its metadata. Shared by `navcam render` and `navcam batch`;
+ * printing what happened is the caller's. */
+#ifndef NC_CAMERA_SHOT_H
+#define NC_CAMERA_SHOT_H
+
+#include <stdint.h>
+
+#include "camera/camsys.h"
+#include "camera/sky.h"
+#include "render/frame_io.h"
+#include "render/render.h"
+#include "render/scene.h"
+
+struct nc_shot_info {
+    int time_samples;
+    char quality[300];     /* render.quality auto's choice ("" when manual) */
+    struct nc_sky_stats stars;
+    double stars_ms;
+    struct nc_sun_view sun;
+    char sun_warning[80];  /* "" when none */
+    double render_ms;
+    double preview_scale;  /* 16-bit preview: what 65535 stands for (0: not a preview) */
+};
+
+/* Mirror f's planes top to bottom and/or left to right in place
+ * (nc_camera.flip_rows, flip_cols). */
+void nc_frame_flip(struct nc_frame *f, int rows, int cols);
+
+/* Render scene (its quality settings may be changed by render.quality auto:
+ * they are recorded in the file) to path as quantity q; sky may be off.
+ * extra attributes go into the file too. */
+int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsys *cs, struct nc_sky *sky,
+            enum nc_quantity q, double exposure_s, uint64_t frame_no, const char *path,
+            const struct nc_image_attr *extra, int nextra, struct nc_shot_info *info);
+
+/* The geometry planes (render.h, enum nc_geom_plane) of scene at pixel
+ * centres: one sample a pixel, direct light only, no time samples; then
+ * mirrored as the stored image is. geom: NC_GEOM_PLANES x w x h floats. */
+int nc_shot_geometry(struct nc_renderer *r, const struct nc_scene *scene, float *geom, int32_t *rock_id);
+
+#endif

@@ -1,0 +1,143 @@
+/* traj.c - reading trajectories (traj.h). */
+#include "core/traj.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+/* The built-in approach to the default scene's asteroid (as `make demo`):
+ * 8 poses, 16 km to 3 km, one per second, looking at the body. */
+static int builtin_approach(struct nc_traj_row **out)
+{
+    const int n = 8;
+    struct nc_traj_row *r = calloc(n, sizeof *r);
+    if (!r)
+        return nc_error(-ENOMEM, "out of memory");
+    for (int i = 0; i < n; i++) {
+        double d = 16000 * exp(log(3000.0 / 16000) * i / (n - 1));
+        r[i].t_s = i;
+        r[i].p = nc_v3(0.08 * d, -d, 0.03 * d);
+        nc_quat_look_at(r[i].p, nc_v3(0, 0, 0), nc_v3(0, 0, 1), &r[i].q);
+        r[i].sun = nc_v3(0.643, -0.766, 0);
+        r[i].capture = 1;
+    }
+    *out = r;
+    return n;
+}
+
+static const char pose_cols[] = "t_s,cam_x_m,cam_y_m,cam_z_m,q_w,q_x,q_y,q_z,sun_x,sun_y,sun_z[,capture]";
+static const char sum_cols[] = "t_s,scobj_x_km,scobj_y_km,scobj_z_km,cx_x,cx_y,cx_z,cy_x,cy_y,cy_z,cz_x,cz_y,cz_z,"
+                               "sz_x,sz_y,sz_z[,capture]";
+
+/* A SUM-like row: v[1..3] SCOBJ km, v[4..12] CX CY CZ, v[13..15] SZ. */
+static int sum_row(const char *path, size_t lineno, const double *v, struct nc_traj_row *r)
+{
+    struct nc_mat3 m;
+    for (int a = 0; a < 3; a++) {
+        const double *ax = v + 4 + 3 * a;
+        double len = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+        if (fabs(len - 1) > 2e-3)
+            return nc_error(NC_ECONFIG, "%s:%zu: %s is not a unit vector (length %.6g)", path, lineno,
+                            a == 0 ? "CX" : a == 1 ? "CY" : "CZ", len);
+        for (int i = 0; i < 3; i++)
+            m.m[i][a] = ax[i];
+    }
+    struct nc_vec3 x = nc_v3(v[4], v[5], v[6]), y = nc_v3(v[7], v[8], v[9]), z = nc_v3(v[10], v[11], v[12]);
+    if (fabs(nc_v3_dot(x, y)) > 1e-3 || fabs(nc_v3_dot(y, z)) > 1e-3 || fabs(nc_v3_dot(x, z)) > 1e-3 ||
+        nc_v3_dot(nc_v3_cross(x, y), z) < 0)
+        return nc_error(NC_ECONFIG, "%s:%zu: CX, CY, CZ are not a right-handed orthonormal set", path, lineno);
+    r->p = nc_v3(-1e3 * v[1], -1e3 * v[2], -1e3 * v[3]);
+    r->q = nc_quat_from_mat(&m);
+    r->sun = nc_v3(v[13], v[14], v[15]);
+    return 0;
+}
+
+int nc_traj_read(const char *path, struct nc_traj_row **out)
+{
+    if (!strcmp(path, "builtin:approach"))
+        return builtin_approach(out);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    struct nc_traj_row *rows = NULL;
+    size_t n = 0, cap = 0, lineno = 0;
+    char line[2048];
+    int rc = 0, sum = 0;
+    while (fgets(line, sizeof line, f)) {
+        lineno++;
+        if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
+            continue;
+        const int need = sum ? 16 : 11;
+        double v[17];
+        int k = 0;
+        char *s = line, *end;
+        for (; k < need + 1; k++) {
+            v[k] = strtod(s, &end);
+            if (end == s)
+                break;
+            s = end + strspn(end, " \t");
+            if (*s == ',')
+                s++;
+        }
+        if (k == 0 && n == 0 && !sum) { /* a header: which layout */
+            sum = !strncmp(line + strspn(line, " \t"), "t_s,scobj_x_km", 14);
+            continue;
+        }
+        int bad = k < need || (*s && *s != '\n' && *s != '\r');
+        for (int i = 0; i < k && !bad; i++)
+            bad = !isfinite(v[i]);
+        if (bad) {
+            rc = nc_error(NC_ECONFIG, "%s:%zu: expected %d or %d finite numbers: %s", path, lineno, need, need + 1,
+                          sum ? sum_cols : pose_cols);
+            break;
+        }
+        if (n == cap) {
+            cap = cap ? 2 * cap : 256;
+            struct nc_traj_row *r2 = realloc(rows, cap * sizeof *rows);
+            if (!r2) {
+                rc = nc_error(-ENOMEM, "out of memory");
+                break;
+            }
+            rows = r2;
+        }
+        struct nc_traj_row *r = &rows[n];
+        r->t_s = v[0];
+        r->capture = k == need + 1 ? v[need] != 0 : 1;
+        r->line = (int)lineno;
+        if (sum) {
+            if ((rc = sum_row(path, lineno, v, r)) < 0)
+                break;
+        } else {
+            r->p = nc_v3(v[1], v[2], v[3]);
+            r->q = (struct nc_quat){v[4], v[5], v[6], v[7]};
+            r->sun = nc_v3(v[8], v[9], v[10]);
+            double qn = nc_quat_norm(r->q);
+            if (fabs(qn - 1) > 1e-3) {
+                rc = nc_error(NC_ECONFIG, "%s:%zu: the quaternion [%g, %g, %g, %g] is not unit (norm %.6g)", path,
+                              lineno, v[4], v[5], v[6], v[7], qn);
+                break;
+            }
+            r->q = (struct nc_quat){r->q.w / qn, r->q.x / qn, r->q.y / qn, r->q.z / qn};
+        }
+        if (!(nc_v3_norm(r->sun) > 0)) {
+            rc = nc_error(NC_ECONFIG, "%s:%zu: the Sun direction is zero", path, lineno);
+            break;
+        }
+        n++;
+    }
+    fclose(f);
+    if (rc < 0) {
+        free(rows);
+        return rc;
+    }
+    if (n > 100000000) {
+        free(rows);
+        return nc_error(NC_ERANGE, "%s: %zu rows: more than 10^8", path, n);
+    }
+    *out = rows;
+    return (int)n;
+}

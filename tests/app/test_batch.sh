@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# navcam batch (docs/batch.md) through its command line: a dataset of a
+# trajectory with its ground truth; the same bytes from shards in any order
+# and thread count; resuming after a crash; SUM-like trajectory rows; and a
+# Slurm job array of 4 tasks on a single-node cluster started here (slurmctld,
+# slurmd, munge from Debian): its merged output identical to one process.
+# usage: test_batch.sh NAVCAM TMPDIR SOURCE_DIR
+set -euo pipefail
+navcam=$1
+tmp=$2
+src=$3
+rm -rf "$tmp"
+mkdir -p "$tmp"
+cd "$tmp"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# A small camera on the default asteroid (craters), with boulders, 8 poses.
+scene=(--set camera.width_px=192 --set camera.height_px=160 --set render.samples_per_pixel=1
+       --set 'bodies.0.boulders={density_per_km2: 4000, slope: 2.2, min_diameter_m: 2, max_diameter_m: 20}')
+python3 - <<'PY'
+import math
+with open("traj.csv", "w") as f:
+    f.write("t_s,cam_x_m,cam_y_m,cam_z_m,q_w,q_x,q_y,q_z,sun_x,sun_y,sun_z\n")
+    for i in range(8):
+        a = 0.2 * i
+        p = (2500 * math.sin(a), -2500 * math.cos(a), 300.0)
+        # camera looking at the origin, +z up in the image: X = Z x up, Y = Z x X
+        n = math.sqrt(sum(v * v for v in p))
+        z = [-c / n for c in p]
+        x = [z[1], -z[0], 0.0]
+        n = math.sqrt(sum(v * v for v in x)); x = [v / n for v in x]
+        y = [z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]]
+        m = [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]]
+        w = math.sqrt(max(0.0, 1 + m[0][0] + m[1][1] + m[2][2])) / 2
+        q = (w, (m[2][1] - m[1][2]) / (4 * w), (m[0][2] - m[2][0]) / (4 * w), (m[1][0] - m[0][1]) / (4 * w))
+        f.write("%d,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.12f,0.643,-0.766,0.1\n" % ((i,) + p + q))
+# the same poses as SUM-like rows: SCOBJ = -p (km), CX CY CZ, SZ
+with open("traj.csv") as f, open("traj_sum.csv", "w") as g:
+    g.write("t_s,scobj_x_km,scobj_y_km,scobj_z_km,cx_x,cx_y,cx_z,cy_x,cy_y,cy_z,cz_x,cz_y,cz_z,sz_x,sz_y,sz_z\n")
+    for line in list(f)[1:]:
+        v = [float(t) for t in line.split(",")]
+        w, x, y, z = v[4:8]
+        R = [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+             [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+             [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+        cols = [[R[r][c] for r in range(3)] for c in range(3)]
+        s = math.sqrt(0.643 ** 2 + 0.766 ** 2 + 0.01)
+        g.write(",".join("%.12g" % t for t in [v[0], -v[1] / 1e3, -v[2] / 1e3, -v[3] / 1e3] + cols[0] + cols[1]
+                         + cols[2] + [0.643 / s, -0.766 / s, 0.1 / s]) + "\n")
+PY
+
+# One process, two threads: the reference.
+"$navcam" batch traj.csv -o ref "${scene[@]}" -j 2 > ref.log 2> ref.err || { cat ref.err; fail "batch"; }
+grep -q "8 rendered, 0 already done" ref.log || fail "reference: $(tail -1 ref.log)"
+for i in 0 7; do
+  f=ref/frame_00000$i
+  for x in .fits _geometry.fits .json _boulders.csv _craters.csv; do [ -s "$f$x" ] || fail "missing $f$x"; done
+done
+python3 - <<'PY' || fail "ground truth"
+import json, glob
+for j in sorted(glob.glob("ref/frame_*.json")):
+    d = json.load(open(j))
+    assert d["quantity"] == "dn" and d["camera"]["width_px"] == 192, j
+    assert d["geometry_planes"][0] == "range_m" and d["geometry_planes"][-1] == "body", j
+    assert d["boulders_in_view"] > 0 and d["craters_in_view"] > 0, (j, d["boulders_in_view"], d["craters_in_view"])
+    rows = open(j.replace(".json", "_boulders.csv")).read().split("\n")
+    assert rows[0] == "body,index,x_m,y_m,z_m,diameter_m,pixels" and len([r for r in rows[1:] if r]) == d["boulders_in_view"]
+    head = open(j.replace(".json", "_geometry.fits"), "rb").read(2880 * 3).decode("ascii", "replace")
+    cards = [head[i:i + 80] for i in range(0, len(head), 80)]
+    assert any(c.startswith("NAXIS3  =                   11") for c in cards), "11 planes"
+    assert any(c.startswith("PLANE1  = 'range_m ") for c in cards) and any(c.startswith("PLANE11 = 'body ") for c in cards)
+print("ground truth ok")
+PY
+
+# Shards in another order, one thread each: the same bytes.
+for k in 2 0 1; do "$navcam" batch traj.csv -o shards "${scene[@]}" --shard $k/3 -j 1 > /dev/null 2>&1 || fail "shard $k"; done
+diff -r ref shards > /dev/null || fail "3 shards in the order 2, 0, 1 differ from one process: $(diff -rq ref shards | head -3)"
+
+# A crash: frame 5's truth and image gone, a half-written temporary left.
+cp -r ref crashed
+rm crashed/frame_000005.json crashed/frame_000005.fits
+head -c 1000 ref/frame_000005.fits > crashed/.frame_000005.tmp.fits
+"$navcam" batch traj.csv -o crashed "${scene[@]}" > resume.log 2>&1 || fail "resume"
+grep -q "1 rendered, 7 already done" resume.log || fail "resume: $(tail -1 resume.log)"
+diff -r -x '.frame_*' ref crashed > /dev/null || fail "resumed dataset differs from the reference"
+
+# SUM-like rows of the same poses: the same frames (to the pose's rounding).
+"$navcam" batch traj_sum.csv -o sum "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "SUM-like rows"
+"$navcam" compare ref/frame_000003.fits sum/frame_000003.fits --fit none > sumcmp.json || fail "compare"
+python3 -c "
+import json; d = json.load(open('sumcmp.json'))
+assert d['relative_error']['p95'] < 0.02 and d['limb_iou'] > 0.99, d
+print('SUM-like rows: p95 %.4f, IoU %.4f' % (d['relative_error']['p95'], d['limb_iou']))" || fail "SUM-like rows differ"
+
+# Errors: bad shard, bad row.
+"$navcam" batch traj.csv -o x --shard 3/3 2> err.txt && fail "--shard 3/3 accepted"
+grep -q "0 <= K < N" err.txt || fail "shard error: $(cat err.txt)"
+printf 't_s,cam_x_m\n0,1,2\n' > bad.csv
+"$navcam" batch bad.csv -o x 2> err.txt && fail "bad trajectory accepted"
+grep -q "bad.csv:2: expected 11 or 12 finite numbers" err.txt || fail "trajectory error: $(cat err.txt)"
+
+# Slurm: a job array of 4 tasks into one directory.
+slurm=$(mktemp -d /tmp/nc_slurm.XXXXXX)
+trap '"$src/scripts/slurm-local.sh" stop "$slurm"' EXIT
+SLURM_CONF=$("$src/scripts/slurm-local.sh" start "$slurm")
+export SLURM_CONF
+mkdir -p logs
+NAVCAM=$navcam timeout 300 sbatch --wait --array=0-3 -D "$tmp/logs" "$src/examples/slurm/navcam_batch.sbatch" \
+  "$tmp/traj.csv" "$tmp/slurm_out" "${scene[@]}" > sbatch.txt || { cat logs/* >&2; fail "sbatch"; }
+for k in 0 1 2 3; do
+  grep -q "shard $k/4: 2 of 8 rows are this shard's; 2 rendered" logs/navcam-batch-*_$k.log ||
+    fail "task $k: $(cat logs/navcam-batch-*_$k.log)"
+done
+diff -r ref slurm_out > /dev/null || fail "the Slurm array's merged output differs from one process"
+echo "PASS: dataset, shards, resume, SUM-like rows, a 4-task Slurm array identical to one process"

@@ -1,0 +1,277 @@
+/* test_sumfile.c - a camera from an SPC SUM file (camera.sumfile,
+ * docs/sumfiles.md) against the SUM projection written out independently:
+ * a body-fixed point is predicted at (sample, line) by SCOBJ, CX, CY, CZ,
+ * MMFL, K-MATRIX and CTR; the rendered geometry at that pixel must be that
+ * point. For a normal and a mirrored (K22 < 0) pixel grid, with bodies[0]
+ * turned in the scene frame; plus the parser's and the scene's errors.
+ * And SPC's ICQ shape format: a sphere written face by face with the
+ * documented axes loads closed, outward and of the right size. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera/shot.h"
+#include "core/error.h"
+#include "core/sumfile.h"
+#include "testutil.h"
+
+static void unit(double *v)
+{
+    double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int i = 0; i < 3; i++)
+        v[i] /= n;
+}
+
+static void cross(const double *a, const double *b, double *o)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* A SUM file looking at the body centre from cam_km, 256 x 200 pixels. */
+static void make_sum(struct nc_sumfile *s, const double *cam_km, double k22_sign)
+{
+    memset(s, 0, sizeof *s);
+    snprintf(s->picture, sizeof s->picture, "TEST0001");
+    snprintf(s->utc, sizeof s->utc, "2020 JAN 15 12:00:00.000");
+    s->npx = 256;
+    s->nln = 200;
+    s->mmfl_mm = 20;
+    s->ctr[0] = 120.25; /* 1-based, off centre */
+    s->ctr[1] = 95.5;
+    const double up[3] = {0, 0, 1};
+    for (int i = 0; i < 3; i++) {
+        s->scobj_km[i] = -cam_km[i];
+        s->cz[i] = -cam_km[i];
+    }
+    unit(s->cz);
+    cross(up, s->cz, s->cx);
+    unit(s->cx);
+    cross(s->cz, s->cx, s->cy);
+    s->sz[0] = 0.8, s->sz[1] = 0.6, s->sz[2] = 0.05;
+    unit(s->sz);
+    s->k[0] = 117.647;
+    s->k[4] = k22_sign * 117.647;
+}
+
+/* SUM projection of body-fixed p_km (the docs' formula, written out). */
+static void project(const struct nc_sumfile *s, const double *p_km, double *sample, double *line)
+{
+    double v[3] = {p_km[0] + s->scobj_km[0], p_km[1] + s->scobj_km[1], p_km[2] + s->scobj_km[2]};
+    double x = s->mmfl_mm * dot(s->cx, v) / dot(s->cz, v), y = s->mmfl_mm * dot(s->cy, v) / dot(s->cz, v);
+    *sample = s->ctr[0] + s->k[0] * x + s->k[1] * y;
+    *line = s->ctr[1] + s->k[3] * x + s->k[4] * y;
+}
+
+static void check_view(double k22_sign, const char *body_q)
+{
+    const double cam_km[3] = {4, -2, 1};
+    struct nc_sumfile sum;
+    make_sum(&sum, cam_km, k22_sign);
+    char path[4096], set[4200];
+    snprintf(path, sizeof path, "%s", nc_test_path(k22_sign > 0 ? "normal.SUM" : "mirrored.SUM"));
+    CHECK(nc_sumfile_write(path, &sum) == 0, "write %s", path);
+    snprintf(set, sizeof set, "camera={sumfile: '%s'}", path);
+    char bq[200];
+    snprintf(bq, sizeof bq, "bodies.0.attitude_q=%s", body_q);
+    const char *sets[] = {set, "sun={distance_au: 1.1}", bq};
+    const char *yaml = "bodies:\n  - shape: {type: sphere, radius_m: 150}\n    material: {model: lambert, A: 0.2}\n"
+                       "    position_m: [1000, -500, 250]\n"
+                       "sun: {direction: [1, 0, 0]}\n"
+                       "camera: {width_px: 8, height_px: 8, fx_px: 10, fy_px: 10, position_m: [0, 0, 0], "
+                       "attitude_q: [1, 0, 0, 0]}\n"
+                       "render: {samples_per_pixel: 1}\n";
+    struct nc_scene s;
+    nc_test_scene(yaml, sets, 3, &s);
+    const struct nc_camera *c = &s.camera;
+    CHECK(c->width_px == 256 && c->height_px == 200 && fabs(c->fx_px - 20 * 117.647) < 1e-9 &&
+              fabs(c->fy_px - c->fx_px) < 1e-9 && c->flip_rows == (k22_sign < 0) && !c->flip_cols,
+          "intrinsics %dx%d fx %g fy %g flips %d %d", c->width_px, c->height_px, c->fx_px, c->fy_px, c->flip_rows,
+          c->flip_cols);
+    CHECK(fabs(c->cx_px - 119.25) < 1e-12 && fabs(c->cy_px - (k22_sign > 0 ? 94.5 : 200 - 95.5)) < 1e-12,
+          "principal point (%g, %g)", c->cx_px, c->cy_px);
+    CHECK(fabs(nc_v3_dot(s.sun.direction, nc_v3(sum.sz[0], sum.sz[1], sum.sz[2])) - 1) < 1e-12 &&
+              fabs(s.sun.distance_m / NC_AU_M - 1.1) < 1e-12,
+          "Sun from SZ, distance from the scene");
+    /* The camera is where SCOBJ says, relative to the body, in its frame. */
+    struct nc_vec3 rel = nc_v3_sub(c->position_m, s.body[0].position_m);
+    struct nc_vec3 cam_body = nc_quat_rotate(nc_quat_conj(s.body[0].attitude_q), rel);
+    CHECK(nc_v3_norm(nc_v3_sub(cam_body, nc_v3(4000, -2000, 1000))) < 1e-6, "camera at (%g, %g, %g) m body-fixed",
+          cam_body.x, cam_body.y, cam_body.z);
+
+    /* Points on the sphere: predicted pixel vs what the render sees there. */
+    struct nc_renderer r;
+    CHECK(nc_renderer_init(&r, &s, 2) == 0, "renderer");
+    const size_t plane = 256 * 200;
+    float *geom = malloc(NC_GEOM_PLANES * plane * sizeof *geom);
+    CHECK(nc_shot_geometry(&r, &s, geom, NULL) == 0, "geometry");
+    double worst = 0, gsd = 4.58 / (20 * 117.647) * 1e3; /* m per pixel at the range */
+    int n = 0;
+    for (int k = 0; k < 25; k++) {
+        double d[3] = {cam_km[0] + 1.5 * sin(k), cam_km[1] + 1.5 * cos(1.3 * k), cam_km[2] + 1.2 * sin(0.7 * k)};
+        unit(d);
+        double p_km[3] = {0.15 * d[0], 0.15 * d[1], 0.15 * d[2]}, sample, line;
+        double to_cam[3] = {cam_km[0] - p_km[0], cam_km[1] - p_km[1], cam_km[2] - p_km[2]};
+        if (dot(d, to_cam) < 0.3 * sqrt(dot(to_cam, to_cam)))
+            continue; /* on the far side or at the limb */
+        project(&sum, p_km, &sample, &line);
+        int x = (int)lround(sample - 1), y = (int)lround(line - 1);
+        if (x < 0 || y < 0 || x >= 256 || y >= 200)
+            continue;
+        size_t o = (size_t)y * 256 + (size_t)x;
+        double dx = geom[NC_GEOM_X * plane + o] - 1e3 * p_km[0], dy = geom[NC_GEOM_Y * plane + o] - 1e3 * p_km[1],
+               dz = geom[NC_GEOM_Z * plane + o] - 1e3 * p_km[2];
+        double err = sqrt(dx * dx + dy * dy + dz * dz);
+        CHECK(geom[NC_GEOM_BODY * plane + o] == 0, "point %d: pixel (%d, %d) shows the body", k, x, y);
+        worst = fmax(worst, err);
+        n++;
+    }
+    /* Pixel centres are 0.5 px from the predicted point at worst, on a
+     * surface tilted by up to ~72 deg: within 2 ground pixels. */
+    CHECK(n >= 8 && worst < 2 * gsd, "%s grid, body turned by %s: %d points, worst %.3f m (pixel %.3f m)",
+          k22_sign > 0 ? "normal" : "mirrored", body_q, n, worst, gsd);
+    free(geom);
+    nc_renderer_free(&r);
+    nc_scene_free(&s);
+}
+
+static void expect_error(const char *text, const char *const *sets, int nsets, const char *needle)
+{
+    char path[4096], set[4200];
+    snprintf(path, sizeof path, "%s", nc_test_path("bad.SUM"));
+    nc_test_write(path, text);
+    snprintf(set, sizeof set, "camera={sumfile: '%s'}", path);
+    const char *all[4] = {set};
+    for (int i = 0; i < nsets; i++)
+        all[i + 1] = sets[i];
+    struct nc_scene s;
+    int rc = nc_test_scene_rc("bodies:\n  - shape: {type: sphere, radius_m: 150}\n    material: {model: lambert, A: "
+                              "0.2}\nsun: {distance_au: 1}\ncamera: {}\n",
+                              all, nsets + 1, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), needle), "expected an error naming '%s', got %d: %s", needle, rc,
+          rc < 0 ? nc_errmsg() : "");
+    if (rc >= 0)
+        nc_scene_free(&s);
+}
+
+/* out = text with the first from replaced by to. */
+static void replaced(char *out, size_t len, const char *text, const char *from, const char *to)
+{
+    const char *at = strstr(text, from);
+    snprintf(out, len, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+}
+
+/* An ICQ sphere of radius r_km: face axes of docs/sumfiles.md (outward,
+ * I direction, J direction), vertices from integer cube points so that the
+ * copies on the cube's edges are equal. */
+static void write_icq(const char *path, int q, double r_km)
+{
+    static const int ax[6][3][3] = {{{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},  {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
+                                    {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}}, {{0, 1, 0}, {-1, 0, 0}, {0, 0, -1}},
+                                    {{1, 0, 0}, {0, 1, 0}, {0, 0, -1}},  {{0, 0, -1}, {1, 0, 0}, {0, 1, 0}}};
+    FILE *f = fopen(path, "w");
+    fprintf(f, "%10d\n", q);
+    for (int face = 0; face < 6; face++)
+        for (int j = 0; j <= q; j++)
+            for (int i = 0; i <= q; i++) {
+                double p[3];
+                for (int k = 0; k < 3; k++)
+                    p[k] = q * ax[face][0][k] + (2 * i - q) * ax[face][1][k] + (2 * j - q) * ax[face][2][k];
+                unit(p);
+                fprintf(f, "%15.5f%15.5f%15.5f\n", r_km * p[0], r_km * p[1], r_km * p[2]);
+            }
+    fclose(f);
+}
+
+static void check_icq(void)
+{
+    const int q = 16;
+    const char *path = nc_test_path("SHAPE.TXT");
+    write_icq(path, q, 0.25);
+    struct nc_mesh m;
+    CHECK(nc_mesh_load(path, 1000, &m) == 0, "load ICQ: %s", nc_errmsg());
+    CHECK(m.nt == 12 * q * q, "%zu triangles (12 Q^2 = %d)", m.nt, 12 * q * q);
+    /* closed: every edge in exactly two triangles, once each way */
+    size_t used = 0, open_edges = 0, outward = 0;
+    unsigned char *seen = calloc(m.nv, 1);
+    for (size_t t = 0; t < m.nt; t++) {
+        struct nc_vec3 n;
+        double area = nc_mesh_face(&m, t, &n);
+        const double *a = m.v + 3 * (size_t)m.tri[3 * t];
+        outward += area > 0 && n.x * a[0] + n.y * a[1] + n.z * a[2] > 0;
+        for (int e = 0; e < 3; e++) {
+            uint32_t u = m.tri[3 * t + (size_t)e], w = m.tri[3 * t + (size_t)(e + 1) % 3];
+            seen[u] = 1;
+            int found = 0;
+            for (size_t s2 = 0; s2 < m.nt && !found; s2++)
+                for (int e2 = 0; e2 < 3; e2++)
+                    found |= m.tri[3 * s2 + (size_t)e2] == w && m.tri[3 * s2 + (size_t)(e2 + 1) % 3] == u;
+            open_edges += !found;
+        }
+    }
+    for (size_t i = 0; i < m.nv; i++)
+        used += seen[i];
+    free(seen);
+    CHECK(used == (size_t)(6 * q * q + 2), "%zu vertices used after welding (6 Q^2 + 2 = %d)", used, 6 * q * q + 2);
+    CHECK(open_edges == 0, "%zu edges without their opposite: not closed", open_edges);
+    CHECK(outward == m.nt, "%zu of %zu triangles wound outward", outward, m.nt);
+    double area = nc_mesh_area_m2(&m), sphere = 4 * M_PI * 250.0 * 250.0;
+    CHECK(area < sphere && area > 0.98 * sphere, "area %.1f m^2 vs the sphere's %.1f", area, sphere);
+    nc_mesh_free(&m);
+    nc_test_write(nc_test_path("short.icq"), "4\n 1 2 3\n");
+    CHECK(nc_mesh_load(nc_test_path("short.icq"), 1, &m) < 0 && nc_test_contains(nc_errmsg(), "1 vertices, but Q = 4 "
+                                                                                                "needs 6 (Q+1)^2 = 150"),
+          "short ICQ: %s", nc_errmsg());
+    nc_test_write(nc_test_path("bad.icq"), "2\n 1 2 x\n");
+    CHECK(nc_mesh_load(nc_test_path("bad.icq"), 1, &m) < 0 && nc_test_contains(nc_errmsg(), "bad.icq:2: expected a "
+                                                                                              "vertex"),
+          "bad ICQ: %s", nc_errmsg());
+}
+
+int main(void)
+{
+    check_icq();
+    check_view(1, "[1, 0, 0, 0]");
+    check_view(-1, "[0.9238795, 0.2209424, 0.1104712, 0.2946]");
+    check_view(1, "[0.5, 0.5, 0.5, 0.5]");
+
+    /* Fortran D notation, labels, unused items after K-MATRIX. */
+    struct nc_sumfile sum;
+    const char *good = "EX0000000001\n2020 JAN 15 12:00:00.000\n  1024  1024    10 65535   NPX, NLN, THRSH\n"
+                       "    0.1252000000D+03    0.5125000000D+03    0.5125000000D+03  MMFL, CTR\n"
+                       "   -0.4000000000D+01    0.2000000000D+01   -0.1000000000D+01  SCOBJ\n"
+                       "    0.4472135955D+00    0.8944271910D+00    0.0000000000D+00  CX\n"
+                       "    0.1951800146D+00   -0.9759000729D-01   -0.9759000729D+00  CY\n"
+                       "   -0.8728715609D+00    0.4364357805D+00   -0.2182178902D+00  CZ\n"
+                       "    0.7990018711D+00    0.5992514033D+00    0.4993761694D-01  SZ\n"
+                       " 117.64700   0.00000   0.00000   0.00000 117.64700   0.00000  K-MATRIX\n"
+                       "    0.00000D+00    0.00000D+00    0.00000D+00    0.00000D+00  DISTORTION\n"
+                       "LANDMARKS\nAA0001    466.69    192.64\nLIMB FITS\nEND FILE\n";
+    nc_test_write(nc_test_path("good.SUM"), good);
+    CHECK(nc_sumfile_read(nc_test_path("good.SUM"), &sum) == 0 && sum.npx == 1024 && sum.mmfl_mm == 125.2 &&
+              sum.ctr[1] == 512.5 && sum.scobj_km[0] == -4 && fabs(sum.cy[2] + 0.9759000729) < 1e-15 &&
+              sum.k[4] == 117.647 && !strcmp(sum.utc, "2020 JAN 15 12:00:00.000"),
+          "D notation: %s", nc_errmsg());
+
+    char bad[2048];
+    snprintf(bad, sizeof bad, "%.*s", (int)(strstr(good, "   -0.8728") - good), good); /* no CZ and after */
+    expect_error(bad, NULL, 0, "no CZ line");
+    replaced(bad, sizeof bad, good, "   -0.8728715609D+00    0.4364357805D+00   -0.2182178902D+00",
+             "    0.8728715609D+00   -0.4364357805D+00    0.2182178902D+00");
+    expect_error(bad, NULL, 0, "left-handed");
+    replaced(bad, sizeof bad, good, " 0.00000 117.64700", " 0.50000 117.64700"); /* K21 */
+    expect_error(bad, NULL, 0, "skewed pixel grid");
+    replaced(bad, sizeof bad, good, "  CY\n", " 0.3  CY\n");
+    expect_error(bad, NULL, 0, "CY: expected 3 numbers before the label, found 4");
+    const char *with_dir[] = {"sun={direction: [1, 0, 0], distance_au: 1}"};
+    expect_error(good, with_dir, 1, "remove sun.direction");
+    const char *no_dist[] = {"sun={}"};
+    expect_error(good, no_dist, 1, "distance_au");
+    const char *with_size[] = {"camera.width_px=100"};
+    expect_error(good, with_size, 1, "remove width_px");
+    return nc_test_end();
+}
