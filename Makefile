@@ -46,6 +46,8 @@ bench: build
 	@if command -v qemu-system-x86_64 >/dev/null && [ -x $(BUILD)/tests/v4l2_capture ]; then \
 	  bench/bench_edge_to_frame.sh $(BUILD); \
 	else echo "bench_edge_to_frame: needs the qemu guest of tests/vm (scripts/install-deps.sh --test)"; fi
+	@if command -v slurmctld >/dev/null; then bench/batch_scaling.sh $(BUILD); \
+	else echo "batch_scaling: needs Slurm and munge (scripts/install-deps.sh --test)"; fi
 
 # Generated documentation: the drivers' option tables (tests/app/test_cli.sh
 # checks that docs/drivers.md matches).

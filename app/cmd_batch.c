@@ -264,20 +264,20 @@ int main(int argc, char **argv)
             ext = optarg;
             if (strcmp(ext, "fits") && strcmp(ext, "tif") && strcmp(ext, "exr") && strcmp(ext, "png")) {
                 fprintf(stderr, "navcam batch: --format expects fits, tif, exr or png, got '%s'\n", optarg);
-                return 2;
+                goto usage;
             }
             break;
         case 'q':
             if (nc_quantity_parse(optarg, &q) < 0) {
                 fprintf(stderr, "navcam batch: %s\n", nc_errmsg());
-                return 2;
+                goto usage;
             }
             break;
         case 'e':
             exposure = strtod(optarg, &end);
             if (*end || !(exposure >= 0 && exposure <= 3600)) {
                 fprintf(stderr, "navcam batch: --exposure expects seconds in 0..3600, got '%s'\n", optarg);
-                return 2;
+                goto usage;
             }
             break;
         case 'K':
@@ -287,40 +287,41 @@ int main(int argc, char **argv)
             if (*end || optarg[0] == '/' || !strchr(optarg, '/') || shard_n < 1 || shard_n > 1000000 ||
                 shard_k < 0 || shard_k >= shard_n) {
                 fprintf(stderr, "navcam batch: --shard expects K/N with 0 <= K < N, got '%s'\n", optarg);
-                return 2;
+                goto usage;
             }
             break;
         case 'j':
             threads = (int)strtol(optarg, &end, 10);
             if (*end || threads < 1 || threads > 1024) {
                 fprintf(stderr, "navcam batch: --threads expects 1..1024, got '%s'\n", optarg);
-                return 2;
+                goto usage;
             }
             break;
-        case 'h': fputs(batch_help, stdout); return 0;
-        default: fputs("Try 'navcam batch --help'.\n", stderr); return 2;
+        case 'h': fputs(batch_help, stdout); free(sets); return 0;
+        default: fputs("Try 'navcam batch --help'.\n", stderr); goto usage;
         }
     }
     if (argc - optind != 1 || !dir) {
         fprintf(stderr, "navcam batch: %s\nTry 'navcam batch --help'.\n",
                 !dir ? "missing -o DIR" : "give one trajectory (TRAJ.csv or builtin:approach)");
-        return 2;
+        goto usage;
     }
     struct nc_traj_row *rows = NULL;
     int nrows = nc_traj_read(argv[optind], &rows);
-    if (nrows < 0)
+    if (nrows < 0) {
+        free(sets);
         return nc_cli_fail();
+    }
     if (mkdir(dir, 0777) < 0 && errno != EEXIST) {
         fprintf(stderr, "navcam batch: %s: %s\n", dir, strerror(errno));
+        free(sets);
+        free(rows);
         return 1;
     }
     struct nc_scene base;
     struct nc_camsys cs;
     struct nc_sky sky;
-    int rc = nc_setup_load(scene_path, sets, nsets, &base, &cs);
-    if (rc >= 0 && (rc = nc_sky_load(scene_path, sets, nsets, &sky)) >= 0 &&
-        (rc = nc_sky_prepare(&sky, &cs, &base.camera)) < 0)
-        nc_sky_free(&sky);
+    int rc = nc_shot_setup(scene_path, sets, nsets, &base, &cs, &sky);
     free(sets);
     if (rc < 0) {
         free(rows);
@@ -400,4 +401,7 @@ int main(int argc, char **argv)
     nc_camsys_free(&cs);
     nc_sky_free(&sky);
     return rc < 0 ? nc_cli_fail() : 0;
+usage:
+    free(sets);
+    return 2;
 }

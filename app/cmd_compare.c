@@ -78,7 +78,7 @@ static int plots(const char *dir, const float *rel, int w, int h, const struct n
             "set ylabel 'y, px'\nset palette defined (-1 'blue', 0 'white', 1 'red')\nset cbrange [%g:%g]\n"
             "set datafile missing NaN\nplot '.relative_error.f32' binary array=(%d,%d) format='%%float' "
             "with image notitle\n"
-            "set terminal pngcairo size 900,600 font ',10'\nset output 'error_histogram.png'\nunset size\n"
+            "set terminal pngcairo size 900,600 font ',10'\nset output 'error_histogram.png'\nset size noratio\n"
             "set autoscale\nset yrange [0:*]\nset title 'foreground pixels by relative error'\n"
             "set xlabel '(render - real) / real'\nset ylabel 'pixels'\nset datafile separator ','\nset grid\n"
             "plot 'error_histogram.csv' using 1:2 skip 1 with boxes fill solid 0.5 notitle\n",

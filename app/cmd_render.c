@@ -173,10 +173,7 @@ int main(int argc, char **argv)
     struct nc_scene scene;
     struct nc_camsys cs;
     struct nc_sky sky;
-    int rc = nc_setup_load(scene_path, sets, nsets, &scene, &cs);
-    if (rc >= 0 && (rc = nc_sky_load(scene_path, sets, nsets, &sky)) >= 0 &&
-        (rc = nc_sky_prepare(&sky, &cs, &scene.camera)) < 0)
-        nc_sky_free(&sky);
+    int rc = nc_shot_setup(scene_path, sets, nsets, &scene, &cs, &sky);
     free(sets);
     if (rc < 0)
         return nc_cli_fail();

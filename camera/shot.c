@@ -41,6 +41,21 @@ static void flip_plane(void *px, size_t elem, int w, int h, int rows, int cols)
             }
 }
 
+int nc_shot_setup(const char *path, const char *const *sets, int nsets, struct nc_scene *scene,
+                  struct nc_camsys *cs, struct nc_sky *sky)
+{
+    int rc = nc_setup_load(path, sets, nsets, scene, cs);
+    if (rc < 0)
+        return rc;
+    if ((rc = nc_sky_load(path, sets, nsets, sky)) >= 0 && (rc = nc_sky_prepare(sky, cs, &scene->camera)) < 0)
+        nc_sky_free(sky);
+    if (rc < 0) {
+        nc_scene_free(scene);
+        nc_camsys_free(cs);
+    }
+    return rc;
+}
+
 void nc_frame_flip(struct nc_frame *f, int rows, int cols)
 {
     if (!rows && !cols)

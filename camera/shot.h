@@ -25,6 +25,11 @@ struct nc_shot_info {
     double preview_scale;  /* 16-bit preview: what 65535 stands for (0: not a preview) */
 };
 
+/* The scene, its camera model and its stars (nc_setup_load, nc_sky_load,
+ * prepared for the camera) from one configuration; nothing to free on error. */
+int nc_shot_setup(const char *path, const char *const *sets, int nsets, struct nc_scene *scene,
+                  struct nc_camsys *cs, struct nc_sky *sky);
+
 /* Mirror f's planes top to bottom and/or left to right in place
  * (nc_camera.flip_rows, flip_cols). */
 void nc_frame_flip(struct nc_frame *f, int rows, int cols);

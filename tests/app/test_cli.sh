@@ -201,6 +201,29 @@ PY
     --set camera.width_px=48 --set camera.height_px=48 "${extra[@]}"
 done
 
+# navcam compare: a render against itself moved by 2 px (the principal
+# point), with plots; sizes that differ; --render's --sumfile errors.
+expect 0 "--register R" -- "$navcam" compare --help
+whole=("${small[@]}" --set camera.pixel_pitch_m=5.5e-5)  # the whole body in the frame
+"$navcam" render -o "$tmp/real.fits" "${whole[@]}" > /dev/null 2>&1
+"$navcam" render -o "$tmp/moved.fits" "${whole[@]}" --set camera.cx_px=49.5 > /dev/null 2>&1
+"$navcam" compare "$tmp/real.fits" "$tmp/moved.fits" --register 3 -o "$tmp/cmp" > "$tmp/cmp.json" 2> "$tmp/cmp.err" &&
+  python3 -c "
+import json, sys; d = json.load(open(sys.argv[1]))
+dx, dy = d['shift_px']
+assert abs(dx + 2) < 0.15 and abs(dy) < 0.15 and d['limb_iou'] > 0.95 and d['relative_error']['p95'] < 0.1, d" \
+  "$tmp/cmp.json" && [ ! -s "$tmp/cmp.err" ] && ok || bad "navcam compare of a 2 px shift: $(cat "$tmp/cmp.json" "$tmp/cmp.err")"
+for f in relative_error.png error_histogram.png error_histogram.csv relative_error.fits; do
+  [ -s "$tmp/cmp/$f" ] && ok || bad "navcam compare -o: no $f"
+done
+"$navcam" render -o "$tmp/other.fits" "${small[@]}" --set camera.width_px=64 > /dev/null 2>&1
+expect 1 "is 96x96 but $tmp/other.fits is 64x96: the images must have the same size" -- \
+  "$navcam" compare "$tmp/real.fits" "$tmp/other.fits"
+expect 2 "--fit expects scale, histogram or none" -- "$navcam" compare a b --fit gamma
+expect 1 "no.SUM: No such file or directory" -- "$navcam" render -o "$tmp/s.fits" --sumfile "$tmp/no.SUM" \
+  --set sun.distance_au=1
+expect 0 "--shard K/N" -- "$navcam" batch --help
+
 # The reference USB trigger adapter: its help, its argument errors, and the
 # stand-alone build its README gives (board-side: no NavCam libraries).
 adapter=$(dirname "$navcam")/navcam-usb-adapter
