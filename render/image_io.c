@@ -213,7 +213,7 @@ int nc_image_write_planes(const char *path, const float *planes, int w, int h, i
     size_t n = (size_t)w * (size_t)h * (size_t)nplanes;
     float *clean = malloc((n ? n : 1) * sizeof *clean);
     struct nc_image_attr *all = malloc((size_t)(nattrs + nplanes) * sizeof *all);
-    char (*key)[16] = malloc((size_t)nplanes * sizeof *key);
+    char (*key)[24] = malloc((size_t)nplanes * sizeof *key);
     int rc;
     if (!clean || !all || !key) {
         rc = nc_error(-ENOMEM, "%s: out of memory", path);

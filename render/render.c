@@ -498,6 +498,25 @@ static void shade_tile(struct job *j, int tile)
     for (int by = 0; by < TILE; by += 4)
         for (int bx = 0; bx < TILE; bx += 4)
             live[by / 4][bx / 4] = y0 + by < H && x0 + bx < W && (!j->cull || block_can_hit(j, x0 + bx, y0 + by));
+    /* Blocks no ray of which can reach a body show sky in the optional
+     * planes too (they are never traced). */
+    if (j->f->rock_id || j->f->geom) {
+        struct surf sky;
+        for (int i = 0; i < NC_PACKET; i++)
+            sky.body[i] = -1;
+        for (int by = 0; by < TILE; by += 4)
+            for (int bx = 0; bx < TILE; bx += 4) {
+                if (live[by / 4][bx / 4] || y0 + by >= H || x0 + bx >= W)
+                    continue;
+                for (int i = 0; i < NC_PACKET && j->f->rock_id; i++) {
+                    int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
+                    if (px < W && py < H)
+                        j->f->rock_id[(size_t)py * (size_t)W + (size_t)px] = -1;
+                }
+                if (j->f->geom)
+                    record_geom(j, &sky, x0 + bx, y0 + by);
+            }
+    }
 
     struct nc_ray16 ray;
     struct nc_vec3 dir[NC_PACKET], orig[NC_PACKET]; /* the camera rays in double precision */

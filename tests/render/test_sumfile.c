@@ -108,7 +108,16 @@ static void check_view(double k22_sign, const char *body_q)
     CHECK(nc_renderer_init(&r, &s, 2) == 0, "renderer");
     const size_t plane = 256 * 200;
     float *geom = malloc(NC_GEOM_PLANES * plane * sizeof *geom);
+    for (size_t i = 0; i < NC_GEOM_PLANES * plane; i++)
+        geom[i] = 12345.0f; /* not what any plane holds */
     CHECK(nc_shot_geometry(&r, &s, geom, NULL) == 0, "geometry");
+    /* The corners show sky (blocks no ray of which reaches the body are not
+     * traced, but their planes are written). */
+    const size_t corner[4] = {0, 255, plane - 256, plane - 1};
+    for (int k = 0; k < 4; k++)
+        CHECK(geom[NC_GEOM_BODY * plane + corner[k]] == -1 && geom[NC_GEOM_RANGE * plane + corner[k]] == 0 &&
+                  geom[NC_GEOM_X * plane + corner[k]] == 0,
+              "corner %d: sky (body %g)", k, geom[NC_GEOM_BODY * plane + corner[k]]);
     double worst = 0, gsd = 4.58 / (20 * 117.647) * 1e3; /* m per pixel at the range */
     int n = 0;
     for (int k = 0; k < 25; k++) {
