@@ -10,12 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "app/cli.h"
 #include "camera/load.h"
 #include "camera/shot.h"
+#include "core/clock.h"
 #include "core/error.h"
 #include "core/traj.h"
 
@@ -62,12 +62,31 @@ static void json_vec(FILE *f, const char *key, const double *v, int n, const cha
     fprintf(f, "]%s", sep);
 }
 
-/* Write through a temporary name, renamed when complete. */
+/* Every file is written under a temporary name, renamed when complete. */
 static int finish(const char *tmp, const char *path)
 {
     if (rename(tmp, path) < 0)
         return nc_error(-errno, "%s: rename to %s: %s", tmp, path, strerror(errno));
     return 0;
+}
+
+/* A text file DIR/NAME: opened as DIR/.NAME.tmp (tmp holds that path) ... */
+static int begin(const char *dir, const char *name, char *tmp, size_t len, FILE **f)
+{
+    snprintf(tmp, len, "%s/.%s.tmp", dir, name);
+    if (!(*f = fopen(tmp, "w")))
+        return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+    return 0;
+}
+
+/* ... and closed and renamed to DIR/NAME when complete (rc < 0: only closed). */
+static int commit(FILE *f, int rc, const char *tmp, const char *dir, const char *name)
+{
+    char path[4200];
+    if (fclose(f) != 0 && rc >= 0)
+        rc = nc_error(-EIO, "%s: write failed", tmp);
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return rc < 0 ? rc : finish(tmp, path);
 }
 
 /* The boulders and craters seen in a geometry render, as CSV files. */
@@ -76,7 +95,7 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
 {
     const struct nc_camera *c = &s->camera;
     const size_t plane = (size_t)c->width_px * (size_t)c->height_px;
-    char tmp[4200], path[4200];
+    char tmp[4200], name[80];
     int rc = 0;
     *nrocks = *ncraters = -1;
     int any_rocks = 0, any_craters = 0;
@@ -85,10 +104,10 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
         any_craters |= s->body[b].craters.n > 0;
     }
     if (any_rocks) {
-        snprintf(tmp, sizeof tmp, "%s/.%s_boulders.csv.tmp", dir, stem);
-        FILE *f = fopen(tmp, "w");
-        if (!f)
-            return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+        snprintf(name, sizeof name, "%s_boulders.csv", stem);
+        FILE *f;
+        if ((rc = begin(dir, name, tmp, sizeof tmp, &f)) < 0)
+            return rc;
         fprintf(f, "body,index,x_m,y_m,z_m,diameter_m,pixels\n");
         *nrocks = 0;
         for (int b = 0; b < s->nbodies && rc == 0; b++) {
@@ -112,17 +131,14 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
                 }
             free(px);
         }
-        if (fclose(f) != 0 && rc == 0)
-            rc = nc_error(-EIO, "%s: write failed", tmp);
-        snprintf(path, sizeof path, "%s/%s_boulders.csv", dir, stem);
-        if (rc < 0 || (rc = finish(tmp, path)) < 0)
+        if ((rc = commit(f, rc, tmp, dir, name)) < 0)
             return rc;
     }
     if (any_craters) {
-        snprintf(tmp, sizeof tmp, "%s/.%s_craters.csv.tmp", dir, stem);
-        FILE *f = fopen(tmp, "w");
-        if (!f)
-            return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+        snprintf(name, sizeof name, "%s_craters.csv", stem);
+        FILE *f;
+        if ((rc = begin(dir, name, tmp, sizeof tmp, &f)) < 0)
+            return rc;
         fprintf(f, "body,index,x_m,y_m,z_m,diameter_m,age,sample_px,line_px\n");
         *ncraters = 0;
         struct nc_mat3 cam = nc_quat_to_mat(c->attitude_q);
@@ -155,10 +171,7 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
                 (*ncraters)++;
             }
         }
-        if (fclose(f) != 0)
-            return nc_error(-EIO, "%s: write failed", tmp);
-        snprintf(path, sizeof path, "%s/%s_craters.csv", dir, stem);
-        if ((rc = finish(tmp, path)) < 0)
+        if ((rc = commit(f, 0, tmp, dir, name)) < 0)
             return rc;
     }
     return 0;
@@ -168,11 +181,12 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
                  const struct nc_traj_row *tr, const struct nc_scene *s, enum nc_quantity q, double exposure,
                  const char *quality, int nrocks, int ncraters)
 {
-    char tmp[4200], path[4200];
-    snprintf(tmp, sizeof tmp, "%s/.%s.json.tmp", dir, stem);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+    char tmp[4200], name[80];
+    snprintf(name, sizeof name, "%s.json", stem);
+    FILE *f;
+    int rc = begin(dir, name, tmp, sizeof tmp, &f);
+    if (rc < 0)
+        return rc;
     const struct nc_camera *c = &s->camera;
     fprintf(f, "{\"row\": %ld, \"line\": %d, \"t_s\": %.17g,\n", row, tr->line, tr->t_s);
     fprintf(f, " \"image\": \"%s.%s\", \"quantity\": \"%s\", \"units\": \"%s\", \"exposure_s\": %.17g, "
@@ -220,18 +234,10 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
                "\"quality\": \"%s\"}}\n",
             s->render.samples_per_pixel, (unsigned long long)s->render.seed, s->render.bounces, s->render.soft_shadows,
             quality[0] ? quality : "manual");
-    if (fclose(f) != 0)
-        return nc_error(-EIO, "%s: write failed", tmp);
-    snprintf(path, sizeof path, "%s/%s.json", dir, stem);
-    return finish(tmp, path);
+    return commit(f, 0, tmp, dir, name);
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
+static double now_s(void) { return (double)nc_mono_ns() * 1e-9; }
 
 int main(int argc, char **argv)
 {

@@ -9,13 +9,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "app/cli.h"
 #include "camera/camsys.h"
 #include "camera/load.h"
 #include "camera/shot.h"
+#include "core/clock.h"
 #include "core/error.h"
 #include "render/frame_io.h"
 #include "render/image_io.h"
@@ -66,12 +66,7 @@ static const char render_help[] =
     "camera +Z is the boresight, +X right and +Y down in the image.\n"
     "Pose, Sun, units and the NavCam version are written into the file's metadata.\n";
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
+static double now_ms(void) { return (double)nc_mono_ns() * 1e-6; }
 
 int main(int argc, char **argv)
 {

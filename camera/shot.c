@@ -5,19 +5,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "camera/load.h"
 #include "camera/quality.h"
+#include "core/clock.h"
 #include "core/error.h"
 #include "render/image_io.h"
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
+static double now_ms(void) { return (double)nc_mono_ns() * 1e-6; }
 
 static void flip_plane(void *px, size_t elem, int w, int h, int rows, int cols)
 {

@@ -124,43 +124,44 @@ double nc_imgcmp_ncc(const float *a, const float *b, const unsigned char *mask, 
     return cab / sqrt(va * vb);
 }
 
+/* The render moved by (tx, ty) against real: keep it if it correlates best. */
+struct search {
+    const float *real, *render;
+    float *moved;
+    int w, h;
+    double best, bx, by;
+};
+
+static void consider(struct search *s, double tx, double ty)
+{
+    nc_imgcmp_shift(s->render, s->w, s->h, tx, ty, s->moved);
+    double c = nc_imgcmp_ncc(s->real, s->moved, NULL, s->w, s->h, 1);
+    if (c > s->best) {
+        s->best = c;
+        s->bx = tx;
+        s->by = ty;
+    }
+}
+
 int nc_imgcmp_register(const float *real, const float *render, int w, int h, int radius_px, double *dx, double *dy)
 {
-    size_t n = (size_t)w * (size_t)h;
-    float *moved = malloc(n * sizeof *moved);
-    if (!moved)
+    struct search s = {real, render, malloc((size_t)w * (size_t)h * sizeof(float)), w, h, -2, 0, 0};
+    if (!s.moved)
         return nc_error(-ENOMEM, "out of memory");
-    double best = -2, bx = 0, by = 0;
     for (int sy = -radius_px; sy <= radius_px; sy++)
-        for (int sx = -radius_px; sx <= radius_px; sx++) {
-            nc_imgcmp_shift(render, w, h, sx, sy, moved);
-            double c = nc_imgcmp_ncc(real, moved, NULL, w, h, 1);
-            if (c > best) {
-                best = c;
-                bx = sx;
-                by = sy;
-            }
-        }
+        for (int sx = -radius_px; sx <= radius_px; sx++)
+            consider(&s, sx, sy);
     for (double step = 0.5; step >= 1.0 / 64; step /= 2) {
-        double cx = bx, cy = by;
-        for (int k = 0; k < 9; k++) {
-            if (k == 4)
-                continue;
-            double tx = cx + step * (k % 3 - 1), ty = cy + step * (k / 3 - 1);
-            nc_imgcmp_shift(render, w, h, tx, ty, moved);
-            double c = nc_imgcmp_ncc(real, moved, NULL, w, h, 1);
-            if (c > best) {
-                best = c;
-                bx = tx;
-                by = ty;
-            }
-        }
+        const double cx = s.bx, cy = s.by;
+        for (int k = 0; k < 9; k++)
+            if (k != 4)
+                consider(&s, cx + step * (k % 3 - 1), cy + step * (k / 3 - 1));
     }
-    free(moved);
-    if (!(best > -2))
+    free(s.moved);
+    if (!(s.best > -2))
         return nc_error(NC_ERANGE, "registration: the images do not overlap at any shift within %d px", radius_px);
-    *dx = bx;
-    *dy = by;
+    *dx = s.bx;
+    *dy = s.by;
     return 0;
 }
 
