@@ -80,8 +80,15 @@ int nc_bench_methods(const struct nc_bench_scene *sc, const struct nc_bench_opts
     }
     if (sc->has_rocks) {
         method(&all[n++], 16, 1, 1, 0, 0);
-        if (!o->quick)
+        if (!o->quick) {
             method(&all[n++], 16, 1, 1, 0, 4);
+            /* every rock, without the bounce and the penumbrae its error
+             * does not need, as samples grow (the cut's bias gone) */
+            method(&all[n++], 16, 0, 0, 0, 0);
+            method(&all[n++], 64, 0, 0, 0, 0);
+            method(&all[n++], 64, 0, 1, 0, 0);
+            method(&all[n++], 256, 0, 1, 0, 0);
+        }
     }
     method(&all[n], 0, 0, 0, 0, -1);
     snprintf(all[n].name, sizeof all[n].name, "auto");
@@ -190,6 +197,7 @@ struct shot {
     int sw, sh;
     double time_ms;
     char chosen[96];
+    char why[512]; /* auto: nc_quality_describe of its last choice */
 };
 
 static int render(const struct nc_bench_scene *sc, const struct nc_bench_opts *o, const struct nc_bench_method *m,
@@ -234,8 +242,12 @@ static int render(const struct nc_bench_scene *sc, const struct nc_bench_opts *o
             t[k - 1] = x;
         }
     out->time_ms = nt ? t[nt / 2] : 0;
-    snprintf(out->chosen, sizeof out->chosen, "spp=%d bounces=%d soft=%d", drawn.render.samples_per_pixel,
-             drawn.render.bounces, drawn.render.soft_shadows);
+    const int autod = m->auto_quality && !ref && nt;
+    snprintf(out->chosen, sizeof out->chosen, "spp=%d bounces=%d soft=%d%s%s", drawn.render.samples_per_pixel,
+             drawn.render.bounces, drawn.render.soft_shadows, autod && qc.all_rocks ? " rocks=all" : "",
+             autod && qc.full_mesh ? " lod=off" : "");
+    if (autod)
+        nc_quality_describe(&qc, out->why, sizeof out->why);
     out->sw = cs.width_px;
     out->sh = cs.height_px;
     if (rc >= 0 && !(out->e = malloc((size_t)cs.width_px * (size_t)cs.height_px * sizeof *out->e)))
@@ -360,6 +372,8 @@ int nc_bench_run_scene(const struct nc_bench_scene *sc, const struct nc_bench_op
             fprintf(log, "%s: %-22s %9.1f ms  rel RMS %.4g p95 %.4g  DN RMS %.4g p95 %.4g (noise %.3g DN)\n",
                     sc->name, m[i].name, res[i].time_ms, res[i].rel_rms, res[i].rel_p95, res[i].dn_rms, res[i].dn_p95,
                     res[i].noise_dn);
+            if (x.why[0])
+                fprintf(log, "%s: auto: %s\n", sc->name, x.why);
             fflush(log);
         }
         shot_free(&x);

@@ -44,7 +44,8 @@ static const char bench_help[] =
     "CSV columns: scene, method, spp, bounces, soft_shadows, lod_error_px,\n"
     "boulder_min_px (-1: the scene's default), time_ms, rel_rms, rel_p95, dn_rms,\n"
     "dn_p95, noise_dn (the camera's shot and read noise at the median lit pixel),\n"
-    "pareto (1: no other method is both faster and closer in rel_rms), chosen\n"
+    "pareto (1: no other method is both faster and closer in rel_rms), pareto_dn\n"
+    "(the same in dn_rms: the error auto bounds), chosen\n"
     "(what auto picked).\n";
 
 static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
@@ -59,24 +60,42 @@ static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
     return 0;
 }
 
+/* The error a front is drawn in: relative radiance RMS, or DN RMS after
+ * the camera model (what render.quality: auto bounds). */
+static double err_of(const struct nc_bench_result *r, int dn) { return dn ? r->dn_rms : r->rel_rms; }
+
 /* Pareto flags over the scene's methods (auto excluded from the front). */
-static void pareto(const struct nc_bench_method *m, struct nc_bench_result *r, int n)
+static void pareto(const struct nc_bench_method *m, const struct nc_bench_result *r, int n, int dn, int *flag)
 {
     for (int i = 0; i < n; i++) {
-        r[i].pareto = !m[i].auto_quality;
-        for (int k = 0; k < n && r[i].pareto; k++)
-            if (k != i && !m[k].auto_quality && r[k].time_ms <= r[i].time_ms && r[k].rel_rms <= r[i].rel_rms &&
-                (r[k].time_ms < r[i].time_ms || r[k].rel_rms < r[i].rel_rms))
-                r[i].pareto = 0;
+        flag[i] = !m[i].auto_quality;
+        for (int k = 0; k < n && flag[i]; k++)
+            if (k != i && !m[k].auto_quality && r[k].time_ms <= r[i].time_ms && err_of(&r[k], dn) <= err_of(&r[i], dn) &&
+                (r[k].time_ms < r[i].time_ms || err_of(&r[k], dn) < err_of(&r[i], dn)))
+                flag[i] = 0;
     }
 }
 
-/* auto's time over the front's at auto's error: the front (sorted by time,
- * errors falling) interpolated in log time against log error between the
- * two methods that bracket it, or its cheapest method where that is already
- * closer; -1 where auto is closer than every method of the front. */
+/* The flagged methods sorted by time (errors falling); returns how many. */
+static int front_of(const struct nc_bench_result *r, int n, const int *flag, int *idx)
+{
+    int nf = 0;
+    for (int i = 0; i < n; i++)
+        if (flag[i]) {
+            int k = nf++;
+            for (; k > 0 && r[idx[k - 1]].time_ms > r[i].time_ms; k--)
+                idx[k] = idx[k - 1];
+            idx[k] = i;
+        }
+    return nf;
+}
+
+/* auto's time over the front's at auto's error: the front interpolated in
+ * log time against log error between the two methods that bracket it, or
+ * its cheapest method where that is already closer; -1 where auto is closer
+ * than every method of the front. */
 static double auto_ratio(const struct nc_bench_method *m, const struct nc_bench_result *r, int n, const int *front,
-                         int nf)
+                         int nf, int dn)
 {
     int a = -1;
     for (int i = 0; i < n; i++)
@@ -84,17 +103,29 @@ static double auto_ratio(const struct nc_bench_method *m, const struct nc_bench_
             a = i;
     if (a < 0 || nf == 0)
         return -1;
-    const double e = r[a].rel_rms;
-    if (r[front[0]].rel_rms <= e)
+    const double e = err_of(&r[a], dn);
+    if (err_of(&r[front[0]], dn) <= e)
         return r[a].time_ms / r[front[0]].time_ms;
     for (int k = 1; k < nf; k++) {
         const struct nc_bench_result *p = &r[front[k - 1]], *q = &r[front[k]];
-        if (q->rel_rms <= e) {
-            double u = log(e / p->rel_rms) / log(q->rel_rms / p->rel_rms);
+        if (err_of(q, dn) <= e) {
+            double u = log(e / err_of(p, dn)) / log(err_of(q, dn) / err_of(p, dn));
             return r[a].time_ms / exp(log(p->time_ms) + u * log(q->time_ms / p->time_ms));
         }
     }
     return -1;
+}
+
+/* One line on auto against a front. */
+static void report_auto(const char *scene, const struct nc_bench_result *a, double ratio, int dn)
+{
+    const char *what = dn ? "DN RMS" : "rel RMS";
+    if (ratio > 0)
+        printf("%s: auto (%s) takes %.2f x the %s front's time at its error (%s %.4g)\n", scene, a->chosen, ratio,
+               dn ? "DN" : "relative", what, err_of(a, dn));
+    else
+        printf("%s: auto (%s) is closer than every method of the %s front (%s %.4g)\n", scene, a->chosen,
+               dn ? "DN" : "relative", what, err_of(a, dn));
 }
 
 static void gp_scene(FILE *gp, const char *name, const char *what)
@@ -185,7 +216,7 @@ int main(int argc, char **argv)
         return 1;
     }
     fprintf(csv, "scene,method,spp,bounces,soft_shadows,lod_error_px,boulder_min_px,time_ms,rel_rms,rel_p95,dn_rms,"
-                 "dn_p95,noise_dn,pareto,chosen\n");
+                 "dn_p95,noise_dn,pareto,pareto_dn,chosen\n");
     fprintf(front, "scene,time_ms,rel_rms\n");
     fprintf(gp, "# gnuplot script written by navcam bench accuracy\nset datafile separator ','\n"
                 "set terminal pngcairo size 1500,1000 font ',9'\nset output 'accuracy.png'\n"
@@ -215,29 +246,20 @@ int main(int argc, char **argv)
         int n = nc_bench_methods(sc, &o, m, 40);
         if ((rc = nc_bench_run_scene(sc, &o, m, n, res, stdout)) < 0)
             break;
-        pareto(m, res, n);
-        for (int i = 0; i < n; i++)
-            fprintf(csv, "%s,%s,%d,%d,%d,%g,%g,%.4f,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%s\n", sc->name, m[i].name, m[i].spp,
+        int flag[40], flag_dn[40], idx[40], idx_dn[40];
+        pareto(m, res, n, 0, flag);
+        pareto(m, res, n, 1, flag_dn);
+        for (int i = 0; i < n; i++) {
+            res[i].pareto = flag[i];
+            fprintf(csv, "%s,%s,%d,%d,%d,%g,%g,%.4f,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%s\n", sc->name, m[i].name, m[i].spp,
                     m[i].bounces, m[i].soft, m[i].lod_error_px, m[i].boulder_min_px, res[i].time_ms, res[i].rel_rms,
-                    res[i].rel_p95, res[i].dn_rms, res[i].dn_p95, res[i].noise_dn, res[i].pareto, res[i].chosen);
-        /* the front, by time */
-        int idx[40], nf = 0;
-        for (int i = 0; i < n; i++)
-            if (res[i].pareto) {
-                int k = nf++;
-                for (; k > 0 && res[idx[k - 1]].time_ms > res[i].time_ms; k--)
-                    idx[k] = idx[k - 1];
-                idx[k] = i;
-            }
+                    res[i].rel_p95, res[i].dn_rms, res[i].dn_p95, res[i].noise_dn, flag[i], flag_dn[i], res[i].chosen);
+        }
+        int nf = front_of(res, n, flag, idx), nf_dn = front_of(res, n, flag_dn, idx_dn);
         for (int k = 0; k < nf; k++)
             fprintf(front, "%s,%.4f,%.6g\n", sc->name, res[idx[k]].time_ms, res[idx[k]].rel_rms);
-        double ratio = auto_ratio(m, res, n, idx, nf);
-        if (ratio > 0)
-            printf("%s: auto (%s) takes %.2f x the front's time at its error (rel RMS %.4g)\n", sc->name,
-                   res[n - 1].chosen, ratio, res[n - 1].rel_rms);
-        else
-            printf("%s: auto (%s) is closer than every method of the front (rel RMS %.4g)\n", sc->name,
-                   res[n - 1].chosen, res[n - 1].rel_rms);
+        report_auto(sc->name, &res[n - 1], auto_ratio(m, res, n, idx, nf, 0), 0);
+        report_auto(sc->name, &res[n - 1], auto_ratio(m, res, n, idx_dn, nf_dn, 1), 1);
         gp_scene(gp, sc->name, sc->what);
         nplots++;
     }

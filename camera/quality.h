@@ -1,19 +1,30 @@
 /* quality.h - render.quality: auto. Picks, per frame, the cheapest render
  * settings whose error stays under a fraction k (render.auto_noise_fraction)
  * of the camera's own noise (shot plus read noise, in electrons, at each
- * pixel's level):
- *   - soft shadows when the penumbra a body can cast on itself or another,
- *     2 tan(a_sun) x its diameter, spans half a pixel at its nearest range;
+ * pixel's level), from pilots: renders of every fourth row of tiles (every
+ * row for frames under 8 tile rows) at one sample a pixel, each anywhere in
+ * its pixel:
+ *   - soft shadows where the penumbra a body can cast on itself or another,
+ *     2 tan(a_sun) x its diameter, spans half a pixel at its nearest range,
+ *     and a pilot with hard shadows differs from the same rays with soft
+ *     ones by more than k/2 camera sigmas RMS;
+ *   - every boulder traced (render.boulder_min_px 0) where the configured
+ *     cut, and the full meshes (render.lod_error_px 0) where the configured
+ *     level of detail, changes a pilot by more than k/2 sigmas RMS (biases
+ *     that samples do not reduce);
  *   - indirect light when a pilot's mean bounce light exceeds k camera
  *     sigmas, with as many bounces as leave less than that unrendered
  *     (each bounce taken to scale the last by the pilot's ratio of indirect
  *     to direct light), at most 8;
- *   - samples per pixel from two pilots with different seeds: the mean over
- *     lit pixels of the Monte Carlo variance at one sample over the camera's
- *     noise variance, divided by k^2, rounded up to a square (1 to 256).
- * The pilots render one sample a pixel in every fourth row of tiles (every
- * row for frames under 8 tile rows). Everything is keyed by the scene's
- * seed: the same frame gets the same choice.
+ *   - samples per pixel: the mean over lit pixels of the Monte Carlo
+ *     variance of one sample over the camera's noise variance (two pilots
+ *     with different seeds), times sum(w^2) of the PSF kernel (independent
+ *     pixel errors through the optics), v1. Where v1 > k^2, two more pilots at 2 x 2
+ *     strata give v4, and the variance is taken to fall as S^-beta with
+ *     beta = log4(v1 / v4) in [1, 2]: the smallest square S (4 to 256)
+ *     with v4 (4 / S)^beta <= k^2.
+ * Everything is keyed by the scene's seed: the same frame gets the same
+ * choice.
  */
 #ifndef NC_CAMERA_QUALITY_H
 #define NC_CAMERA_QUALITY_H
@@ -26,7 +37,11 @@ struct nc_quality_choice {
     double mc_to_noise_var;  /* mean over lit pixels of (MC variance at 1 sample / camera noise variance) */
     double indirect_sigma;   /* mean bounce light over the camera's noise sigma */
     double indirect_ratio;   /* bounce light over direct light */
-    double penumbra_px;
+    double penumbra_px;      /* the widest penumbra any body can cast, px (a bound) */
+    double hard_shadow_rms;  /* hard against soft shadows, camera sigmas RMS (0: not tried) */
+    double cut_rms, lod_rms; /* the boulder cut, the level of detail against none, the same */
+    int all_rocks, full_mesh; /* render.boulder_min_px and render.lod_error_px set to 0 */
+    double strata_beta;      /* the variance's fall with samples, S^-beta */
     double pilot_ms;
 };
 

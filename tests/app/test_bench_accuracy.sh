@@ -3,13 +3,16 @@
 # scenes at a small size: the CSV is complete and finite, every scene has a
 # Pareto front, the DN error falls with samples, render.quality: auto picks
 # indirect light for the crater at low Sun and none for the convex sphere,
-# and gnuplot draws the chart.
+# samples for the sphere's limb (its pilots sample the whole pixel) with a
+# DN error under the camera's noise, every rock where the boulder cut's
+# bias shows, and gnuplot draws the chart.
 # Usage: test_bench_accuracy.sh NAVCAM TMPDIR
 set -u
 navcam=$1
 tmp=$2
 rm -rf "$tmp" && mkdir -p "$tmp"
-if ! "$navcam" bench accuracy --quick --size 48 --ref-spp 64 --scene sphere --scene crater -o "$tmp/out" \
+if ! "$navcam" bench accuracy --quick --size 48 --ref-spp 64 --scene sphere --scene crater \
+    --scene rubble -o "$tmp/out" \
     > "$tmp/log" 2>&1; then
   cat "$tmp/log" >&2
   echo "FAIL: navcam bench accuracy exited non-zero" >&2
@@ -31,14 +34,27 @@ for r in rows:
         v = float(r[k])
         check(math.isfinite(v) and v >= 0, "%s %s: %s = %s" % (r["scene"], r["method"], k, r[k]))
     check(float(r["time_ms"]) > 0, "%s %s: time 0" % (r["scene"], r["method"]))
-check(sorted(scenes) == ["crater", "sphere"], "scenes %s" % sorted(scenes))
+check(sorted(scenes) == ["crater", "rubble", "sphere"], "scenes %s" % sorted(scenes))
 for name, m in scenes.items():
-    check(len(m) == 7, "%s: %d methods" % (name, len(m)))
+    check(len(m) == (8 if name == "rubble" else 7), "%s: %d methods" % (name, len(m)))
     check(any(r["pareto"] == "1" for r in m.values()), "%s: no Pareto front" % name)
     check(float(m["4spp"]["dn_rms"]) < float(m["1spp"]["dn_rms"]), "%s: DN error does not fall with samples" % name)
     check(m["auto"]["chosen"].startswith("spp="), "%s: auto chose '%s'" % (name, m["auto"]["chosen"]))
 check("bounces=0" in scenes["sphere"]["auto"]["chosen"], "sphere: auto chose %s" % scenes["sphere"]["auto"]["chosen"])
 check("bounces=0" not in scenes["crater"]["auto"]["chosen"], "crater: auto chose %s" % scenes["crater"]["auto"]["chosen"])
+# One sample at each pixel's centre sees no limb: auto must ask for samples,
+# and land under the camera's noise (k = 0.25 of it, plus the 64-sample
+# reference's own error at this size).
+spp = int(scenes["sphere"]["auto"]["chosen"].split()[0][4:])
+check(spp >= 16, "sphere: auto chose %d samples a pixel" % spp)
+for name in ("sphere", "crater"):
+    a = scenes[name]["auto"]
+    check(float(a["dn_rms"]) <= 0.6 * float(a["noise_dn"]),
+          "%s: auto's DN error %s against the camera's noise %s" % (name, a["dn_rms"], a["noise_dn"]))
+r = scenes["rubble"]
+check("rocks=all" in r["auto"]["chosen"], "rubble: auto chose %s (the boulder cut's bias)" % r["auto"]["chosen"])
+check(float(r["auto"]["dn_rms"]) < float(r["16spp b1 soft rocks0"]["dn_rms"]),
+      "rubble: auto's DN error %s, 16 spp with every rock %s" % (r["auto"]["dn_rms"], r["16spp b1 soft rocks0"]["dn_rms"]))
 png = open(d + "/accuracy.png", "rb").read(8)
 check(png == b"\x89PNG\r\n\x1a\n", "accuracy.png is not a PNG")
 for f in fail:
