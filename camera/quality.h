@@ -41,7 +41,7 @@ struct nc_quality_choice {
     double hard_shadow_rms;  /* hard against soft shadows, camera sigmas RMS (0: not tried) */
     double cut_rms, lod_rms; /* the boulder cut, the level of detail against none, the same */
     int all_rocks, full_mesh; /* render.boulder_min_px and render.lod_error_px set to 0 */
-    double strata_beta;      /* the variance's fall with samples, S^-beta */
+    double strata_beta;      /* the variance's fall with samples, S^-beta (1: not measured, one sample chosen) */
     double pilot_ms;
 };
 
