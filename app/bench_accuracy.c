@@ -307,15 +307,25 @@ static void errors(const struct shot *ref, const struct shot *x, const struct dn
         if (ref->f.coverage[i] > 0 && ref->f.radiance[i] > floor)
             v[k++] = fabs((double)x->f.radiance[i] - ref->f.radiance[i]) / ref->f.radiance[i];
     stats(v, k, &res->rel_rms, &res->rel_p95);
-    /* DN, noise-free, clipped at the full well, where either frame has light */
+    /* DN, noise-free, clipped at the full well, where either frame has
+     * light; and the same pixels' errors over their own camera noise (shot
+     * at the reference's electrons, plus read) */
+    double *u = malloc((ne ? ne : 1) * sizeof *u);
+    if (!u) {
+        free(v);
+        return;
+    }
     k = 0;
     for (size_t i = 0; i < ne; i++) {
-        double a = fmin(ref->e[i] * dm->t, dm->full_well_e) * dm->dn_per_e;
-        double b = fmin(x->e[i] * dm->t, dm->full_well_e) * dm->dn_per_e;
-        if (a >= 1 || b >= 1)
-            v[k++] = fabs(b - a);
+        double a = fmin(ref->e[i] * dm->t, dm->full_well_e), b = fmin(x->e[i] * dm->t, dm->full_well_e);
+        if (a * dm->dn_per_e >= 1 || b * dm->dn_per_e >= 1) {
+            u[k] = fabs(b - a) / sqrt(fmax(a + dm->read_e * dm->read_e, 1.0)); /* 1 e: sky, no read noise */
+            v[k++] = fabs(b - a) * dm->dn_per_e;
+        }
     }
     stats(v, k, &res->dn_rms, &res->dn_p95);
+    stats(u, k, &res->sigma_rms, &res->sigma_p95);
+    free(u);
     k = 0;
     for (size_t i = 0; i < ne; i++)
         if (ref->e[i] * dm->t * dm->dn_per_e >= 1)
@@ -369,9 +379,11 @@ int nc_bench_run_scene(const struct nc_bench_scene *sc, const struct nc_bench_op
             res[i].time_ms = x.time_ms;
             errors(&ref, &x, &dm, &res[i]);
             snprintf(res[i].chosen, sizeof res[i].chosen, "%s", m[i].auto_quality ? x.chosen : "");
-            fprintf(log, "%s: %-22s %9.1f ms  rel RMS %.4g p95 %.4g  DN RMS %.4g p95 %.4g (noise %.3g DN)\n",
+            fprintf(log,
+                    "%s: %-22s %9.1f ms  rel RMS %.4g p95 %.4g  DN RMS %.4g p95 %.4g (noise %.3g DN)  "
+                    "sigma RMS %.3g p95 %.3g\n",
                     sc->name, m[i].name, res[i].time_ms, res[i].rel_rms, res[i].rel_p95, res[i].dn_rms, res[i].dn_p95,
-                    res[i].noise_dn);
+                    res[i].noise_dn, res[i].sigma_rms, res[i].sigma_p95);
             if (x.why[0])
                 fprintf(log, "%s: auto: %s\n", sc->name, x.why);
             fflush(log);

@@ -26,6 +26,8 @@ struct nc_bench_result {
     double rel_rms, rel_p95;      /* |L - Lref| / Lref over the body's pixels */
     double dn_rms, dn_p95;        /* |DN - DNref| after the camera model, noise-free */
     double noise_dn;              /* the camera's own noise (shot + read) at the median body pixel, DN */
+    double sigma_rms, sigma_p95;  /* |e - eref| / sqrt(eref + read^2): each pixel's error over its own
+                                     camera noise (what render.quality: auto bounds by k) */
     int pareto;                   /* no other method of the scene is both faster and closer (rel_rms) */
     char chosen[96];              /* auto: the settings it picked */
 };

@@ -44,9 +44,10 @@ static const char bench_help[] =
     "CSV columns: scene, method, spp, bounces, soft_shadows, lod_error_px,\n"
     "boulder_min_px (-1: the scene's default), time_ms, rel_rms, rel_p95, dn_rms,\n"
     "dn_p95, noise_dn (the camera's shot and read noise at the median lit pixel),\n"
-    "pareto (1: no other method is both faster and closer in rel_rms), pareto_dn\n"
-    "(the same in dn_rms: the error auto bounds), chosen\n"
-    "(what auto picked).\n";
+    "sigma_rms, sigma_p95 (each pixel's DN error over its own shot and read noise:\n"
+    "the error render.quality: auto bounds by auto_noise_fraction), pareto (1: no\n"
+    "other method is both faster and closer in rel_rms), pareto_dn (the same in\n"
+    "dn_rms), pareto_sigma (in sigma_rms), chosen (what auto picked).\n";
 
 static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
 {
@@ -60,18 +61,27 @@ static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
     return 0;
 }
 
-/* The error a front is drawn in: relative radiance RMS, or DN RMS after
- * the camera model (what render.quality: auto bounds). */
-static double err_of(const struct nc_bench_result *r, int dn) { return dn ? r->dn_rms : r->rel_rms; }
+/* The errors a front is drawn in: relative radiance RMS, DN RMS after the
+ * camera model, and RMS of each pixel's error over its own camera noise
+ * (what render.quality: auto bounds by k). */
+enum metric { M_REL, M_DN, M_SIGMA, NMETRIC };
+static const char *const metric_name[NMETRIC] = {"relative", "DN", "sigma"};
+static const char *const metric_err[NMETRIC] = {"rel RMS", "DN RMS", "sigma RMS"};
+
+static double err_of(const struct nc_bench_result *r, int metric)
+{
+    return metric == M_REL ? r->rel_rms : metric == M_DN ? r->dn_rms : r->sigma_rms;
+}
 
 /* Pareto flags over the scene's methods (auto excluded from the front). */
-static void pareto(const struct nc_bench_method *m, const struct nc_bench_result *r, int n, int dn, int *flag)
+static void pareto(const struct nc_bench_method *m, const struct nc_bench_result *r, int n, int metric, int *flag)
 {
     for (int i = 0; i < n; i++) {
         flag[i] = !m[i].auto_quality;
         for (int k = 0; k < n && flag[i]; k++)
-            if (k != i && !m[k].auto_quality && r[k].time_ms <= r[i].time_ms && err_of(&r[k], dn) <= err_of(&r[i], dn) &&
-                (r[k].time_ms < r[i].time_ms || err_of(&r[k], dn) < err_of(&r[i], dn)))
+            if (k != i && !m[k].auto_quality && r[k].time_ms <= r[i].time_ms &&
+                err_of(&r[k], metric) <= err_of(&r[i], metric) &&
+                (r[k].time_ms < r[i].time_ms || err_of(&r[k], metric) < err_of(&r[i], metric)))
                 flag[i] = 0;
     }
 }
@@ -95,7 +105,7 @@ static int front_of(const struct nc_bench_result *r, int n, const int *flag, int
  * its cheapest method where that is already closer; -1 where auto is closer
  * than every method of the front. */
 static double auto_ratio(const struct nc_bench_method *m, const struct nc_bench_result *r, int n, const int *front,
-                         int nf, int dn)
+                         int nf, int metric)
 {
     int a = -1;
     for (int i = 0; i < n; i++)
@@ -103,13 +113,13 @@ static double auto_ratio(const struct nc_bench_method *m, const struct nc_bench_
             a = i;
     if (a < 0 || nf == 0)
         return -1;
-    const double e = err_of(&r[a], dn);
-    if (err_of(&r[front[0]], dn) <= e)
+    const double e = err_of(&r[a], metric);
+    if (err_of(&r[front[0]], metric) <= e)
         return r[a].time_ms / r[front[0]].time_ms;
     for (int k = 1; k < nf; k++) {
         const struct nc_bench_result *p = &r[front[k - 1]], *q = &r[front[k]];
-        if (err_of(q, dn) <= e) {
-            double u = log(e / err_of(p, dn)) / log(err_of(q, dn) / err_of(p, dn));
+        if (err_of(q, metric) <= e) {
+            double u = log(e / err_of(p, metric)) / log(err_of(q, metric) / err_of(p, metric));
             return r[a].time_ms / exp(log(p->time_ms) + u * log(q->time_ms / p->time_ms));
         }
     }
@@ -117,15 +127,14 @@ static double auto_ratio(const struct nc_bench_method *m, const struct nc_bench_
 }
 
 /* One line on auto against a front. */
-static void report_auto(const char *scene, const struct nc_bench_result *a, double ratio, int dn)
+static void report_auto(const char *scene, const struct nc_bench_result *a, double ratio, int metric)
 {
-    const char *what = dn ? "DN RMS" : "rel RMS";
     if (ratio > 0)
         printf("%s: auto (%s) takes %.2f x the %s front's time at its error (%s %.4g)\n", scene, a->chosen, ratio,
-               dn ? "DN" : "relative", what, err_of(a, dn));
+               metric_name[metric], metric_err[metric], err_of(a, metric));
     else
         printf("%s: auto (%s) is closer than every method of the %s front (%s %.4g)\n", scene, a->chosen,
-               dn ? "DN" : "relative", what, err_of(a, dn));
+               metric_name[metric], metric_err[metric], err_of(a, metric));
 }
 
 static void gp_scene(FILE *gp, const char *name, const char *what)
@@ -216,7 +225,7 @@ int main(int argc, char **argv)
         return 1;
     }
     fprintf(csv, "scene,method,spp,bounces,soft_shadows,lod_error_px,boulder_min_px,time_ms,rel_rms,rel_p95,dn_rms,"
-                 "dn_p95,noise_dn,pareto,pareto_dn,chosen\n");
+                 "dn_p95,noise_dn,sigma_rms,sigma_p95,pareto,pareto_dn,pareto_sigma,chosen\n");
     fprintf(front, "scene,time_ms,rel_rms\n");
     fprintf(gp, "# gnuplot script written by navcam bench accuracy\nset datafile separator ','\n"
                 "set terminal pngcairo size 1500,1000 font ',9'\nset output 'accuracy.png'\n"
@@ -246,20 +255,23 @@ int main(int argc, char **argv)
         int n = nc_bench_methods(sc, &o, m, 40);
         if ((rc = nc_bench_run_scene(sc, &o, m, n, res, stdout)) < 0)
             break;
-        int flag[40], flag_dn[40], idx[40], idx_dn[40];
-        pareto(m, res, n, 0, flag);
-        pareto(m, res, n, 1, flag_dn);
-        for (int i = 0; i < n; i++) {
-            res[i].pareto = flag[i];
-            fprintf(csv, "%s,%s,%d,%d,%d,%g,%g,%.4f,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%s\n", sc->name, m[i].name, m[i].spp,
-                    m[i].bounces, m[i].soft, m[i].lod_error_px, m[i].boulder_min_px, res[i].time_ms, res[i].rel_rms,
-                    res[i].rel_p95, res[i].dn_rms, res[i].dn_p95, res[i].noise_dn, flag[i], flag_dn[i], res[i].chosen);
+        int flag[NMETRIC][40], idx[NMETRIC][40], nf[NMETRIC];
+        for (int q = 0; q < NMETRIC; q++) {
+            pareto(m, res, n, q, flag[q]);
+            nf[q] = front_of(res, n, flag[q], idx[q]);
         }
-        int nf = front_of(res, n, flag, idx), nf_dn = front_of(res, n, flag_dn, idx_dn);
-        for (int k = 0; k < nf; k++)
-            fprintf(front, "%s,%.4f,%.6g\n", sc->name, res[idx[k]].time_ms, res[idx[k]].rel_rms);
-        report_auto(sc->name, &res[n - 1], auto_ratio(m, res, n, idx, nf, 0), 0);
-        report_auto(sc->name, &res[n - 1], auto_ratio(m, res, n, idx_dn, nf_dn, 1), 1);
+        for (int i = 0; i < n; i++) {
+            res[i].pareto = flag[M_REL][i];
+            fprintf(csv, "%s,%s,%d,%d,%d,%g,%g,%.4f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%s\n", sc->name,
+                    m[i].name, m[i].spp, m[i].bounces, m[i].soft, m[i].lod_error_px, m[i].boulder_min_px,
+                    res[i].time_ms, res[i].rel_rms, res[i].rel_p95, res[i].dn_rms, res[i].dn_p95, res[i].noise_dn,
+                    res[i].sigma_rms, res[i].sigma_p95, flag[M_REL][i], flag[M_DN][i], flag[M_SIGMA][i],
+                    res[i].chosen);
+        }
+        for (int k = 0; k < nf[M_REL]; k++)
+            fprintf(front, "%s,%.4f,%.6g\n", sc->name, res[idx[M_REL][k]].time_ms, res[idx[M_REL][k]].rel_rms);
+        for (int q = 0; q < NMETRIC; q++)
+            report_auto(sc->name, &res[n - 1], auto_ratio(m, res, n, idx[q], nf[q], q), q);
         gp_scene(gp, sc->name, sc->what);
         nplots++;
     }

@@ -1,9 +1,10 @@
 /* quality.h - render.quality: auto. Picks, per frame, the cheapest render
  * settings whose error stays under a fraction k (render.auto_noise_fraction)
  * of the camera's own noise (shot plus read noise, in electrons, at each
- * pixel's level), from pilots: renders of every fourth row of tiles (every
- * row for frames under 8 tile rows) at one sample a pixel, each anywhere in
- * its pixel:
+ * pixel's level), from pilots: renders at one sample a pixel, each anywhere
+ * in its pixel, of rows of tiles over each body's image (every l-th, l the
+ * largest power of 2 up to 16 that puts 4 rows through it; rows no body
+ * can reach are skipped, so a small body is seen wherever it lies):
  *   - soft shadows where the penumbra a body can cast on itself or another,
  *     2 tan(a_sun) x its diameter, spans half a pixel at its nearest range,
  *     and a pilot with hard shadows differs from the same rays with soft
@@ -21,8 +22,9 @@
  *     with different seeds), times sum(w^2) of the PSF kernel (independent
  *     pixel errors through the optics), v1. Where v1 > k^2, two more pilots at 2 x 2
  *     strata give v4, and the variance is taken to fall as S^-beta with
- *     beta = log4(v1 / v4) in [1, 2]: the smallest square S (4 to 256)
- *     with v4 (4 / S)^beta <= k^2.
+ *     beta = log4(v1 / v4) in [1, 2], at least 1.5 without a bounce
+ *     (jittered strata cut an edge's variance as S^-1.5): the smallest
+ *     square S (4 to 256) with v4 (4 / S)^beta <= k^2.
  * Everything is keyed by the scene's seed: the same frame gets the same
  * choice.
  */
@@ -42,6 +44,7 @@ struct nc_quality_choice {
     double cut_rms, lod_rms; /* the boulder cut, the level of detail against none, the same */
     int all_rocks, full_mesh; /* render.boulder_min_px and render.lod_error_px set to 0 */
     double strata_beta;      /* the variance's fall with samples, S^-beta (1: not measured, one sample chosen) */
+    int pilot_rows;          /* rows of tiles each pilot rendered */
     double pilot_ms;
 };
 

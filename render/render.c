@@ -132,7 +132,8 @@ struct job {
     struct nc_material mat[NC_MAX_BODIES];     /* each body's, with its rocks not traced folded in */
     int tiles_x, tiles_y, n_strata;
     struct nc_sample_pass pass; /* this time sample's share of each pixel's samples ({0, 1, S}: all) */
-    int tile_row_begin, tile_row_end, tile_row_step; /* the rows of tiles to render */
+    int tile_row_begin, n_tile_rows; /* the rows of tiles to render: begin, begin + 1, ... */
+    const int *tile_rows;            /* or these (not NULL) */
     atomic_int next;
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
     struct nc_vec3 sun_dir;
@@ -622,13 +623,13 @@ static void shade_tile(struct job *j, int tile)
 static void *worker(void *arg)
 {
     struct job *j = arg;
-    const int nrows = (j->tile_row_end - j->tile_row_begin + j->tile_row_step - 1) / j->tile_row_step;
-    const int ntiles = j->tiles_x * nrows;
+    const int ntiles = j->tiles_x * j->n_tile_rows;
     for (;;) {
         int t = atomic_fetch_add(&j->next, 1);
         if (t >= ntiles)
             break;
-        shade_tile(j, t % j->tiles_x + (j->tile_row_begin + t / j->tiles_x * j->tile_row_step) * j->tiles_x);
+        const int i = t / j->tiles_x, row = j->tile_rows ? j->tile_rows[i] : j->tile_row_begin + i;
+        shade_tile(j, t % j->tiles_x + row * j->tiles_x);
     }
     return NULL;
 }
@@ -647,24 +648,29 @@ int nc_render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_fr
 }
 
 static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
-                       int tile_row_end, int tile_row_step, const double *row_dt, const struct nc_sample_pass *pass);
+                       int tile_row_end, const int *tile_rows, const double *row_dt,
+                       const struct nc_sample_pass *pass);
 
 int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
                          int tile_row_end, const double *row_dt, const struct nc_sample_pass *pass)
 {
-    return render_rows(r, s, f, tile_row_begin, tile_row_end, 1, row_dt, pass);
+    return render_rows(r, s, f, tile_row_begin, tile_row_end, NULL, row_dt, pass);
 }
 
-int nc_render_rows_every(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_step,
-                         const struct nc_sample_pass *pass)
+int nc_render_row_list(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, const int *tile_rows,
+                       int n, const struct nc_sample_pass *pass)
 {
-    if (tile_row_step < 1)
-        return nc_error(NC_ERANGE, "render: every %d-th row of tiles", tile_row_step);
-    return render_rows(r, s, f, 0, nc_render_tile_rows(s), tile_row_step, NULL, pass);
+    const int rows = nc_render_tile_rows(s);
+    for (int i = 0; i < n; i++)
+        if (tile_rows[i] < 0 || tile_rows[i] >= rows)
+            return nc_error(NC_ERANGE, "render: tile row %d of %d", tile_rows[i], rows);
+    return render_rows(r, s, f, 0, n, tile_rows, NULL, pass);
 }
 
+/* Tile rows [begin, end), or tile_rows[0 .. end - begin) where not NULL. */
 static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
-                       int tile_row_end, int tile_row_step, const double *row_dt, const struct nc_sample_pass *pass)
+                       int tile_row_end, const int *tile_rows, const double *row_dt,
+                       const struct nc_sample_pass *pass)
 {
     const struct nc_camera *c = &s->camera;
     if (f->width_px != c->width_px || f->height_px != c->height_px)
@@ -699,10 +705,10 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
     }
     j.tiles_x = (c->width_px + TILE - 1) / TILE;
     j.tiles_y = (c->height_px + TILE - 1) / TILE;
-    j.tile_row_begin = tile_row_begin < 0 ? 0 : tile_row_begin;
-    j.tile_row_end = tile_row_end > j.tiles_y ? j.tiles_y : tile_row_end;
-    j.tile_row_step = tile_row_step;
-    if (j.tile_row_end <= j.tile_row_begin) {
+    j.tile_rows = tile_rows;
+    j.tile_row_begin = tile_rows || tile_row_begin < 0 ? 0 : tile_row_begin;
+    j.n_tile_rows = (tile_rows || tile_row_end <= j.tiles_y ? tile_row_end : j.tiles_y) - j.tile_row_begin;
+    if (j.n_tile_rows <= 0) {
         free(j.row);
         return 0;
     }

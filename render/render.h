@@ -102,9 +102,10 @@ struct nc_sample_pass {
  * pass NULL renders every stratum (S samples). */
 int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
                          int tile_row_end, const double *row_dt, const struct nc_sample_pass *pass);
-/* Tile rows 0, step, 2 step, ... of the frame (a sample of it: pilots). */
-int nc_render_rows_every(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_step,
-                         const struct nc_sample_pass *pass);
+/* The n tile rows tile_rows[] of the frame, each in [0, nc_render_tile_rows)
+ * (a sample of it: pilots); other rows of f are left as they are. */
+int nc_render_row_list(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, const int *tile_rows,
+                       int n, const struct nc_sample_pass *pass);
 
 /* An exposure: pose motion integrated over the exposure window. The scene's
  * poses are those at mid-exposure (of the middle row, for a rolling shutter);

@@ -42,10 +42,13 @@ struct rt_body {
     struct nc__rt_rocks rocks;
     int analytic;
     /* Shadow-ray culling (shadow_grid.h): which levels are closed outward
-     * surfaces, and the grid of the level shown (body frame, body origin). */
+     * surfaces, and the grids of the level shown (body frame, body origin),
+     * one for hard shadows and one for soft (wider: rays to the whole solar
+     * disk), kept both so that frames alternating the two (auto's pilots)
+     * do not rebuild them; grid is the one in use. */
     int closed[NC_LOD_MAX_LEVELS];
-    struct nc_shadow_grid grid;
-    int grid_level; /* -1: no valid grid */
+    struct nc_shadow_grid grids[2], *grid;
+    int grid_levels[2], grid_level; /* -1: no valid grid */
     /* The grid's axes u, v, sun in the camera-relative scene frame, and the
      * offsets that give a point's grid coordinates from it: x . axis - off. */
     struct nc_vec3 grid_axis[3];
@@ -238,7 +241,8 @@ static int body_init(struct nc_rt *rt, unsigned index, const struct nc_body *src
 {
     struct rt_body *b = &rt->body[index];
     b->src = src;
-    b->grid_level = -1;
+    b->grid_level = b->grid_levels[0] = b->grid_levels[1] = -1;
+    b->grid = &b->grids[0];
     int rc = 0;
     if (src->shape == NC_SHAPE_SPHERE || src->shape == NC_SHAPE_ELLIPSOID) {
         b->analytic = 1;
@@ -365,12 +369,12 @@ static void reanchor(struct rt_body *b, struct nc_vec3 a)
  * the pose, never of the path to it. */
 #define GRID_TOL_RAD 2.5e-4
 
-static int build_grid(struct rt_body *b, int k, struct nc_vec3 sun, double tol_rad, double margin_m)
+static int build_grid(struct rt_body *b, int slot, int k, struct nc_vec3 sun, double tol_rad, double margin_m)
 {
     const unsigned *tri = rtcGetGeometryBufferData(b->geom[k], RTC_BUFFER_TYPE_INDEX, 0);
-    int rc = nc_shadow_grid_build(&b->grid, b->src->mesh.v, tri, b->nt[k], sun, tol_rad, nc_v3(0, 0, 0),
+    int rc = nc_shadow_grid_build(&b->grids[slot], b->src->mesh.v, tri, b->nt[k], sun, tol_rad, nc_v3(0, 0, 0),
                                   b->src->bounding_radius_m, margin_m);
-    b->grid_level = rc < 0 ? -1 : k;
+    b->grid_levels[slot] = rc < 0 ? -1 : k;
     return rc;
 }
 
@@ -399,13 +403,16 @@ static int update_grid(struct rt_body *b, const struct nc_scene *s)
      * within its angular radius more (rounded up to 1e-4 rad, so that a
      * slowly changing distance rarely rebuilds it). */
     const double tol = GRID_TOL_RAD + (s->render.soft_shadows ? 1e-4 * ceil(nc_scene_sun_radius_rad(s) / 1e-4) : 0);
-    const struct nc_vec3 gs = b->grid.sun;
+    const int slot = s->render.soft_shadows;
+    const struct nc_shadow_grid *g = &b->grids[slot];
     int rc = 0;
-    if (b->grid_level != k || b->grid.margin_m != margin || b->grid.tol_rad != tol || gs.x != sun.x ||
-        gs.y != sun.y || gs.z != sun.z)
-        rc = build_grid(b, k, sun, tol, margin);
+    if (b->grid_levels[slot] != k || g->margin_m != margin || g->tol_rad != tol || g->sun.x != sun.x ||
+        g->sun.y != sun.y || g->sun.z != sun.z)
+        rc = build_grid(b, slot, k, sun, tol, margin);
+    b->grid = &b->grids[slot];
+    b->grid_level = b->grid_levels[slot];
     /* body coordinates: R^T (x - origin_rel) */
-    const struct nc_vec3 ax[3] = {b->grid.u, b->grid.v, b->grid.sun};
+    const struct nc_vec3 ax[3] = {b->grid->u, b->grid->v, b->grid->sun};
     for (int c = 0; c < 3; c++) {
         b->grid_axis[c] = nc_mat_mul_v(&b->R, ax[c]);
         b->grid_off[c] = nc_v3_dot(b->origin_rel, b->grid_axis[c]);
@@ -630,7 +637,7 @@ static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct
         double c[3];
         for (int k = 0; k < 3; k++)
             c[k] = nc_v3_dot(o, b->grid_axis[k]) - b->grid_off[k];
-        if (!nc_shadow_grid_lit_at(&b->grid, c[0], c[1], c[2]))
+        if (!nc_shadow_grid_lit_at(b->grid, c[0], c[1], c[2]))
             return 0;
     }
     for (int k = 0; k < rt->nbodies; k++)
@@ -653,7 +660,7 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
                 ld[1] = ray->dy[i];
                 ld[2] = ray->dz[i];
                 ok = !b->analytic && b->grid_level == b->level &&
-                     nc_shadow_grid_dir_ok(&b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(nc_v3(ld[0], ld[1], ld[2]))));
+                     nc_shadow_grid_dir_ok(b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(nc_v3(ld[0], ld[1], ld[2]))));
             }
             if (proven_lit(rt, from[i], ok, ray, i)) {
                 ray->valid[i] = 0;
@@ -858,7 +865,8 @@ void nc_rt_destroy(struct nc_rt *rt)
     for (int i = 0; i < rt->nbodies; i++) {
         free(rt->body[i].verts);
         free(rt->body[i].vnormal);
-        nc_shadow_grid_free(&rt->body[i].grid);
+        for (int g = 0; g < 2; g++)
+            nc_shadow_grid_free(&rt->body[i].grids[g]);
     }
     free(rt->geom_to_body);
     free(rt->inst_tile);

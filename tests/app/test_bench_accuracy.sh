@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# test_bench_accuracy.sh - `navcam bench accuracy` end to end on two of its
-# scenes at a small size: the CSV is complete and finite, every scene has a
-# Pareto front, the DN error falls with samples, render.quality: auto picks
-# indirect light for the crater at low Sun and none for the convex sphere,
-# samples for the sphere's limb (its pilots sample the whole pixel) with a
-# DN error under the camera's noise, every rock where the boulder cut's
-# bias shows, and gnuplot draws the chart.
+# test_bench_accuracy.sh - `navcam bench accuracy` end to end on three of
+# its scenes at a small size: the CSV is complete and finite, every scene
+# has a Pareto front in each error (relative, DN, sigma), the DN error
+# falls with samples, render.quality: auto picks indirect light for the
+# crater at low Sun and none for the convex sphere, samples for the
+# sphere's limb (its pilots sample the whole pixel) with a DN error under
+# the camera's noise, every rock where the boulder cut's bias shows, and
+# gnuplot draws the chart.
 # Usage: test_bench_accuracy.sh NAVCAM TMPDIR
 set -u
 navcam=$1
@@ -30,14 +31,16 @@ def check(cond, msg):
 scenes = {}
 for r in rows:
     scenes.setdefault(r["scene"], {})[r["method"]] = r
-    for k in ("time_ms", "rel_rms", "rel_p95", "dn_rms", "dn_p95", "noise_dn"):
+    for k in ("time_ms", "rel_rms", "rel_p95", "dn_rms", "dn_p95", "noise_dn", "sigma_rms", "sigma_p95"):
         v = float(r[k])
         check(math.isfinite(v) and v >= 0, "%s %s: %s = %s" % (r["scene"], r["method"], k, r[k]))
     check(float(r["time_ms"]) > 0, "%s %s: time 0" % (r["scene"], r["method"]))
 check(sorted(scenes) == ["crater", "rubble", "sphere"], "scenes %s" % sorted(scenes))
 for name, m in scenes.items():
     check(len(m) == (8 if name == "rubble" else 7), "%s: %d methods" % (name, len(m)))
-    check(any(r["pareto"] == "1" for r in m.values()), "%s: no Pareto front" % name)
+    for col in ("pareto", "pareto_dn", "pareto_sigma"):
+        check(any(r[col] == "1" for r in m.values()), "%s: no Pareto front in %s" % (name, col))
+    check(m["auto"]["pareto_sigma"] == "0", "%s: auto is on the sigma front it is measured against" % name)
     check(float(m["4spp"]["dn_rms"]) < float(m["1spp"]["dn_rms"]), "%s: DN error does not fall with samples" % name)
     check(m["auto"]["chosen"].startswith("spp="), "%s: auto chose '%s'" % (name, m["auto"]["chosen"]))
 check("bounces=0" in scenes["sphere"]["auto"]["chosen"], "sphere: auto chose %s" % scenes["sphere"]["auto"]["chosen"])
