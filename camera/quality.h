@@ -7,8 +7,9 @@
  * can reach are skipped, so a small body is seen wherever it lies):
  *   - soft shadows where the penumbra a body can cast on itself or another,
  *     2 tan(a_sun) x its diameter, spans half a pixel at its nearest range,
- *     and a pilot with hard shadows differs from the same rays with soft
- *     ones by more than k/2 camera sigmas RMS;
+ *     and hard shadows are biased by more than k/2 camera sigmas RMS (the
+ *     mean of (soft - hard)(soft2 - hard2), two pilot pairs each drawn
+ *     with its own rays: the Sun-disk noise of one sample cancels);
  *   - every boulder traced (render.boulder_min_px 0) where the configured
  *     cut, and the full meshes (render.lod_error_px 0) where the configured
  *     level of detail, changes a pilot by more than k/2 sigmas RMS (biases

@@ -1,6 +1,6 @@
 /* test_quality.c - render.quality: auto (camera/quality.h) on a small
- * body, the case its pilots (every fourth row of 16-pixel tiles) could
- * miss: a 250 m Hapke sphere 75 km away, about 30 px across in a 256 x 256
+ * body, the case pilots on every fourth row of 16-pixel tiles (as they
+ * were) missed: a 250 m Hapke sphere 75 km away, about 30 px across in a 256 x 256
  * frame, its image wholly between pilot rows 0 and 4, and centred on row 4.
  * In both places auto must see the limb and pick samples whose error,
  * against a 1024-sample reference through the camera model, is within
