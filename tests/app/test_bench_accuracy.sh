@@ -40,7 +40,6 @@ for name, m in scenes.items():
     check(len(m) == (8 if name == "rubble" else 7), "%s: %d methods" % (name, len(m)))
     for col in ("pareto", "pareto_dn", "pareto_sigma"):
         check(any(r[col] == "1" for r in m.values()), "%s: no Pareto front in %s" % (name, col))
-    check(m["auto"]["pareto_sigma"] == "0", "%s: auto is on the sigma front it is measured against" % name)
     check(float(m["4spp"]["dn_rms"]) < float(m["1spp"]["dn_rms"]), "%s: DN error does not fall with samples" % name)
     check(m["auto"]["chosen"].startswith("spp="), "%s: auto chose '%s'" % (name, m["auto"]["chosen"]))
 check("bounces=0" in scenes["sphere"]["auto"]["chosen"], "sphere: auto chose %s" % scenes["sphere"]["auto"]["chosen"])
