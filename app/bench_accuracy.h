@@ -45,6 +45,8 @@ struct nc_bench_opts {
 extern const struct nc_bench_scene nc_bench_scenes[];
 extern const int nc_bench_nscenes;
 
+#define NC_BENCH_METHODS_MAX 48 /* methods a scene can have (nc_bench_methods) */
+
 /* The methods swept on scene sc; returns how many (at most max). */
 int nc_bench_methods(const struct nc_bench_scene *sc, const struct nc_bench_opts *o, struct nc_bench_method *m, int max);
 /* Render the reference and every method of scene sc, filling res[0..n).

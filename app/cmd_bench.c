@@ -250,12 +250,12 @@ int main(int argc, char **argv)
                 continue;
             }
         }
-        struct nc_bench_method m[40];
-        struct nc_bench_result res[40];
-        int n = nc_bench_methods(sc, &o, m, 40);
+        struct nc_bench_method m[NC_BENCH_METHODS_MAX];
+        struct nc_bench_result res[NC_BENCH_METHODS_MAX];
+        int n = nc_bench_methods(sc, &o, m, NC_BENCH_METHODS_MAX);
         if ((rc = nc_bench_run_scene(sc, &o, m, n, res, stdout)) < 0)
             break;
-        int flag[NMETRIC][40], idx[NMETRIC][40], nf[NMETRIC];
+        int flag[NMETRIC][NC_BENCH_METHODS_MAX], idx[NMETRIC][NC_BENCH_METHODS_MAX], nf[NMETRIC];
         for (int q = 0; q < NMETRIC; q++) {
             pareto(m, res, n, q, flag[q]);
             nf[q] = front_of(res, n, flag[q], idx[q]);

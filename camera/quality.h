@@ -1,31 +1,41 @@
 /* quality.h - render.quality: auto. Picks, per frame, the cheapest render
  * settings whose error stays under a fraction k (render.auto_noise_fraction)
  * of the camera's own noise (shot plus read noise, in electrons, at each
- * pixel's level), from pilots: renders at one sample a pixel, each anywhere
- * in its pixel, of rows of tiles over each body's image (every l-th, l the
- * largest power of 2 up to 16 that puts 4 rows through it; rows no body
- * can reach are skipped, so a small body is seen wherever it lies):
+ * pixel's level), from two pilots a and b: renders at 4 samples a pixel
+ * (2 x 2 strata) with their own seeds, of a staggered lattice of tiles
+ * over each body's image (every second row of tiles and every second tile
+ * in it where that puts 4 rows, 4 columns and 32 tiles through the image,
+ * else every tile; tiles no body can reach are skipped, so a small body is
+ * seen wherever it lies), half of each tile's
+ * pixels (a checkerboard of 4 x 4 blocks) and the other half where a bounce
+ * is taken. Each pilot also keeps its direct sunlight, the same with hard
+ * shadows, and one of its samples (render.h's planes), in the renderer's
+ * scratch frames:
  *   - soft shadows where the penumbra a body can cast on itself or another,
  *     2 tan(a_sun) x its diameter, spans half a pixel at its nearest range,
  *     and hard shadows are biased by more than k/2 camera sigmas RMS (the
- *     mean of (soft - hard)(soft2 - hard2), two pilot pairs each drawn
- *     with its own rays: the Sun-disk noise of one sample cancels);
+ *     mean of (a - hard_a)(b - hard_b): two independent pairs, the Sun-disk
+ *     noise of one sample cancels); a lone sphere or ellipsoid, which
+ *     neither shadows nor lights itself, takes neither soft shadows nor a
+ *     bounce in its pilots;
  *   - every boulder traced (render.boulder_min_px 0) where the configured
  *     cut, and the full meshes (render.lod_error_px 0) where the configured
- *     level of detail, changes a pilot by more than k/2 sigmas RMS (biases
- *     that samples do not reduce);
- *   - indirect light when a pilot's mean bounce light exceeds k camera
+ *     level of detail, changes b's direct light with hard shadows by more
+ *     than k/2 sigmas RMS (biases that samples do not reduce; a pilot each,
+ *     b's rays with hard shadows, no bounce and the setting changed);
+ *   - indirect light when the pilots' mean bounce light exceeds k camera
  *     sigmas, with as many bounces as leave less than that unrendered
- *     (each bounce taken to scale the last by the pilot's ratio of indirect
+ *     (each bounce taken to scale the last by the pilots' ratio of indirect
  *     to direct light), at most 8;
  *   - samples per pixel: the mean over lit pixels of the Monte Carlo
- *     variance of one sample over the camera's noise variance (two pilots
- *     with different seeds), times sum(w^2) of the PSF kernel (independent
- *     pixel errors through the optics), v1. Where v1 > k^2, two more pilots at 2 x 2
- *     strata give v4, and the variance is taken to fall as S^-beta with
- *     beta = log4(v1 / v4) in [1, 2], at least 1.5 without a bounce
- *     (jittered strata cut an edge's variance as S^-1.5): the smallest
- *     square S (4 to 256) with v4 (4 / S)^beta <= k^2.
+ *     variance over the camera's noise variance, times sum(w^2) of the PSF
+ *     kernel (independent pixel errors through the optics), at one sample
+ *     (v1: the pilots' one samples) and at four (v4). Where v1 > k^2 the
+ *     variance is taken to fall as S^-beta from 4 samples on, beta =
+ *     log4(v1 / v4), in [1.5, 2] without a bounce (jittered strata cut an
+ *     edge's variance as S^-1.5) and in [1, 1.5] with one (the paths'
+ *     noise falls as S^-1): the smallest square S (4 to 256) with
+ *     v4 (4 / S)^beta <= k^2.
  * Everything is keyed by the scene's seed: the same frame gets the same
  * choice.
  */
@@ -45,7 +55,7 @@ struct nc_quality_choice {
     double cut_rms, lod_rms; /* the boulder cut, the level of detail against none, the same */
     int all_rocks, full_mesh; /* render.boulder_min_px and render.lod_error_px set to 0 */
     double strata_beta;      /* the variance's fall with samples, S^-beta (1: not measured, one sample chosen) */
-    int pilot_rows;          /* rows of tiles each pilot rendered */
+    int pilot_tiles;         /* tiles each pilot rendered */
     double pilot_ms;
 };
 

@@ -42,6 +42,9 @@ void nc_frame_free(struct nc_frame *f)
     free(f->coverage);
     free(f->rock_id);
     free(f->geom);
+    free(f->direct);
+    free(f->direct_hard);
+    free(f->one);
     memset(f, 0, sizeof *f);
 }
 
@@ -68,8 +71,36 @@ double nc_render_fold_theta_bar_deg(const struct nc_renderer *r, int nbodies)
     return d;
 }
 
+struct nc_frame *nc_renderer_scratch(struct nc_renderer *r, int i, int w, int h, unsigned planes)
+{
+    if (i < 0 || i >= NC_SCRATCH_FRAMES) {
+        nc_error(NC_ERANGE, "render: scratch frame %d of %d", i, NC_SCRATCH_FRAMES);
+        return NULL;
+    }
+    struct nc_frame *f = &r->scratch[i];
+    if (f->width_px != w || f->height_px != h) {
+        nc_frame_free(f);
+        if (nc_frame_alloc(f, w, h) < 0)
+            return NULL;
+    }
+    const size_t n = (size_t)w * (size_t)h;
+    float **plane[3] = {&f->direct, &f->direct_hard, &f->one};
+    for (int k = 0; k < 3; k++) {
+        if (!(planes & 1u << k)) {
+            free(*plane[k]);
+            *plane[k] = NULL;
+        } else if (!*plane[k] && !(*plane[k] = malloc(n * sizeof(float)))) {
+            nc_error(-ENOMEM, "out of memory for a %dx%d frame", w, h);
+            return NULL;
+        }
+    }
+    return f;
+}
+
 void nc_renderer_free(struct nc_renderer *r)
 {
+    for (int i = 0; i < NC_SCRATCH_FRAMES; i++)
+        nc_frame_free(&r->scratch[i]);
     nc_pool_destroy(r->pool);
     r->pool = NULL;
     nc_rt_destroy(r->rt);
@@ -110,6 +141,8 @@ static int sample_of(uint64_t seed, uint64_t pid, int x, int N)
         return 0;
     const uint64_t h = mix64(seed ^ mix64(pid + 0x7065726dull)), n = (uint64_t)N; /* "perm" */
     uint64_t a = 1 + (h >> 32) % (n - 1), b = (h & 0xffffffffu) % n;
+    if (x == 0)
+        return (int)b;
     while (gcd64(a, n) != 1) /* a = 1 ends it */
         a = a % (n - 1) + 1;
     return (int)((a * (uint64_t)x + b) % n);
@@ -133,7 +166,9 @@ struct job {
     int tiles_x, tiles_y, n_strata;
     struct nc_sample_pass pass; /* this time sample's share of each pixel's samples ({0, 1, S}: all) */
     int tile_row_begin, n_tile_rows; /* the rows of tiles to render: begin, begin + 1, ... */
-    const int *tile_rows;            /* or these (not NULL) */
+    const int *tiles;                /* or these n_tiles tiles (not NULL) */
+    int n_tiles;
+    int blocks; /* 1, 2: only the 4x4 blocks of each tile on the even, odd squares of a checkerboard (nc_render_tile_list) */
     atomic_int next;
     /* Sun: constant in the scene frame unless the Sun is at a finite position. */
     struct nc_vec3 sun_dir;
@@ -276,22 +311,46 @@ struct tile_counts {
     unsigned long shadow_culled, shadow_traced;
 };
 
+/* Shadow rays' lanes that meet nothing: culled (proven) or traced. */
+static void unoccluded16(struct job *j, struct nc_ray16 *shadow, const int *from, int any, int *lit,
+                         struct tile_counts *cnt)
+{
+    int occluded[NC_PACKET];
+    int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, shadow, from);
+    cnt->shadow_culled += (unsigned long)culled;
+    cnt->shadow_traced += (unsigned long)(any - culled);
+    if (culled == any) {
+        memset(occluded, 0, sizeof occluded); /* every ray proven: nothing to trace */
+    } else {
+        if (j->r->ray_hook)
+            j->r->ray_hook(j->r->ray_hook_user, 1, shadow);
+        nc_rt_occluded16(j->rt, shadow, occluded);
+    }
+    for (int i = 0; i < NC_PACKET; i++)
+        lit[i] = lit[i] && !occluded[i];
+}
+
 /* Direct sunlight at the surface points of s seen along their rays: r[i]
  * (1/sr; radiance = r irr), 0 where the point is unlit, shadowed or missing.
  * (px0, py0) is the packet's pixel block, sidx the pixel sample and depth the
- * path vertex (0: the camera ray's), which key the solar disk's points. */
+ * path vertex (0: the camera ray's), which key the solar disk's points.
+ * r_hard (NULL: not wanted): the same with the shadow ray aimed at the
+ * Sun's centre (hard shadows), r itself when shadows are hard. */
 static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, int sidx, int depth, double *r,
-                       struct tile_counts *cnt)
+                       double *r_hard, struct tile_counts *cnt)
 {
     const int W = j->s->camera.width_px;
-    struct nc_ray16 shadow;
+    struct nc_ray16 shadow, centre;
     struct nc_photometry geo[NC_PACKET];
-    int occluded[NC_PACKET], from[NC_PACKET], lit[NC_PACKET], any = 0; /* how many lit */
+    int from[NC_PACKET], lit[NC_PACKET], any = 0; /* how many lit */
+    const int twin = r_hard && j->sun_tan_radius > 0;
     const uint64_t disk_seed = depth ? mix64(j->disk_seed + (uint64_t)depth) : j->disk_seed;
     for (int i = 0; i < NC_PACKET; i++) {
         shadow.valid[i] = lit[i] = 0;
         from[i] = -1;
         r[i] = 0;
+        if (r_hard)
+            r_hard[i] = 0;
         if (s->body[i] < 0)
             continue;
         struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i];
@@ -308,6 +367,16 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
         shadow.oy[i] = (float)(p.y + eps * nrm.y);
         shadow.oz[i] = (float)(p.z + eps * nrm.z);
         struct nc_vec3 sray = sdir;
+        if (twin) {
+            centre.ox[i] = shadow.ox[i];
+            centre.oy[i] = shadow.oy[i];
+            centre.oz[i] = shadow.oz[i];
+            centre.dx[i] = (float)sdir.x;
+            centre.dy[i] = (float)sdir.y;
+            centre.dz[i] = (float)sdir.z;
+            centre.tnear[i] = 0.0f;
+            centre.tfar[i] = INFINITY;
+        }
         if (j->sun_tan_radius > 0) {
             /* Soft shadows: toward a point of the solar disk, uniform
              * over it, from a stream of its own (pixel, sample, depth). */
@@ -333,21 +402,28 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
     }
     if (!any)
         return;
-    int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, &shadow, from);
-    cnt->shadow_culled += (unsigned long)culled;
-    cnt->shadow_traced += (unsigned long)(any - culled);
-    if (culled == any) {
-        memset(occluded, 0, sizeof occluded); /* every ray proven: nothing to trace */
-    } else {
-        if (j->r->ray_hook)
-            j->r->ray_hook(j->r->ray_hook_user, 1, &shadow);
-        nc_rt_occluded16(j->rt, &shadow, occluded);
+    int lit_hard[NC_PACKET], from_hard[NC_PACKET];
+    if (twin) { /* the soft shadows' grid serves every ray into the disk, its centre too */
+        for (int i = 0; i < NC_PACKET; i++) {
+            centre.valid[i] = shadow.valid[i];
+            lit_hard[i] = lit[i];
+            from_hard[i] = lit[i] && s->outside[i] && nc_v3_dot(s->n[i], s->sdir[i]) > 0 ? s->body[i] : -1;
+        }
+        unoccluded16(j, &centre, from_hard, any, lit_hard, cnt);
     }
+    unoccluded16(j, &shadow, from, any, lit, cnt);
     int todo[NC_PACKET], ntodo = 0;
     for (int i = 0; i < NC_PACKET; i++)
-        if (lit[i] && !occluded[i])
+        if (lit[i] || (twin && lit_hard[i]))
             todo[ntodo++] = i;
-    eval_lanes(j, s->body, geo, todo, ntodo, r);
+    double rr[NC_PACKET];
+    eval_lanes(j, s->body, geo, todo, ntodo, rr);
+    for (int k = 0; k < ntodo; k++) {
+        int i = todo[k];
+        r[i] = lit[i] ? rr[i] : 0.0;
+        if (r_hard)
+            r_hard[i] = (twin ? lit_hard[i] : lit[i]) ? rr[i] : 0.0;
+    }
 }
 
 /* Indirect light: from the camera ray's surface points s (changed: on return
@@ -439,7 +515,7 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
             if (!ray.valid[i])
                 hit.body[i] = -1;
         surface16(j, &hit, orig, w, s);
-        sunlight16(j, s, px0, py0, sidx, k, r, cnt);
+        sunlight16(j, s, px0, py0, sidx, k, r, NULL, cnt);
         for (int i = 0; i < NC_PACKET; i++) {
             if (s->body[i] < 0 || r[i] == 0)
                 continue;
@@ -489,16 +565,31 @@ static void shade_tile(struct job *j, int tile)
     const struct nc_sample_pass *ps = &j->pass;
     const int slots = ps->N / ps->K; /* samples each pixel takes in this pass */
     const int x0 = (tile % j->tiles_x) * TILE, y0 = (tile / j->tiles_x) * TILE;
-    double acc_L[TILE * TILE], acc_iof[TILE * TILE], acc_range[TILE * TILE];
+    double acc_L[TILE * TILE], acc_iof[TILE * TILE], acc_range[TILE * TILE], acc_dir[TILE * TILE],
+        acc_hard[TILE * TILE];
     int hits[TILE * TILE];
+    const int planes = j->f->direct || j->f->direct_hard;
+    /* This render's 4x4 blocks of the tile (the others are left as they are), and those traced. */
+    int mine[TILE / 4][TILE / 4], live[TILE / 4][TILE / 4];
+    for (int by = 0; by < TILE; by += 4)
+        for (int bx = 0; bx < TILE; bx += 4) {
+            mine[by / 4][bx / 4] = y0 + by < H && x0 + bx < W && (!j->blocks || (bx + by) / 4 % 2 == j->blocks - 1);
+            live[by / 4][bx / 4] = mine[by / 4][bx / 4] && (!j->cull || block_can_hit(j, x0 + bx, y0 + by));
+        }
+    float *one = j->f->one;
+    int one_g[TILE * TILE]; /* the sample plane `one` keeps: (0 <= g < N) */
+    for (int k = 0; k < TILE * TILE && one; k++) {
+        const int x = x0 + k % TILE, y = y0 + k / TILE;
+        one_g[k] = sample_of(s->render.seed, (uint64_t)y * (uint64_t)W + (uint64_t)x, ps->k, ps->N);
+        if (mine[k / TILE / 4][k % TILE / 4] && x < W && y < H)
+            one[(size_t)y * (size_t)W + (size_t)x] = 0.0f; /* where that sample hits nothing */
+    }
     memset(acc_L, 0, sizeof acc_L);
+    memset(acc_dir, 0, sizeof acc_dir);
+    memset(acc_hard, 0, sizeof acc_hard);
     memset(acc_iof, 0, sizeof acc_iof);
     memset(acc_range, 0, sizeof acc_range);
     memset(hits, 0, sizeof hits);
-    int live[TILE / 4][TILE / 4];
-    for (int by = 0; by < TILE; by += 4)
-        for (int bx = 0; bx < TILE; bx += 4)
-            live[by / 4][bx / 4] = y0 + by < H && x0 + bx < W && (!j->cull || block_can_hit(j, x0 + bx, y0 + by));
     /* Blocks no ray of which can reach a body show sky in the optional
      * planes too (they are never traced). */
     if (j->f->rock_id || j->f->geom) {
@@ -507,7 +598,7 @@ static void shade_tile(struct job *j, int tile)
             sky.body[i] = -1;
         for (int by = 0; by < TILE; by += 4)
             for (int bx = 0; bx < TILE; bx += 4) {
-                if (live[by / 4][bx / 4] || y0 + by >= H || x0 + bx >= W)
+                if (live[by / 4][bx / 4] || !mine[by / 4][bx / 4])
                     continue;
                 for (int i = 0; i < NC_PACKET && j->f->rock_id; i++) {
                     int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
@@ -525,6 +616,7 @@ static void shade_tile(struct job *j, int tile)
     struct surf sf;
     struct tile_counts cnt = {0, 0};
     double r[NC_PACKET];
+    int g_lane[NC_PACKET];
 
     for (int slot = 0; slot < slots; slot++) {
         /* This sample's number in the pixel's exposure (the soft-shadow and
@@ -539,9 +631,11 @@ static void shade_tile(struct job *j, int tile)
                     int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
                     ray.valid[i] = (px < W && py < H) ? -1 : 0;
                     double ox = 0, oy = 0;
+                    uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                    int g = ps->K > 1 && (S > 1 || one) ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N)
+                                                        : slot;
+                    g_lane[i] = g;
                     if (S > 1) { /* sample g, in stratum g mod S, jittered within it */
-                        uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                        int g = ps->K > 1 ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N) : slot;
                         const int sx = g % S % n, sy = g % S / n;
                         ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)g)) / n - 0.5;
                         oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)g + 1)) / n - 0.5;
@@ -590,20 +684,28 @@ static void shade_tile(struct job *j, int tile)
                 if (!any)
                     continue;
                 /* Direct sunlight, then what reaches these points from other surfaces. */
-                double L[NC_PACKET], iof[NC_PACKET];
-                sunlight16(j, &sf, x0 + bx, y0 + by, sidx, 0, r, &cnt);
+                double L[NC_PACKET], iof[NC_PACKET], sun[NC_PACKET], hard[NC_PACKET];
+                sunlight16(j, &sf, x0 + bx, y0 + by, sidx, 0, r, planes ? hard : NULL, &cnt);
                 for (int i = 0; i < NC_PACKET; i++) {
-                    L[i] = sf.body[i] >= 0 ? r[i] * sf.irr[i] : 0.0;
+                    L[i] = sun[i] = sf.body[i] >= 0 ? r[i] * sf.irr[i] : 0.0;
                     iof[i] = M_PI * r[i];
+                    if (planes)
+                        hard[i] = sf.body[i] >= 0 ? hard[i] * sf.irr[i] : 0.0;
                 }
                 if (j->bounces > 0)
                     indirect16(j, &sf, x0 + bx, y0 + by, sidx, L, iof, &cnt);
                 for (int i = 0; i < NC_PACKET; i++) {
                     int o = (by + (i >> 2)) * TILE + bx + (i & 3);
                     if (sf.body[i] >= 0 && j->r->as_point[sf.body[i]])
-                        L[i] = iof[i] = 0; /* its light comes as a point (nc_render_exposure) */
+                        L[i] = iof[i] = sun[i] = hard[i] = 0; /* its light comes as a point (nc_render_exposure) */
                     acc_L[o] += L[i];
                     acc_iof[o] += iof[i];
+                    if (one && ray.valid[i] && g_lane[i] == one_g[o])
+                        one[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] = (float)L[i];
+                    if (planes) {
+                        acc_dir[o] += sun[i];
+                        acc_hard[o] += hard[i];
+                    }
                 }
             }
     }
@@ -612,24 +714,29 @@ static void shade_tile(struct job *j, int tile)
     for (int y = y0; y < y0 + TILE && y < H; y++)
         for (int x = x0; x < x0 + TILE && x < W; x++) {
             int k = (y - y0) * TILE + (x - x0);
+            if (!mine[(y - y0) / 4][(x - x0) / 4])
+                continue;
             size_t o = (size_t)y * (size_t)W + (size_t)x;
             j->f->radiance[o] = (float)(acc_L[k] * inv);
             j->f->iof[o] = (float)(acc_iof[k] * inv);
             j->f->range_m[o] = hits[k] ? (float)(acc_range[k] / hits[k]) : 0.0f;
             j->f->coverage[o] = (float)(hits[k] * inv);
+            if (j->f->direct)
+                j->f->direct[o] = (float)(acc_dir[k] * inv);
+            if (j->f->direct_hard)
+                j->f->direct_hard[o] = (float)(acc_hard[k] * inv);
         }
 }
 
 static void *worker(void *arg)
 {
     struct job *j = arg;
-    const int ntiles = j->tiles_x * j->n_tile_rows;
+    const int ntiles = j->tiles ? j->n_tiles : j->tiles_x * j->n_tile_rows;
     for (;;) {
         int t = atomic_fetch_add(&j->next, 1);
         if (t >= ntiles)
             break;
-        const int i = t / j->tiles_x, row = j->tile_rows ? j->tile_rows[i] : j->tile_row_begin + i;
-        shade_tile(j, t % j->tiles_x + row * j->tiles_x);
+        shade_tile(j, j->tiles ? j->tiles[t] : t + j->tile_row_begin * j->tiles_x);
     }
     return NULL;
 }
@@ -648,28 +755,30 @@ int nc_render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_fr
 }
 
 static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
-                       int tile_row_end, const int *tile_rows, const double *row_dt,
+                       int tile_row_end, const int *tiles, int blocks, const double *row_dt,
                        const struct nc_sample_pass *pass);
 
 int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
                          int tile_row_end, const double *row_dt, const struct nc_sample_pass *pass)
 {
-    return render_rows(r, s, f, tile_row_begin, tile_row_end, NULL, row_dt, pass);
+    return render_rows(r, s, f, tile_row_begin, tile_row_end, NULL, 0, row_dt, pass);
 }
 
-int nc_render_row_list(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, const int *tile_rows,
-                       int n, const struct nc_sample_pass *pass)
+int nc_render_tile_list(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, const int *tiles, int n,
+                        int blocks, const struct nc_sample_pass *pass)
 {
-    const int rows = nc_render_tile_rows(s);
+    const int all = nc_render_tile_rows(s) * ((s->camera.width_px + TILE - 1) / TILE);
     for (int i = 0; i < n; i++)
-        if (tile_rows[i] < 0 || tile_rows[i] >= rows)
-            return nc_error(NC_ERANGE, "render: tile row %d of %d", tile_rows[i], rows);
-    return render_rows(r, s, f, 0, n, tile_rows, NULL, pass);
+        if (tiles[i] < 0 || tiles[i] >= all)
+            return nc_error(NC_ERANGE, "render: tile %d of %d", tiles[i], all);
+    if (blocks < 0 || blocks > 2)
+        return nc_error(NC_ERANGE, "render: blocks %d (0, 1 or 2)", blocks);
+    return render_rows(r, s, f, 0, n, tiles, blocks, NULL, pass);
 }
 
-/* Tile rows [begin, end), or tile_rows[0 .. end - begin) where not NULL. */
+/* Tile rows [begin, end), or the tiles tiles[0 .. end - begin) where not NULL. */
 static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
-                       int tile_row_end, const int *tile_rows, const double *row_dt,
+                       int tile_row_end, const int *tiles, int blocks, const double *row_dt,
                        const struct nc_sample_pass *pass)
 {
     const struct nc_camera *c = &s->camera;
@@ -705,10 +814,12 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
     }
     j.tiles_x = (c->width_px + TILE - 1) / TILE;
     j.tiles_y = (c->height_px + TILE - 1) / TILE;
-    j.tile_rows = tile_rows;
-    j.tile_row_begin = tile_rows || tile_row_begin < 0 ? 0 : tile_row_begin;
-    j.n_tile_rows = (tile_rows || tile_row_end <= j.tiles_y ? tile_row_end : j.tiles_y) - j.tile_row_begin;
-    if (j.n_tile_rows <= 0) {
+    j.tiles = tiles;
+    j.blocks = blocks;
+    j.n_tiles = tile_row_end - tile_row_begin;
+    j.tile_row_begin = tile_row_begin < 0 ? 0 : tile_row_begin;
+    j.n_tile_rows = (tile_row_end <= j.tiles_y ? tile_row_end : j.tiles_y) - j.tile_row_begin;
+    if (tiles ? j.n_tiles <= 0 : j.n_tile_rows <= 0) {
         free(j.row);
         return 0;
     }

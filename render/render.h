@@ -35,6 +35,18 @@ struct nc_frame {
      * the pixel's centre. Where the sample hit nothing, body is -1 and
      * every other plane 0. */
     float *geom;
+    /* Optional (the caller allocates w x h floats each; nc_frame_free frees
+     * them), W m^-2 sr^-1, means over the pixel's samples like radiance:
+     * direct, the part of radiance that is sunlight at the camera rays'
+     * surface points (radiance - direct: the indirect light); direct_hard,
+     * the same sunlight with each shadow ray aimed at the Sun's centre
+     * (hard shadows: what render.soft_shadows 0 would give with these
+     * samples; equal to direct when shadows are hard). */
+    float *direct, *direct_hard;
+    /* Optional (w x h floats, the same): the radiance of one of the
+     * pixel's samples, uniformly random over its strata (keyed by the
+     * seed; in a pass, its first): a one-sample render within this one. */
+    float *one;
 };
 
 /* The planes of nc_frame.geom: range (m) along the ray; the point hit in
@@ -45,6 +57,8 @@ struct nc_frame {
 enum nc_geom_plane { NC_GEOM_RANGE, NC_GEOM_X, NC_GEOM_Y, NC_GEOM_Z, NC_GEOM_NX, NC_GEOM_NY, NC_GEOM_NZ,
                      NC_GEOM_INCIDENCE, NC_GEOM_EMISSION, NC_GEOM_PHASE, NC_GEOM_BODY, NC_GEOM_PLANES };
 extern const char *const nc_geom_plane_names[NC_GEOM_PLANES];
+
+#define NC_SCRATCH_FRAMES 4
 
 struct nc_renderer {
     struct nc_rt *rt;
@@ -70,10 +84,20 @@ struct nc_renderer {
      * pixel): their ray hits hide what is behind them but give no light;
      * their light is added as a point (render/stars.h). 0 outside it. */
     unsigned char as_point[NC_MAX_BODIES];
+    struct nc_frame scratch[NC_SCRATCH_FRAMES]; /* nc_renderer_scratch */
 };
 
 int nc_frame_alloc(struct nc_frame *f, int width_px, int height_px);
 void nc_frame_free(struct nc_frame *f);
+/* Frames kept with the renderer for renders of a sample of a frame
+ * (nc_render_tile_list: quality.h's pilots), so that each call does not
+ * allocate and fault in its memory anew: scratch frame i (0 <= i <
+ * NC_SCRATCH_FRAMES) at w x h, carrying the optional planes the bits of
+ * `planes` ask for (NC_PLANE_*) and no others; its pixels hold what the
+ * last render into it left. NULL: out of memory or no such frame
+ * (nc_errmsg). nc_renderer_free frees them. */
+enum { NC_PLANE_DIRECT = 1, NC_PLANE_DIRECT_HARD = 2, NC_PLANE_ONE = 4 };
+struct nc_frame *nc_renderer_scratch(struct nc_renderer *r, int i, int w, int h, unsigned planes);
 
 /* threads <= 0: use scene render.threads, then all online cores. */
 int nc_renderer_init(struct nc_renderer *r, const struct nc_scene *s, int threads);
@@ -102,10 +126,15 @@ struct nc_sample_pass {
  * pass NULL renders every stratum (S samples). */
 int nc_render_rows_timed(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
                          int tile_row_end, const double *row_dt, const struct nc_sample_pass *pass);
-/* The n tile rows tile_rows[] of the frame, each in [0, nc_render_tile_rows)
- * (a sample of it: pilots); other rows of f are left as they are. */
-int nc_render_row_list(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, const int *tile_rows,
-                       int n, const struct nc_sample_pass *pass);
+/* The n tiles tiles[] of the frame (a sample of it: pilots), tile (tx, ty)
+ * numbered ty (width + 15) / 16 + tx; other pixels of f are left as they
+ * are. blocks 0: every pixel of those tiles; 1 or 2: only the 4 x 4 pixel
+ * blocks (bx, by) of each tile (0 to 3 each) with bx + by even or odd, a
+ * checkerboard (half the pixels, spread over the tile), the others left
+ * as they are: rendering 1 and then 2 into the same frame gives what 0
+ * does. */
+int nc_render_tile_list(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, const int *tiles, int n,
+                        int blocks, const struct nc_sample_pass *pass);
 
 /* An exposure: pose motion integrated over the exposure window. The scene's
  * poses are those at mid-exposure (of the middle row, for a rolling shutter);

@@ -7,7 +7,10 @@
  * the solar disk (two overlapping disks). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
+#include "core/error.h"
 #include "testutil.h"
 
 static const char yaml[] =
@@ -112,6 +115,35 @@ static void check_soft(void)
     CHECK(umbra > 50 && beyond > 3000 && partial > 200, "too few pixels: %d %d %d", umbra, beyond, partial);
     CHECK(wrong == 0, "%d pixels in the umbra lit or beyond the penumbra not as with hard shadows", wrong);
     CHECK(fabs(bias) < 0.02 && rms < 0.2, "penumbra: bias %g, RMS %g", bias, rms);
+
+    /* The same samples with a bounce, its direct sunlight and hard-shadow twin planes. */
+    struct nc_scene ps = ss;
+    ps.render.bounces = 1;
+    struct nc_frame pf;
+    struct nc_renderer r;
+    const size_t n = (size_t)c->width_px * (size_t)c->height_px;
+    if (nc_renderer_init(&r, &ps, 2) < 0 || nc_frame_alloc(&pf, c->width_px, c->height_px) < 0 ||
+        !(pf.direct = malloc(n * sizeof *pf.direct)) || !(pf.direct_hard = malloc(n * sizeof *pf.direct_hard)) ||
+        nc_render_frame(&r, &ps, &pf) < 0) {
+        fprintf(stderr, "render: %s\n", nc_errmsg());
+        exit(2);
+    }
+    size_t differ_dir = 0, differ_hard = 0, bounce_lit = 0, penumbra = 0;
+    for (size_t i = 0; i < n; i++) {
+        differ_dir += memcmp(&pf.direct[i], &sf.radiance[i], sizeof(float)) != 0;
+        differ_hard += memcmp(&pf.direct_hard[i], &hf.radiance[i], sizeof(float)) != 0;
+        bounce_lit += pf.radiance[i] > pf.direct[i];
+        penumbra += pf.direct[i] != pf.direct_hard[i];
+    }
+    printf("with a bounce: %zu pixels gain bounce light, %zu differ soft from hard; direct plane unlike the soft "
+           "render's radiance in %zu pixels, direct_hard unlike the hard render's in %zu\n",
+           bounce_lit, penumbra, differ_dir, differ_hard);
+    CHECK(differ_dir == 0 && differ_hard == 0, "planes differ from the renders they stand for: %zu, %zu", differ_dir,
+          differ_hard);
+    CHECK(bounce_lit > 1000 && penumbra > 200, "the planes should differ from radiance (%zu) and each other (%zu)",
+          bounce_lit, penumbra);
+    nc_renderer_free(&r);
+    nc_frame_free(&pf);
     nc_frame_free(&hf);
     nc_frame_free(&sf);
     nc_frame_free(&bf);
