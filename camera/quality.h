@@ -35,7 +35,8 @@
  *     log4(v1 / v4), in [1.5, 2] without a bounce (jittered strata cut an
  *     edge's variance as S^-1.5) and in [1, 1.5] with one (the paths'
  *     noise falls as S^-1): the smallest square S (4 to 256) with
- *     v4 (4 / S)^beta <= k^2.
+ *     v4 (4 / S)^beta <= (0.7 k)^2, a margin for the pilots' own sampling
+ *     error.
  * Everything is keyed by the scene's seed: the same frame gets the same
  * choice.
  */
