@@ -28,17 +28,10 @@ struct pilot_tiles {
     double *weight;
 };
 
-enum { PILOT_STEP_MAX = 2, PILOT_SPAN_MIN = 4, PILOT_TILES_MIN = 32 };
+enum { PILOT_SPAN_MIN = 4, PILOT_TILES_MIN = 32 };
 
-/* The largest power of 2 up to PILOT_STEP_MAX that puts PILOT_SPAN_MIN of
- * span's tiles in its lattice. */
-static int lattice_step(int span)
-{
-    int l = PILOT_STEP_MAX;
-    while (l > 1 && span < PILOT_SPAN_MIN * l)
-        l /= 2;
-    return l;
-}
+/* Every second tile of a span where that leaves PILOT_SPAN_MIN of them, else every one. */
+static int lattice_step(int span) { return span >= 2 * PILOT_SPAN_MIN ? 2 : 1; }
 
 static int pilot_tiles_pick(const struct nc_scene *s, struct pilot_tiles *pt)
 {
@@ -121,21 +114,16 @@ static void pilot_tiles_free(struct pilot_tiles *pt)
     free(pt->weight);
 }
 
-/* A pilot: the chosen tiles into f at spp 1 or 4, their blocks as
- * nc_render_tile_list's. One sample lies anywhere in the pixel (one pass
- * of four over 2 x 2 strata: a random stratum per pixel, jittered in it),
- * so that two pilots differ by what the pixel's area holds too (a limb, a
- * shadow's edge, facets), not only by the soft-shadow and bounce streams;
- * 4 are the 2 x 2 strata. */
-static int pilot(struct nc_renderer *r, const struct nc_scene *s, uint64_t seed, int bounces, int spp, int blocks,
+/* A pilot: the chosen tiles (their blocks as nc_render_tile_list's) into
+ * f at 4 samples a pixel, 2 x 2 strata, with its seed and bounces. */
+static int pilot(struct nc_renderer *r, const struct nc_scene *s, uint64_t seed, int bounces, int blocks,
                  const struct pilot_tiles *pt, struct nc_frame *f)
 {
     struct nc_scene p = *s;
     p.render.samples_per_pixel = 4;
     p.render.seed = seed;
     p.render.bounces = bounces;
-    const struct nc_sample_pass one = {0, 4, 4}; /* NULL: all four strata */
-    return nc_render_tile_list(r, &p, f, pt->tile, pt->n, blocks, spp == 1 ? &one : NULL);
+    return nc_render_tile_list(r, &p, f, pt->tile, pt->n, blocks, NULL);
 }
 
 /* Two pilots a and b of 4 samples a pixel (2 x 2 strata) with their own
@@ -271,9 +259,9 @@ int nc_quality_auto(struct nc_renderer *r, struct nc_scene *s, const struct nc_c
     const uint64_t sa = s->render.seed * 0x9e3779b97f4a7c15ull + 0x51, sb = sa + 0x2545f4914f6cdd1dull;
     const struct nc_scene ps = *s; /* as the pilots are drawn */
     if (rc >= 0)
-        rc = pilot(r, &ps, sa, pb, 4, 1, &pt, f[0]);
+        rc = pilot(r, &ps, sa, pb, 1, &pt, f[0]);
     if (rc >= 0)
-        rc = pilot(r, &ps, sb, pb, 4, 1, &pt, f[1]);
+        rc = pilot(r, &ps, sb, pb, 1, &pt, f[1]);
     for (int v = 0; v < NV && rc >= 0; v++)
         if (want[v]) {
             struct nc_scene p = ps;
@@ -282,7 +270,7 @@ int nc_quality_auto(struct nc_renderer *r, struct nc_scene *s, const struct nc_c
                 p.render.boulder_min_px = 0;
             else
                 p.render.lod_error_px = 0;
-            rc = pilot(r, &p, sb, 0, 4, 1, &pt, f[2 + v]); /* b's rays */
+            rc = pilot(r, &p, sb, 0, 1, &pt, f[2 + v]); /* b's rays */
             fv[v] = f[2 + v];
         }
     struct pilot_stats st = {0};
@@ -309,9 +297,9 @@ int nc_quality_auto(struct nc_renderer *r, struct nc_scene *s, const struct nc_c
         while (out->bounces < 8 && out->indirect_sigma * pow(rho, out->bounces) / (1 - rho) >= k)
             out->bounces++;
         if (rc >= 0)
-            rc = pilot(r, &ps, sa, pb, 4, 2, &pt, f[0]);
+            rc = pilot(r, &ps, sa, pb, 2, &pt, f[0]);
         if (rc >= 0)
-            rc = pilot(r, &ps, sb, pb, 4, 2, &pt, f[1]);
+            rc = pilot(r, &ps, sb, pb, 2, &pt, f[1]);
         if (rc >= 0)
             pilot_stats(s, cs, exposure_s, &pt, 0, f[0], f[1], NULL, &st);
         out->mc_to_noise_var = st.v1;

@@ -585,8 +585,10 @@ static void shade_tile(struct job *j, int tile)
             one[(size_t)y * (size_t)W + (size_t)x] = 0.0f; /* where that sample hits nothing */
     }
     memset(acc_L, 0, sizeof acc_L);
-    memset(acc_dir, 0, sizeof acc_dir);
-    memset(acc_hard, 0, sizeof acc_hard);
+    if (planes) {
+        memset(acc_dir, 0, sizeof acc_dir);
+        memset(acc_hard, 0, sizeof acc_hard);
+    }
     memset(acc_iof, 0, sizeof acc_iof);
     memset(acc_range, 0, sizeof acc_range);
     memset(hits, 0, sizeof hits);
