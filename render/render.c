@@ -557,6 +557,49 @@ static void record_geom(const struct job *j, const struct surf *sf, int px0, int
     }
 }
 
+/* Camera rays of one 4x4 pixel block, traced for up to SLOT_GROUP samples
+ * at once: ray[q] is sample slot0 + q of the block's 16 pixels. Regrouped
+ * into packets of 2x2 pixels x 4 samples (or as near as ns allows), each
+ * packet spans a quarter of the image area of a 4x4-pixel one, so Embree
+ * opens fewer tree nodes and tests fewer triangles per packet. A ray's hit
+ * does not depend on the rays it travels with. */
+#define SLOT_GROUP 16
+static void trace_camera(const struct job *j, const struct nc_ray16 *ray, struct nc_hit16 *hit, int ns)
+{
+    if (ns == 1 || j->r->one_sample_packets) {
+        for (int q = 0; q < ns; q++) {
+            if (j->r->ray_hook)
+                j->r->ray_hook(j->r->ray_hook_user, 0, &ray[q]);
+            nc_rt_intersect16(j->rt, &ray[q], &hit[q], 1);
+        }
+        return;
+    }
+    /* The 16 pixels (lane x + 4 y) along a Hilbert curve: each four make a
+     * 2x2 quad and each next pixel is a neighbour. A packet's lanes are
+     * consecutive (pixel, sample) pairs of this order. */
+    static const int quad[NC_PACKET] = {0, 1, 5, 4, 8, 12, 13, 9, 10, 14, 15, 11, 7, 6, 2, 3};
+    for (int p0 = 0; p0 < NC_PACKET * ns; p0 += NC_PACKET) {
+        struct nc_ray16 pk;
+        struct nc_hit16 hk;
+        for (int k = 0; k < NC_PACKET; k++) {
+            const int q = (p0 + k) % ns, i = quad[(p0 + k) / ns];
+            const struct nc_ray16 *rq = &ray[q];
+            pk.ox[k] = rq->ox[i], pk.oy[k] = rq->oy[i], pk.oz[k] = rq->oz[i];
+            pk.dx[k] = rq->dx[i], pk.dy[k] = rq->dy[i], pk.dz[k] = rq->dz[i];
+            pk.tnear[k] = rq->tnear[i], pk.tfar[k] = rq->tfar[i], pk.valid[k] = rq->valid[i];
+        }
+        if (j->r->ray_hook)
+            j->r->ray_hook(j->r->ray_hook_user, 0, &pk);
+        nc_rt_intersect16(j->rt, &pk, &hk, 1);
+        for (int k = 0; k < NC_PACKET; k++) {
+            const int q = (p0 + k) % ns, i = quad[(p0 + k) / ns];
+            struct nc_hit16 *h = &hit[q];
+            h->t[i] = hk.t[k], h->nx[i] = hk.nx[k], h->ny[i] = hk.ny[k], h->nz[i] = hk.nz[k];
+            h->body[i] = hk.body[k], h->albedo[i] = hk.albedo[k], h->rock[i] = hk.rock[k];
+        }
+    }
+}
+
 static void shade_tile(struct job *j, int tile)
 {
     const struct nc_scene *s = j->s;
@@ -612,101 +655,106 @@ static void shade_tile(struct job *j, int tile)
             }
     }
 
-    struct nc_ray16 ray;
-    struct nc_vec3 dir[NC_PACKET], orig[NC_PACKET]; /* the camera rays in double precision */
-    struct nc_hit16 hit;
+    /* The camera rays of up to SLOT_GROUP samples of a block at a time (trace_camera). */
+    struct nc_ray16 ray[SLOT_GROUP];
+    struct nc_vec3 dir[SLOT_GROUP][NC_PACKET], orig[SLOT_GROUP][NC_PACKET]; /* in double precision */
+    int g_lane[SLOT_GROUP][NC_PACKET];
+    struct nc_hit16 hit[SLOT_GROUP];
     struct surf sf;
     struct tile_counts cnt = {0, 0};
     double r[NC_PACKET];
-    int g_lane[NC_PACKET];
 
-    for (int slot = 0; slot < slots; slot++) {
-        /* This sample's number in the pixel's exposure (the soft-shadow and
-         * path streams'); the same in all lanes, unique per pixel. */
-        const int sidx = ps->k * slots + slot;
+    for (int slot0 = 0; slot0 < slots; slot0 += SLOT_GROUP) {
+        const int ns = slots - slot0 < SLOT_GROUP ? slots - slot0 : SLOT_GROUP;
         for (int by = 0; by < TILE; by += 4)
             for (int bx = 0; bx < TILE; bx += 4) {
                 if (!live[by / 4][bx / 4])
                     continue;
-                /* Camera rays for a 4x4 pixel block. */
-                for (int i = 0; i < NC_PACKET; i++) {
-                    int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
-                    ray.valid[i] = (px < W && py < H) ? -1 : 0;
-                    double ox = 0, oy = 0;
-                    uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                    int g = ps->K > 1 && (S > 1 || one) ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N)
-                                                        : slot;
-                    g_lane[i] = g;
-                    if (S > 1) { /* sample g, in stratum g mod S, jittered within it */
-                        const int sx = g % S % n, sy = g % S / n;
-                        ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)g)) / n - 0.5;
-                        oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)g + 1)) / n - 0.5;
+                /* Camera rays for a 4x4 pixel block, ns samples each. */
+                for (int q = 0; q < ns; q++)
+                    for (int i = 0; i < NC_PACKET; i++) {
+                        const int slot = slot0 + q, px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
+                        ray[q].valid[i] = (px < W && py < H) ? -1 : 0;
+                        double ox = 0, oy = 0;
+                        uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                        int g = ps->K > 1 && (S > 1 || one)
+                                    ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N)
+                                    : slot;
+                        g_lane[q][i] = g;
+                        if (S > 1) { /* sample g, in stratum g mod S, jittered within it */
+                            const int sx = g % S % n, sy = g % S / n;
+                            ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)g)) / n - 0.5;
+                            oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)g + 1)) / n - 0.5;
+                        }
+                        double fx = px + ox, fy = py + oy;
+                        const struct row_cam *rc = &j->row[py < H ? py : H - 1];
+                        struct nc_vec3 d;
+                        if (c->distorted) { /* the lens model, inverted exactly for this sample */
+                            d = nc_v3_unit(nc_mat_mul_v(&rc->R, nc_camera_ray(c, fx, fy)));
+                        } else { /* R ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per row */
+                            d = nc_v3_unit(nc_v3(rc->d00.x + fx * rc->ex.x + fy * rc->ey.x,
+                                                 rc->d00.y + fx * rc->ex.y + fy * rc->ey.y,
+                                                 rc->d00.z + fx * rc->ex.z + fy * rc->ey.z));
+                        }
+                        dir[q][i] = d;
+                        orig[q][i] = rc->o;
+                        ray[q].ox[i] = (float)rc->o.x;
+                        ray[q].oy[i] = (float)rc->o.y;
+                        ray[q].oz[i] = (float)rc->o.z;
+                        ray[q].dx[i] = (float)d.x;
+                        ray[q].dy[i] = (float)d.y;
+                        ray[q].dz[i] = (float)d.z;
+                        ray[q].tnear[i] = 0.0f;
+                        ray[q].tfar[i] = INFINITY;
                     }
-                    double fx = px + ox, fy = py + oy;
-                    const struct row_cam *rc = &j->row[py < H ? py : H - 1];
-                    struct nc_vec3 d;
-                    if (c->distorted) { /* the lens model, inverted exactly for this sample */
-                        d = nc_v3_unit(nc_mat_mul_v(&rc->R, nc_camera_ray(c, fx, fy)));
-                    } else { /* R ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per row */
-                        d = nc_v3_unit(nc_v3(rc->d00.x + fx * rc->ex.x + fy * rc->ey.x,
-                                             rc->d00.y + fx * rc->ex.y + fy * rc->ey.y,
-                                             rc->d00.z + fx * rc->ex.z + fy * rc->ey.z));
+                trace_camera(j, ray, hit, ns);
+                for (int q = 0; q < ns; q++) {
+                    /* This sample's number in the pixel's exposure (the soft-shadow and
+                     * path streams'); the same in all lanes, unique per pixel. */
+                    const int slot = slot0 + q, sidx = ps->k * slots + slot;
+                    if (slot == 0 && j->f->rock_id) /* the rock each pixel's first sample (here) hit */
+                        for (int i = 0; i < NC_PACKET; i++)
+                            if (ray[q].valid[i])
+                                j->f->rock_id[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
+                                    hit[q].body[i] >= 0 ? hit[q].rock[i] : -1;
+                    surface16(j, &hit[q], orig[q], dir[q], &sf);
+                    if (slot == 0 && j->f->geom)
+                        record_geom(j, &sf, x0 + bx, y0 + by);
+                    int any = 0;
+                    for (int i = 0; i < NC_PACKET; i++) {
+                        if (sf.body[i] < 0)
+                            continue;
+                        int k = (by + (i >> 2)) * TILE + bx + (i & 3);
+                        acc_range[k] += sf.t[i];
+                        hits[k]++;
+                        any++;
                     }
-                    dir[i] = d;
-                    orig[i] = rc->o;
-                    ray.ox[i] = (float)rc->o.x;
-                    ray.oy[i] = (float)rc->o.y;
-                    ray.oz[i] = (float)rc->o.z;
-                    ray.dx[i] = (float)d.x;
-                    ray.dy[i] = (float)d.y;
-                    ray.dz[i] = (float)d.z;
-                    ray.tnear[i] = 0.0f;
-                    ray.tfar[i] = INFINITY;
-                }
-                if (j->r->ray_hook)
-                    j->r->ray_hook(j->r->ray_hook_user, 0, &ray);
-                nc_rt_intersect16(j->rt, &ray, &hit, 1);
-                if (slot == 0 && j->f->rock_id) /* the rock each pixel's first sample (here) hit */
-                    for (int i = 0; i < NC_PACKET; i++)
-                        if (ray.valid[i])
-                            j->f->rock_id[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
-                                hit.body[i] >= 0 ? hit.rock[i] : -1;
-                surface16(j, &hit, orig, dir, &sf);
-                if (slot == 0 && j->f->geom)
-                    record_geom(j, &sf, x0 + bx, y0 + by);
-                int any = 0;
-                for (int i = 0; i < NC_PACKET; i++) {
-                    if (sf.body[i] < 0)
+                    if (!any)
                         continue;
-                    int k = (by + (i >> 2)) * TILE + bx + (i & 3);
-                    acc_range[k] += sf.t[i];
-                    hits[k]++;
-                    any++;
-                }
-                if (!any)
-                    continue;
-                /* Direct sunlight, then what reaches these points from other surfaces. */
-                double L[NC_PACKET], iof[NC_PACKET], sun[NC_PACKET], hard[NC_PACKET];
-                sunlight16(j, &sf, x0 + bx, y0 + by, sidx, 0, r, planes ? hard : NULL, &cnt);
-                for (int i = 0; i < NC_PACKET; i++) {
-                    L[i] = sun[i] = sf.body[i] >= 0 ? r[i] * sf.irr[i] : 0.0;
-                    iof[i] = M_PI * r[i];
-                    if (planes)
-                        hard[i] = sf.body[i] >= 0 ? hard[i] * sf.irr[i] : 0.0;
-                }
-                if (j->bounces > 0)
-                    indirect16(j, &sf, x0 + bx, y0 + by, sidx, L, iof, &cnt);
-                for (int i = 0; i < NC_PACKET; i++) {
-                    int o = (by + (i >> 2)) * TILE + bx + (i & 3);
-                    if (sf.body[i] >= 0 && j->r->as_point[sf.body[i]])
-                        L[i] = iof[i] = sun[i] = hard[i] = 0; /* its light comes as a point (nc_render_exposure) */
-                    acc_L[o] += L[i];
-                    acc_iof[o] += iof[i];
-                    if (one && ray.valid[i] && g_lane[i] == one_g[o])
-                        one[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] = (float)L[i];
-                    if (planes) {
-                        acc_dir[o] += sun[i];
-                        acc_hard[o] += hard[i];
+                    /* Direct sunlight, then what reaches these points from other surfaces. */
+                    double L[NC_PACKET], iof[NC_PACKET], sun[NC_PACKET], hard[NC_PACKET];
+                    sunlight16(j, &sf, x0 + bx, y0 + by, sidx, 0, r, planes ? hard : NULL, &cnt);
+                    for (int i = 0; i < NC_PACKET; i++) {
+                        L[i] = sun[i] = sf.body[i] >= 0 ? r[i] * sf.irr[i] : 0.0;
+                        iof[i] = M_PI * r[i];
+                        if (planes)
+                            hard[i] = sf.body[i] >= 0 ? hard[i] * sf.irr[i] : 0.0;
+                    }
+                    if (j->bounces > 0)
+                        indirect16(j, &sf, x0 + bx, y0 + by, sidx, L, iof, &cnt);
+                    for (int i = 0; i < NC_PACKET; i++) {
+                        int o = (by + (i >> 2)) * TILE + bx + (i & 3);
+                        if (sf.body[i] >= 0 && j->r->as_point[sf.body[i]])
+                            L[i] = iof[i] = sun[i] = hard[i] = 0; /* its light comes as a point (nc_render_exposure) */
+                        acc_L[o] += L[i];
+                        acc_iof[o] += iof[i];
+                        if (one && ray[q].valid[i] && g_lane[q][i] == one_g[o])
+                            one[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
+                                (float)L[i];
+                        if (planes) {
+                            acc_dir[o] += sun[i];
+                            acc_hard[o] += hard[i];
+                        }
                     }
                 }
             }

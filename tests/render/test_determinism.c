@@ -1,5 +1,6 @@
 /* test_determinism.c - the same scene gives bit-identical frames for any
  * thread count, for repeated renders, and for a freshly built renderer. */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -44,6 +45,65 @@ static void check_cull(struct nc_scene *s, const struct nc_exposure *ex, const c
           packets[1][1]);
     CHECK(expect_skip ? packets[0][0] < packets[1][0] : packets[0][0] == packets[1][0],
           "%s: %ld camera packets traced with the test, %ld without", what, packets[0][0], packets[1][0]);
+    nc_frame_free(&a);
+    nc_frame_free(&b);
+    nc_renderer_free(&ra);
+    nc_renderer_free(&rb);
+}
+
+/* The widest angle between two rays of any camera packet, rad. */
+struct spread {
+    long packets;
+    double max_rad;
+};
+
+static void packet_spread(void *user, int shadow, const struct nc_ray16 *ray)
+{
+    struct spread *sp = user;
+    if (shadow)
+        return;
+    sp->packets++;
+    for (int a = 0; a < NC_PACKET; a++)
+        for (int b = a + 1; b < NC_PACKET; b++) {
+            if (!ray->valid[a] || !ray->valid[b])
+                continue;
+            double c = ray->dx[a] * ray->dx[b] + ray->dy[a] * ray->dy[b] + ray->dz[a] * ray->dz[b];
+            double ang = acos(c > 1 ? 1 : c);
+            if (ang > sp->max_rad)
+                sp->max_rad = ang;
+        }
+}
+
+/* Camera packets of 2x2 pixels x 4 samples (the default) and of one sample
+ * of 4x4 pixels give the same frame, with as many packets, the former
+ * narrower: at 4 samples (2x2 strata), 9 (a packet takes parts of two
+ * pixels) and 16 samples over 2 time samples (8 a pass). */
+static void check_grouped(struct nc_scene *s, int spp, const struct nc_exposure *ex, const char *what)
+{
+    struct nc_frame a, b;
+    struct nc_renderer ra, rb;
+    struct spread sa = {0, 0}, sb = {0, 0};
+    int ka = 0, kb = 0, keep = s->render.samples_per_pixel;
+    s->render.samples_per_pixel = spp;
+    nc_renderer_init(&ra, s, 1);
+    nc_renderer_init(&rb, s, 1);
+    rb.one_sample_packets = 1;
+    ra.ray_hook = rb.ray_hook = packet_spread;
+    ra.ray_hook_user = &sa;
+    rb.ray_hook_user = &sb;
+    nc_frame_alloc(&a, s->camera.width_px, s->camera.height_px);
+    nc_frame_alloc(&b, s->camera.width_px, s->camera.height_px);
+    nc_render_exposure(&ra, s, ex, &a, &ka);
+    nc_render_exposure(&rb, s, ex, &b, &kb);
+    CHECK(ka == kb && ka == (ex->max_time_samples ? ex->max_time_samples : 1) && same(&a, &b),
+          "%s: grouped camera packets changed the frame (%d, %d time samples)", what, ka, kb);
+    CHECK(sa.packets == sb.packets, "%s: %ld grouped camera packets, %ld of one sample", what, sa.packets, sb.packets);
+    /* a 4x4 block spans about 4.2 pixels corner to corner, a 2x2 quad 2.8 */
+    CHECK(sa.max_rad < 0.8 * sb.max_rad, "%s: grouped packets span %.3g rad, one-sample packets %.3g", what,
+          sa.max_rad, sb.max_rad);
+    printf("%s: %ld camera packets; widest %.3g mrad grouped, %.3g mrad one sample a packet\n", what, sa.packets,
+           1e3 * sa.max_rad, 1e3 * sb.max_rad);
+    s->render.samples_per_pixel = keep;
     nc_frame_free(&a);
     nc_frame_free(&b);
     nc_renderer_free(&ra);
@@ -140,6 +200,12 @@ int main(void)
     s.camera.position_m = nc_v3(0, -s.body[0].bounding_radius_m * 0.9, 0);
     check_cull(&s, &still, "camera inside the bounding sphere", 0);
     s.camera.position_m = keep;
+    check_grouped(&s, 4, &still, "4 samples");
+    check_grouped(&s, 9, &still, "9 samples");
+    struct nc_exposure turning = {.exposure_s = 0.01, .max_time_samples = 2};
+    s.camera.angular_velocity_rad_s = nc_v3(0, 0.05, 0);
+    check_grouped(&s, 16, &turning, "16 samples, 2 time samples");
+    s.camera.angular_velocity_rad_s = nc_v3(0, 0, 0);
     nc_renderer_free(&r1);
     nc_renderer_free(&r3);
     nc_frame_free(&ref);
