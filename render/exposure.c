@@ -60,7 +60,39 @@ static int fold_time_samples(int k0, int S)
     return S * ((k0 + S - 1) / S);
 }
 
-/* The exposure's K time samples (K > 1 or a rolling shutter), S strata. */
+/* Global shutter: one band of all rows. Rolling: bands of 16 rows; the
+ * camera of each row is at that row's own time, the bodies at the band's
+ * mid-time (within 8 line times of every row in it): band b's mid-time tc
+ * and each row's offset from it, row_dt. */
+static double band_times(const struct nc_exposure *ex, int b, int H, double *row_dt)
+{
+    int y0 = NC_TILE * b, y1 = NC_TILE * (b + 1) < H ? NC_TILE * (b + 1) : H;
+    double tc = ex->rolling ? (0.5 * (y0 + y1 - 1) - 0.5 * (H - 1)) * ex->line_time_s : 0.0;
+    for (int y = 0; y < H; y++)
+        row_dt[y] = ex->rolling ? (y - 0.5 * (H - 1)) * ex->line_time_s - tc : 0.0;
+    return tc;
+}
+
+/* A rolling shutter with one time sample: each band rendered straight into
+ * f (its rows are its own; nothing to add up). */
+static int rolling_into(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex,
+                        struct nc_frame *f)
+{
+    const int H = f->height_px, bands = nc_render_tile_rows(s);
+    double *row_dt = malloc((size_t)H * sizeof *row_dt);
+    if (!row_dt)
+        return nc_error(-ENOMEM, "out of memory");
+    int rc = 0;
+    for (int b = 0; b < bands && rc >= 0; b++) {
+        struct nc_scene at;
+        nc_scene_propagate(s, band_times(ex, b, H, row_dt), &at);
+        rc = nc_render_rows_timed(r, &at, f, b, b + 1, row_dt, NULL);
+    }
+    free(row_dt);
+    return rc;
+}
+
+/* The exposure's K > 1 time samples, S strata. */
 static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex, int K,
                              int S, struct nc_frame *f)
 {
@@ -77,9 +109,6 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
         rc = rc < 0 ? rc : nc_error(-ENOMEM, "out of memory");
         goto out;
     }
-    /* Global shutter: one band of all rows. Rolling: bands of 16 rows; the
-     * camera of each row is at that row's own time, the bodies at the band's
-     * mid-time (within 8 line times of every row in it). */
     double *row_dt = malloc((size_t)H * sizeof *row_dt);
     if (!row_dt) {
         rc = nc_error(-ENOMEM, "out of memory");
@@ -89,9 +118,7 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
     for (int b = 0; b < nb && rc >= 0; b++) {
         int r0 = ex->rolling ? b : 0, r1 = ex->rolling ? b + 1 : bands;
         int y0 = NC_TILE * r0, y1 = NC_TILE * r1 < H ? NC_TILE * r1 : H;
-        double tc = ex->rolling ? (0.5 * (y0 + y1 - 1) - 0.5 * (H - 1)) * ex->line_time_s : 0.0;
-        for (int y = 0; y < H; y++)
-            row_dt[y] = ex->rolling ? (y - 0.5 * (H - 1)) * ex->line_time_s - tc : 0.0;
+        double tc = band_times(ex, b, H, row_dt);
         for (int k = 0; k < K && rc >= 0; k++) {
             struct nc_scene at;
             nc_scene_propagate(s, tc + T * ((k + 0.5) / K - 0.5), &at);
@@ -137,7 +164,8 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
     struct nc_point_source pts[NC_MAX_BODIES];
     int np = nc_render_point_bodies(r, s, pts), rc = np;
     if (rc >= 0)
-        rc = K == 1 && !ex->rolling ? nc_render_frame(r, s, f) : time_samples_into(r, s, ex, K, S, f);
+        rc = K > 1 ? time_samples_into(r, s, ex, K, S, f) : ex->rolling ? rolling_into(r, s, ex, f)
+                                                                          : nc_render_frame(r, s, f);
     if (rc >= 0 && np > 0) { /* anything in front of them is in their own renders: no occlusion rays */
         long hidden, drawn = nc_render_points(r, s, T, pts, (size_t)np, 0, f, &hidden);
         rc = drawn < 0 ? (int)drawn : 0;

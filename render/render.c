@@ -852,7 +852,13 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
     j.row = malloc((size_t)c->height_px * sizeof *j.row);
     if (!j.row)
         return nc_error(-ENOMEM, "out of memory");
-    for (int y = 0; y < c->height_px; y++) {
+    /* the rows of the tile rows rendered (a rolling shutter's band), else all */
+    int ya = 0, yb = c->height_px;
+    if (!tiles) {
+        ya = tile_row_begin > 0 ? TILE * tile_row_begin : 0;
+        yb = TILE * tile_row_end < c->height_px ? TILE * tile_row_end : c->height_px;
+    }
+    for (int y = ya; y < yb; y++) {
         struct row_cam *rw = &j.row[y];
         double dt = row_dt ? row_dt[y] : 0.0;
         struct nc_quat q = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt) : c->attitude_q;
