@@ -34,13 +34,17 @@ struct acc {
     double *L, *iof, *range, *cov;
 };
 
-static void accumulate(struct acc *a, const struct nc_frame *f, size_t o0, size_t o1)
+/* Rows [o0, o1) of sample f into the sums a: the first sample sets them. */
+static void accumulate(struct acc *a, const struct nc_frame *f, size_t o0, size_t o1, int first)
 {
     for (size_t o = o0; o < o1; o++) {
-        a->L[o] += f->radiance[o];
-        a->iof[o] += f->iof[o];
-        a->range[o] += (double)f->range_m[o] * f->coverage[o];
-        a->cov[o] += f->coverage[o];
+        double L = f->radiance[o], iof = f->iof[o], range = (double)f->range_m[o] * f->coverage[o],
+               cov = f->coverage[o];
+        if (first) {
+            a->L[o] = L, a->iof[o] = iof, a->range[o] = range, a->cov[o] = cov;
+        } else {
+            a->L[o] += L, a->iof[o] += iof, a->range[o] += range, a->cov[o] += cov;
+        }
     }
 }
 
@@ -99,20 +103,27 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
     const double T = ex->exposure_s;
     const int W = f->width_px, H = f->height_px, bands = nc_render_tile_rows(s);
     const size_t n = (size_t)W * (size_t)H;
-    struct nc_frame sub;
-    struct acc a = {calloc(n, sizeof(double)), calloc(n, sizeof(double)), calloc(n, sizeof(double)),
-                    calloc(n, sizeof(double))};
-    int rc = nc_frame_alloc(&sub, W, H);
-    if (rc >= 0 && f->rock_id && !(sub.rock_id = malloc(n * sizeof *sub.rock_id)))
-        rc = nc_error(-ENOMEM, "out of memory");
-    if (rc < 0 || !a.L || !a.iof || !a.range || !a.cov) {
-        rc = rc < 0 ? rc : nc_error(-ENOMEM, "out of memory");
-        goto out;
+    struct nc_frame *sub = &r->exp_sub;
+    int rc = 0;
+    if (sub->width_px != W || sub->height_px != H) {
+        nc_frame_free(sub);
+        free(r->exp_sum);
+        r->exp_sum = NULL;
+        if ((rc = nc_frame_alloc(sub, W, H)) < 0)
+            return rc;
     }
+    if (!r->exp_sum && !(r->exp_sum = malloc(4 * n * sizeof *r->exp_sum)))
+        return nc_error(-ENOMEM, "out of memory");
+    if (f->rock_id && !sub->rock_id && !(sub->rock_id = malloc(n * sizeof *sub->rock_id)))
+        return nc_error(-ENOMEM, "out of memory");
+    int32_t *keep_rock = sub->rock_id;
+    if (!f->rock_id) /* render no rock plane the caller did not ask for */
+        sub->rock_id = NULL;
+    struct acc a = {r->exp_sum, r->exp_sum + n, r->exp_sum + 2 * n, r->exp_sum + 3 * n};
     double *row_dt = malloc((size_t)H * sizeof *row_dt);
     if (!row_dt) {
-        rc = nc_error(-ENOMEM, "out of memory");
-        goto out;
+        sub->rock_id = keep_rock;
+        return nc_error(-ENOMEM, "out of memory");
     }
     int nb = ex->rolling ? bands : 1;
     for (int b = 0; b < nb && rc >= 0; b++) {
@@ -123,26 +134,21 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
             struct nc_scene at;
             nc_scene_propagate(s, tc + T * ((k + 0.5) / K - 0.5), &at);
             const struct nc_sample_pass pass = {k, K, K > S ? K : S};
-            if ((rc = nc_render_rows_timed(r, &at, &sub, r0, r1, row_dt, &pass)) >= 0)
-                accumulate(&a, &sub, (size_t)y0 * W, (size_t)y1 * W);
+            if ((rc = nc_render_rows_timed(r, &at, sub, r0, r1, row_dt, &pass)) >= 0)
+                accumulate(&a, sub, (size_t)y0 * W, (size_t)y1 * W, k == 0);
             if (rc >= 0 && f->rock_id && k == K / 2) /* the rocks seen at the middle time sample */
-                memcpy(f->rock_id + (size_t)y0 * W, sub.rock_id + (size_t)y0 * W,
+                memcpy(f->rock_id + (size_t)y0 * W, sub->rock_id + (size_t)y0 * W,
                        (size_t)(y1 - y0) * (size_t)W * sizeof *f->rock_id);
         }
     }
     free(row_dt);
+    sub->rock_id = keep_rock;
     for (size_t o = 0; rc >= 0 && o < n; o++) {
         f->radiance[o] = (float)(a.L[o] / K);
         f->iof[o] = (float)(a.iof[o] / K);
         f->range_m[o] = a.cov[o] > 0 ? (float)(a.range[o] / a.cov[o]) : 0.0f;
         f->coverage[o] = (float)(a.cov[o] / K);
     }
-out:
-    nc_frame_free(&sub);
-    free(a.L);
-    free(a.iof);
-    free(a.range);
-    free(a.cov);
     return rc;
 }
 

@@ -101,6 +101,9 @@ void nc_renderer_free(struct nc_renderer *r)
 {
     for (int i = 0; i < NC_SCRATCH_FRAMES; i++)
         nc_frame_free(&r->scratch[i]);
+    nc_frame_free(&r->exp_sub);
+    free(r->exp_sum);
+    r->exp_sum = NULL;
     nc_pool_destroy(r->pool);
     r->pool = NULL;
     nc_rt_destroy(r->rt);

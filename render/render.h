@@ -89,6 +89,12 @@ struct nc_renderer {
      * their light is added as a point (render/stars.h). 0 outside it. */
     unsigned char as_point[NC_MAX_BODIES];
     struct nc_frame scratch[NC_SCRATCH_FRAMES]; /* nc_renderer_scratch */
+    /* nc_render_exposure's time samples: one sample's frame and the sums
+     * over samples (exp_sum: 4 planes of exp_sub's size), kept between
+     * exposures so that each does not allocate and fault in ~50 MB anew at
+     * 1024x1024. */
+    struct nc_frame exp_sub;
+    double *exp_sum;
 };
 
 int nc_frame_alloc(struct nc_frame *f, int width_px, int height_px);

@@ -174,6 +174,10 @@ int main(void)
     nc_render_exposure(&r3, &s, &ex, &e3, &k3);
     CHECK(k1 > 1 && k1 == k3 && same(&e1, &e3), "smeared rolling-shutter exposure differs between 1 and 3 threads (%d, %d samples)",
           k1, k3);
+    /* Again with the same renderer: its time-sample buffers (kept between
+     * exposures) start each exposure afresh. */
+    nc_render_exposure(&r3, &s, &ex, &e3, &k3);
+    CHECK(k1 == k3 && same(&e1, &e3), "a second smeared exposure with the same renderer differs from the first");
     nc_frame_free(&e1);
     nc_frame_free(&e3);
     /* Empty blocks: the body in view, still and smeared (rolling shutter,
