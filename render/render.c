@@ -564,8 +564,10 @@ static void record_geom(const struct job *j, const struct surf *sf, int px0, int
  * at once: ray[q] is sample slot0 + q of the block's 16 pixels. Regrouped
  * into packets of 2x2 pixels x 4 samples (or as near as ns allows), each
  * packet spans a quarter of the image area of a 4x4-pixel one, so Embree
- * opens fewer tree nodes and tests fewer triangles per packet. A ray's hit
- * does not depend on the rays it travels with. */
+ * opens fewer tree nodes and tests fewer triangles per packet. Embree gives
+ * each ray its own closest hit whatever its packet-mates (an exact tie
+ * between two triangles might resolve either way; test_determinism compares
+ * the two packings bit for bit and has met none). */
 #define SLOT_GROUP 16
 static void trace_camera(const struct job *j, const struct nc_ray16 *ray, struct nc_hit16 *hit, int ns)
 {

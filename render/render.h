@@ -78,7 +78,7 @@ struct nc_renderer {
     int no_shadow_cull;
     /* 1: trace camera rays in packets of one sample of 4x4 pixels, as the
      * shading takes them, instead of 2x2 pixels x 4 samples (trace_camera in
-     * render.c); tests compare the two (the frames are identical). */
+     * render.c); tests compare the two (the frames are the same). */
     int one_sample_packets;
     /* Per body, at the last frame: the roughness theta_bar (deg) its
      * material was rendered with after folding in the rocks not traced, or
