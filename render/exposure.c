@@ -114,17 +114,16 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
     }
     if (!r->exp_sum && !(r->exp_sum = malloc(4 * n * sizeof *r->exp_sum)))
         return nc_error(-ENOMEM, "out of memory");
-    if (f->rock_id && !sub->rock_id && !(sub->rock_id = malloc(n * sizeof *sub->rock_id)))
-        return nc_error(-ENOMEM, "out of memory");
-    int32_t *keep_rock = sub->rock_id;
-    if (!f->rock_id) /* render no rock plane the caller did not ask for */
+    if (!f->rock_id) { /* render no rock plane the caller did not ask for */
+        free(sub->rock_id);
         sub->rock_id = NULL;
-    struct acc a = {r->exp_sum, r->exp_sum + n, r->exp_sum + 2 * n, r->exp_sum + 3 * n};
-    double *row_dt = malloc((size_t)H * sizeof *row_dt);
-    if (!row_dt) {
-        sub->rock_id = keep_rock;
+    } else if (!sub->rock_id && !(sub->rock_id = malloc(n * sizeof *sub->rock_id))) {
         return nc_error(-ENOMEM, "out of memory");
     }
+    struct acc a = {r->exp_sum, r->exp_sum + n, r->exp_sum + 2 * n, r->exp_sum + 3 * n};
+    double *row_dt = malloc((size_t)H * sizeof *row_dt);
+    if (!row_dt)
+        return nc_error(-ENOMEM, "out of memory");
     int nb = ex->rolling ? bands : 1;
     for (int b = 0; b < nb && rc >= 0; b++) {
         int r0 = ex->rolling ? b : 0, r1 = ex->rolling ? b + 1 : bands;
@@ -142,7 +141,6 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
         }
     }
     free(row_dt);
-    sub->rock_id = keep_rock;
     for (size_t o = 0; rc >= 0 && o < n; o++) {
         f->radiance[o] = (float)(a.L[o] / K);
         f->iof[o] = (float)(a.iof[o] / K);

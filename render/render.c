@@ -586,8 +586,9 @@ static void trace_camera(const struct job *j, const struct nc_ray16 *ray, struct
     for (int p0 = 0; p0 < NC_PACKET * ns; p0 += NC_PACKET) {
         struct nc_ray16 pk;
         struct nc_hit16 hk;
+        int qk[NC_PACKET], ik[NC_PACKET]; /* lane k's sample and pixel */
         for (int k = 0; k < NC_PACKET; k++) {
-            const int q = (p0 + k) % ns, i = quad[(p0 + k) / ns];
+            const int q = qk[k] = (p0 + k) % ns, i = ik[k] = quad[(p0 + k) / ns];
             const struct nc_ray16 *rq = &ray[q];
             pk.ox[k] = rq->ox[i], pk.oy[k] = rq->oy[i], pk.oz[k] = rq->oz[i];
             pk.dx[k] = rq->dx[i], pk.dy[k] = rq->dy[i], pk.dz[k] = rq->dz[i];
@@ -597,8 +598,8 @@ static void trace_camera(const struct job *j, const struct nc_ray16 *ray, struct
             j->r->ray_hook(j->r->ray_hook_user, 0, &pk);
         nc_rt_intersect16(j->rt, &pk, &hk, 1);
         for (int k = 0; k < NC_PACKET; k++) {
-            const int q = (p0 + k) % ns, i = quad[(p0 + k) / ns];
-            struct nc_hit16 *h = &hit[q];
+            const int i = ik[k];
+            struct nc_hit16 *h = &hit[qk[k]];
             h->t[i] = hk.t[k], h->nx[i] = hk.nx[k], h->ny[i] = hk.ny[k], h->nz[i] = hk.nz[k];
             h->body[i] = hk.body[k], h->albedo[i] = hk.albedo[k], h->rock[i] = hk.rock[k];
         }
