@@ -85,10 +85,10 @@ static void init_sync(struct nc__emu *e)
     pthread_mutex_init(&e->stat_lock, NULL);
     pthread_cond_init(&e->jcond, NULL);
     pthread_cond_init(&e->scond, NULL);
-    pthread_cond_init(&e->sfree, NULL);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&e->sfree, &ca);
     pthread_cond_init(&e->tl_cond, &ca);
     pthread_condattr_destroy(&ca);
 }

@@ -88,14 +88,25 @@ static void hold_job(struct nc__emu *e, const struct nc__job *j)
 }
 
 /* A free slot for the job's result. Lock-step waits for one (it never
- * drops); the other modes take what is free or drop by policy. NULL: none
- * (dropped, or shutting down: the job is held for the shutdown's answers). */
-static struct nc__slot *free_slot(struct nc__emu *e, const struct nc__job *j)
+ * drops). The other modes hand a frame only to an idle output thread, so
+ * that it leaves at once: they wait for the frame before to be taken by
+ * every output until the job is due (its exposure's end, plus one frame
+ * period, plus render_ns, the render it took: the latency bound of
+ * docs/emulator.md, the camera model's time aside) and else drop it
+ * (output_busy: an output slower than the render). NULL: none (dropped, or
+ * shutting down: the job is held for the shutdown's answers). */
+static struct nc__slot *free_slot(struct nc__emu *e, const struct nc__job *j, int64_t render_ns)
 {
     pthread_mutex_lock(&e->slock);
     while (e->mode == NC__MODE_LOCKSTEP && e->scount == e->nslots && atomic_load(&e->stop) < 2)
         pthread_cond_wait(&e->sfree, &e->slock);
-    struct nc__slot *sl = e->scount < e->nslots ? &e->slots[(e->shead + e->scount) % e->nslots] : NULL;
+    const int64_t due = j->ready_mono_ns + j->period_ns + render_ns;
+    while (e->mode != NC__MODE_LOCKSTEP && e->scount > 0 && atomic_load(&e->stop) < 2 && nc_mono_ns() < due) {
+        struct timespec ts = {(time_t)(due / 1000000000), (long)(due % 1000000000)};
+        pthread_cond_timedwait(&e->sfree, &e->slock, &ts);
+    }
+    const int room = e->mode == NC__MODE_LOCKSTEP ? e->scount < e->nslots : e->scount == 0;
+    struct nc__slot *sl = room ? &e->slots[(e->shead + e->scount) % e->nslots] : NULL;
     pthread_mutex_unlock(&e->slock);
     if (!sl && e->mode == NC__MODE_LOCKSTEP)
         hold_job(e, j);
@@ -120,7 +131,7 @@ static void drop_job(struct nc__emu *e, const struct nc__job *j, enum nc__drop_r
         nc__serve_drop(e, j, why);
         return;
     }
-    struct nc__slot *sl = free_slot(e, j);
+    struct nc__slot *sl = free_slot(e, j, 0);
     if (!sl)
         return;
     sl->job = *j;
@@ -163,7 +174,7 @@ static void finish_frame(struct stage *st, const struct staged *x)
 {
     struct nc__emu *e = st->e;
     const struct nc__job *j = &x->j;
-    struct nc__slot *sl = free_slot(e, j);
+    struct nc__slot *sl = free_slot(e, j, x->t1 - x->t0);
     if (!sl)
         return;
     int64_t t1 = nc_mono_ns();

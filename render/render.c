@@ -243,11 +243,33 @@ struct surf {
     double factor[NC_PACKET]; /* on the albedo: variation and map */
 };
 
+/* (x, y, z) / |(x, y, z)| into lane i of u, as nc_v3_unit does it (the
+ * same operations: the same bits); branch-free, for loops the compiler
+ * vectorises. */
+static inline void unit_lane(double x, double y, double z, double (*u)[NC_PACKET], int i)
+{
+    const double len = sqrt(x * x + y * y + z * z), s = 1.0 / len;
+    u[0][i] = len > 0 ? x * s : x;
+    u[1][i] = len > 0 ? y * s : y;
+    u[2][i] = len > 0 ? z * s : z;
+}
+
+/* The unit facet normals of a packet's hits (zero where a lane missed), in
+ * AVX2 where the CPU has it (no FMA: the same bits as plain code). */
+__attribute__((target_clones("avx2", "default"))) static void unit_normals(const struct nc_hit16 *hit,
+                                                                             double (*un)[NC_PACKET])
+{
+    for (int i = 0; i < NC_PACKET; i++)
+        unit_lane(hit->nx[i], hit->ny[i], hit->nz[i], un, i);
+}
+
 /* Fill s from a packet's hits, for rays from orig along the unit dir. */
 static void surface16(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
                       const struct nc_vec3 *dir, struct surf *s)
 {
     const struct nc_scene *sc = j->s;
+    double un[3][NC_PACKET];
+    unit_normals(hit, un);
     for (int i = 0; i < NC_PACKET; i++) {
         s->body[i] = hit->body[i];
         if (hit->body[i] < 0)
@@ -260,7 +282,7 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
             continue;
         }
         if (exact == 0)
-            nrm = nc_v3_unit(nc_v3(hit->nx[i], hit->ny[i], hit->nz[i]));
+            nrm = nc_v3(un[0][i], un[1][i], un[2][i]);
         s->outside[i] = nc_v3_dot(nrm, d) <= 0;
         if (!s->outside[i]) /* back face: inconsistent winding, or the ray from inside */
             nrm = nc_v3_scale(nrm, -1.0);
@@ -560,6 +582,50 @@ static void record_geom(const struct job *j, const struct surf *sf, int px0, int
     }
 }
 
+/* A packet's camera samples: lane i is pixel (px, py) (its centre) and,
+ * with strata, the point (jx, jy) / n - 1/2 of it (stratum plus jitter), on
+ * its row's camera rc. */
+struct image_points {
+    double px[NC_PACKET], py[NC_PACKET], jx[NC_PACKET], jy[NC_PACKET];
+    const struct row_cam *rc[NC_PACKET];
+};
+
+/* The unit directions d[i] of a packet's camera rays through the image
+ * points ip (n strata a side; 0: the pixel centres). The pinhole case is
+ * branch-free loops, vectorised (AVX2 where the CPU has it: no FMA, so the
+ * same bits as plain scalar code, and as nc_v3_unit). */
+__attribute__((target_clones("avx2", "default"))) static void camera_dirs(const struct nc_camera *c,
+                                                                            const struct image_points *ip, int n,
+                                                                            struct nc_vec3 *d)
+{
+    double fx[NC_PACKET], fy[NC_PACKET];
+    for (int i = 0; i < NC_PACKET; i++) {
+        fx[i] = ip->px[i] + (n ? ip->jx[i] / n - 0.5 : 0.0);
+        fy[i] = ip->py[i] + (n ? ip->jy[i] / n - 0.5 : 0.0);
+    }
+    const struct row_cam *const *rc = ip->rc;
+    if (c->distorted) { /* the lens model, inverted exactly for each sample */
+        for (int i = 0; i < NC_PACKET; i++)
+            d[i] = nc_v3_unit(nc_mat_mul_v(&rc[i]->R, nc_camera_ray(c, fx[i], fy[i])));
+        return;
+    }
+    /* R ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per row */
+    double a[9][NC_PACKET], u[3][NC_PACKET];
+    for (int i = 0; i < NC_PACKET; i++) {
+        a[0][i] = rc[i]->d00.x, a[1][i] = rc[i]->d00.y, a[2][i] = rc[i]->d00.z;
+        a[3][i] = rc[i]->ex.x, a[4][i] = rc[i]->ex.y, a[5][i] = rc[i]->ex.z;
+        a[6][i] = rc[i]->ey.x, a[7][i] = rc[i]->ey.y, a[8][i] = rc[i]->ey.z;
+    }
+    for (int i = 0; i < NC_PACKET; i++) {
+        const double vx = a[0][i] + fx[i] * a[3][i] + fy[i] * a[6][i];
+        const double vy = a[1][i] + fx[i] * a[4][i] + fy[i] * a[7][i];
+        const double vz = a[2][i] + fx[i] * a[5][i] + fy[i] * a[8][i];
+        unit_lane(vx, vy, vz, u, i);
+    }
+    for (int i = 0; i < NC_PACKET; i++)
+        d[i] = nc_v3(u[0][i], u[1][i], u[2][i]);
+}
+
 /* Camera rays of one 4x4 pixel block, traced for up to SLOT_GROUP samples
  * at once: ray[q] is sample slot0 + q of the block's 16 pixels. Regrouped
  * into packets of 2x2 pixels x 4 samples (or as near as ns allows), each
@@ -583,12 +649,15 @@ static void trace_camera(const struct job *j, const struct nc_ray16 *ray, struct
      * 2x2 quad and each next pixel is a neighbour. A packet's lanes are
      * consecutive (pixel, sample) pairs of this order. */
     static const int quad[NC_PACKET] = {0, 1, 5, 4, 8, 12, 13, 9, 10, 14, 15, 11, 7, 6, 2, 3};
+    int lq = 0, lp = 0;
     for (int p0 = 0; p0 < NC_PACKET * ns; p0 += NC_PACKET) {
         struct nc_ray16 pk;
         struct nc_hit16 hk;
         int qk[NC_PACKET], ik[NC_PACKET]; /* lane k's sample and pixel */
         for (int k = 0; k < NC_PACKET; k++) {
-            const int q = qk[k] = (p0 + k) % ns, i = ik[k] = quad[(p0 + k) / ns];
+            const int q = qk[k] = lq, i = ik[k] = quad[lp];
+            if (++lq == ns) /* (p0 + k) mod ns and (p0 + k) / ns, without dividing */
+                lq = 0, lp++;
             const struct nc_ray16 *rq = &ray[q];
             pk.ox[k] = rq->ox[i], pk.oy[k] = rq->oy[i], pk.oz[k] = rq->oz[i];
             pk.dx[k] = rq->dx[i], pk.dy[k] = rq->dy[i], pk.dz[k] = rq->dz[i];
@@ -677,42 +746,41 @@ static void shade_tile(struct job *j, int tile)
                 if (!live[by / 4][bx / 4])
                     continue;
                 /* Camera rays for a 4x4 pixel block, ns samples each. */
-                for (int q = 0; q < ns; q++)
+                for (int q = 0; q < ns; q++) {
+                    const int slot = slot0 + q, vary = ps->K > 1 && (S > 1 || one); /* g differs from lane to lane */
+                    /* Sample g lies in stratum g mod S = (sx, sy), jittered within it by the hashes. */
+                    const int sx_slot = slot % S % n, sy_slot = slot % S / n;
+                    struct image_points ip;
                     for (int i = 0; i < NC_PACKET; i++) {
-                        const int slot = slot0 + q, px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
+                        const int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
                         ray[q].valid[i] = (px < W && py < H) ? -1 : 0;
-                        double ox = 0, oy = 0;
                         uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                        int g = ps->K > 1 && (S > 1 || one)
-                                    ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N)
-                                    : slot;
+                        int g = vary ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N) : slot;
                         g_lane[q][i] = g;
-                        if (S > 1) { /* sample g, in stratum g mod S, jittered within it */
-                            const int sx = g % S % n, sy = g % S / n;
-                            ox = (sx + hash01(s->render.seed, pid, 2 * (uint64_t)g)) / n - 0.5;
-                            oy = (sy + hash01(s->render.seed, pid, 2 * (uint64_t)g + 1)) / n - 0.5;
+                        ip.px[i] = px;
+                        ip.py[i] = py;
+                        if (S > 1) {
+                            const int sx = vary ? g % S % n : sx_slot, sy = vary ? g % S / n : sy_slot;
+                            ip.jx[i] = sx + hash01(s->render.seed, pid, 2 * (uint64_t)g);
+                            ip.jy[i] = sy + hash01(s->render.seed, pid, 2 * (uint64_t)g + 1);
                         }
-                        double fx = px + ox, fy = py + oy;
-                        const struct row_cam *rc = &j->row[py < H ? py : H - 1];
-                        struct nc_vec3 d;
-                        if (c->distorted) { /* the lens model, inverted exactly for this sample */
-                            d = nc_v3_unit(nc_mat_mul_v(&rc->R, nc_camera_ray(c, fx, fy)));
-                        } else { /* R ((x - cx)/fx, (y - cy)/fy, 1) = d00 + x ex + y ey, expanded once per row */
-                            d = nc_v3_unit(nc_v3(rc->d00.x + fx * rc->ex.x + fy * rc->ey.x,
-                                                 rc->d00.y + fx * rc->ex.y + fy * rc->ey.y,
-                                                 rc->d00.z + fx * rc->ex.z + fy * rc->ey.z));
-                        }
-                        dir[q][i] = d;
-                        orig[q][i] = rc->o;
-                        ray[q].ox[i] = (float)rc->o.x;
-                        ray[q].oy[i] = (float)rc->o.y;
-                        ray[q].oz[i] = (float)rc->o.z;
+                        ip.rc[i] = &j->row[py < H ? py : H - 1];
+                    }
+                    camera_dirs(c, &ip, S > 1 ? n : 0, dir[q]);
+                    const struct row_cam *const *rc = ip.rc;
+                    for (int i = 0; i < NC_PACKET; i++) {
+                        const struct nc_vec3 d = dir[q][i];
+                        orig[q][i] = rc[i]->o;
+                        ray[q].ox[i] = (float)rc[i]->o.x;
+                        ray[q].oy[i] = (float)rc[i]->o.y;
+                        ray[q].oz[i] = (float)rc[i]->o.z;
                         ray[q].dx[i] = (float)d.x;
                         ray[q].dy[i] = (float)d.y;
                         ray[q].dz[i] = (float)d.z;
                         ray[q].tnear[i] = 0.0f;
                         ray[q].tfar[i] = INFINITY;
                     }
+                }
                 trace_camera(j, ray, hit, ns);
                 for (int q = 0; q < ns; q++) {
                     /* This sample's number in the pixel's exposure (the soft-shadow and

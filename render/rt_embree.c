@@ -542,6 +542,7 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
         unsigned inst = rh.hit.instID[0][i];
         if (!ray->valid[i] || rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID || inst >= rt->ninst) {
             hit->body[i] = -1;
+            hit->nx[i] = hit->ny[i] = hit->nz[i] = 0.0f; /* defined for the packet-wide loops */
             continue;
         }
         const struct rt_body *b = &rt->body[rt->geom_to_body[inst]];
