@@ -590,6 +590,20 @@ struct image_points {
     const struct row_cam *rc[NC_PACKET];
 };
 
+/* The jitter of each lane's sample g[i] within its stratum (jx, jy hold
+ * the stratum's corner): two hashes of (seed, pixel, sample) added, for all
+ * lanes at once (64-bit multiplies: AVX-512 where the CPU has it). Integer
+ * arithmetic, an exact conversion and an exact scaling by 2^-53, so one
+ * rounding (the sum's) on any path, contracted or not: the same bits. */
+__attribute__((target_clones("arch=x86-64-v4", "default"))) static void jitter16(uint64_t seed, const uint64_t *pid,
+                                                                            const int *g, struct image_points *ip)
+{
+    for (int i = 0; i < NC_PACKET; i++) {
+        ip->jx[i] += hash01(seed, pid[i], 2 * (uint64_t)g[i]);
+        ip->jy[i] += hash01(seed, pid[i], 2 * (uint64_t)g[i] + 1);
+    }
+}
+
 /* The unit directions d[i] of a packet's camera rays through the image
  * points ip (n strata a side; 0: the pixel centres). The pinhole case is
  * branch-free loops, vectorised (AVX2 where the CPU has it: no FMA, so the
@@ -751,21 +765,23 @@ static void shade_tile(struct job *j, int tile)
                     /* Sample g lies in stratum g mod S = (sx, sy), jittered within it by the hashes. */
                     const int sx_slot = slot % S % n, sy_slot = slot % S / n;
                     struct image_points ip;
+                    uint64_t pid[NC_PACKET];
                     for (int i = 0; i < NC_PACKET; i++) {
                         const int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
                         ray[q].valid[i] = (px < W && py < H) ? -1 : 0;
-                        uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                        int g = vary ? sample_of(s->render.seed, pid, ps->k + slot * ps->K, ps->N) : slot;
+                        pid[i] = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                        int g = vary ? sample_of(s->render.seed, pid[i], ps->k + slot * ps->K, ps->N) : slot;
                         g_lane[q][i] = g;
                         ip.px[i] = px;
                         ip.py[i] = py;
                         if (S > 1) {
-                            const int sx = vary ? g % S % n : sx_slot, sy = vary ? g % S / n : sy_slot;
-                            ip.jx[i] = sx + hash01(s->render.seed, pid, 2 * (uint64_t)g);
-                            ip.jy[i] = sy + hash01(s->render.seed, pid, 2 * (uint64_t)g + 1);
+                            ip.jx[i] = vary ? g % S % n : sx_slot;
+                            ip.jy[i] = vary ? g % S / n : sy_slot;
                         }
                         ip.rc[i] = &j->row[py < H ? py : H - 1];
                     }
+                    if (S > 1)
+                        jitter16(s->render.seed, pid, g_lane[q], &ip);
                     camera_dirs(c, &ip, S > 1 ? n : 0, dir[q]);
                     const struct row_cam *const *rc = ip.rc;
                     for (int i = 0; i < NC_PACKET; i++) {
