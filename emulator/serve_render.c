@@ -110,8 +110,8 @@ static struct nc__slot *free_slot(struct nc__emu *e, const struct nc__job *j, in
     pthread_mutex_unlock(&e->slock);
     if (!sl && e->mode == NC__MODE_LOCKSTEP)
         hold_job(e, j);
-    else if (!sl)
-        nc__serve_drop(e, j, NC__DROP_OUTPUT_BUSY);
+    else if (!sl) /* the wait for the outputs ended by shutdown, or past the due time */
+        nc__serve_drop(e, j, atomic_load(&e->stop) >= 2 ? NC__DROP_SHUTDOWN : NC__DROP_OUTPUT_BUSY);
     return sl;
 }
 
