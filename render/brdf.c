@@ -365,17 +365,16 @@ __attribute__((target_clones("avx2", "default"))) static void hapke_chunk(const 
     rows(nc_vlog, lg, 2, n);
 
     /* Stage 3: H, the phase function and the opposition effects. */
-    for (size_t k = 0; k < n; k++) {
-        Bc[k] = 0.0;
-        if (p[HBC0] > 0) /* eq. 18, with tan(g/2) */
-            Bc[k] = p[HBC0] * hapke_BC(sqrt((1.0 - cg[k]) / (1.0 + cg[k])) / p[HHC]);
-    }
+    double tg2[HCHUNK];
+    for (size_t k = 0; k < n; k++)
+        tg2[k] = sqrt((1.0 - cg[k]) / (1.0 + cg[k])); /* tan(g/2); infinite at g = 180 deg */
+    for (size_t k = 0; k < n; k++) /* eq. 18 (expm1: not vectorised) */
+        Bc[k] = p[HBC0] > 0 ? p[HBC0] * hapke_BC(tg2[k] / p[HHC]) : 0.0;
     const double w0 = p[HW], r00 = c[CR0], b = p[HB], cc = p[HC], Bs0 = p[HBS0], hS = p[HHS];
     for (size_t k = 0; k < n; k++) {
         const double w = fa[k] != 1.0 ? scaled(w0, fa[k], 1.0) : w0, sq = sqrt(1.0 - w);
         const double r0 = fa[k] != 1.0 ? (1.0 - sq) / (1.0 + sq) : r00;
-        const double tg2 = sqrt((1.0 - cg[k]) / (1.0 + cg[k])); /* tan(g/2); infinite at g = 180 deg */
-        const double Bs = Bs0 > 0 ? Bs0 * hS / (hS + tg2) : 0.0; /* eq. 13 */
+        const double Bs = Bs0 > 0 ? Bs0 * hS / (hS + tg2[k]) : 0.0; /* eq. 13 */
         const double M = hapke_H(xA[k], w, r0, lg[k]) * hapke_H(xB[k], w, r0, lg[HCHUNK + k]) - 1.0; /* eq. 14 */
         const double bracket = (hapke_p(b, cc, cg[k]) * (1.0 + Bs) + M) * (1.0 + Bc[k]);
         /* Hapke 2012 eq. 12.55 (IMSA): K both multiplies and divides the H arguments. */
