@@ -241,8 +241,8 @@ static void check_config(void)
  * rim (0.9 to 1.1 radii) by at least a quarter of its depth (Pike's
  * 0.196 D, less what its age took). Over TILES tiles (seeds), the craters
  * seen recover the configured slope and density within 5 % (the
- * statistical 1-sigma, 1/sqrt(N), is printed); those not seen are the ones
- * younger craters overprinted. */
+ * statistical 1-sigma, 1/sqrt(N), is printed); those not seen are where
+ * other craters' cavities and ejecta changed the relief. */
 enum { TILES = 4, TILE_COUNT = 700 };
 static const double tile_post = 0.5, tile_d_lo = 3, tile_d_hi = 40, tile_slope = 2, tile_half = 200;
 
