@@ -182,6 +182,7 @@ struct job {
     int bounces, roulette_after; /* indirect light (render.bounces, render.roulette_after) */
     uint64_t path_seed;          /* the bounce directions' stream */
     int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
+    int bins; /* camera rays through nc_rt_intersect_block (a pinhole at rest over meshes) */
 };
 
 /* Whether any ray of the 4x4 pixel block at (px0, py0) can reach a body's
@@ -649,8 +650,15 @@ __attribute__((target_clones("avx2", "default"))) static void camera_dirs(const 
  * between two triangles might resolve either way; test_determinism compares
  * the two packings bit for bit and has met none). */
 #define SLOT_GROUP 16
-static void trace_camera(const struct job *j, const struct nc_ray16 *ray, struct nc_hit16 *hit, int ns)
+static void trace_camera(const struct job *j, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
+                         int ns)
 {
+    if (j->bins) { /* a pinhole at rest: the block's own triangles */
+        for (int q = 0; q < ns && j->r->ray_hook; q++)
+            j->r->ray_hook(j->r->ray_hook_user, 0, &ray[q]);
+        nc_rt_intersect_block(j->rt, px0, py0, ray, hit, ns);
+        return;
+    }
     if (ns == 1 || j->r->one_sample_packets) {
         for (int q = 0; q < ns; q++) {
             if (j->r->ray_hook)
@@ -797,7 +805,7 @@ static void shade_tile(struct job *j, int tile)
                         ray[q].tfar[i] = INFINITY;
                     }
                 }
-                trace_camera(j, ray, hit, ns);
+                trace_camera(j, x0 + bx, y0 + by, ray, hit, ns);
                 for (int q = 0; q < ns; q++) {
                     /* This sample's number in the pixel's exposure (the soft-shadow and
                      * path streams'); the same in all lanes, unique per pixel. */
@@ -982,6 +990,27 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
     }
     atomic_init(&j.next, 0);
     j.cull = !c->distorted && !r->no_cull; /* the lens model's rays are not linear in the pixel */
+    /* Threads kept between frames (and between a rolling shutter's bands);
+     * fewer threads only cost time, never change pixels. */
+    if (r->pool_threads != r->threads) { /* a caller changed r->threads */
+        nc_pool_destroy(r->pool);
+        r->pool = nc_pool_create(r->threads);
+        r->pool_threads = r->threads;
+    }
+    /* Camera rays through binned triangles when every row has the same
+     * camera (no rolling-shutter motion) and the rays are linear in the pixel. */
+    int pinhole = !c->distorted && !r->no_bins;
+    for (int y = ya + 1; y < yb && pinhole; y++)
+        pinhole = !memcmp(&j.row[y].o, &j.row[ya].o, sizeof j.row[ya].o) &&
+                  !memcmp(&j.row[y].d00, &j.row[ya].d00, sizeof j.row[ya].d00) &&
+                  !memcmp(&j.row[y].ex, &j.row[ya].ex, sizeof j.row[ya].ex) &&
+                  !memcmp(&j.row[y].ey, &j.row[ya].ey, sizeof j.row[ya].ey);
+    const struct nc_rt_pinhole pin = {j.row[ya].o, j.row[ya].d00, j.row[ya].ex, j.row[ya].ey, c->width_px, c->height_px};
+    if ((rc = nc_rt_bin_camera(r->rt, pinhole ? &pin : NULL, r->pool, r->threads)) < 0) {
+        free(j.row);
+        return rc;
+    }
+    j.bins = rc > 0;
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
     j.sun_tan_radius = s->render.soft_shadows ? tan(nc_scene_sun_radius_rad(s)) : 0.0;
     nc_v3_basis(j.sun_dir, &j.sun_e1, &j.sun_e2);
@@ -990,13 +1019,6 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
     j.roulette_after = s->render.roulette_after;
     j.path_seed = mix64(s->render.seed ^ 0x70617468ull); /* "path" */
 
-    /* Threads kept between frames (and between a rolling shutter's bands);
-     * fewer threads only cost time, never change pixels. */
-    if (r->pool_threads != r->threads) { /* a caller changed r->threads */
-        nc_pool_destroy(r->pool);
-        r->pool = nc_pool_create(r->threads);
-        r->pool_threads = r->threads;
-    }
     nc_pool_run(r->pool, worker, &j);
     free(j.row);
     return 0;

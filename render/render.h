@@ -80,6 +80,10 @@ struct nc_renderer {
      * shading takes them, instead of 2x2 pixels x 4 samples (trace_camera in
      * render.c); tests compare the two (the frames are the same). */
     int one_sample_packets;
+    /* 1: trace camera rays through Embree even where a pass's camera is a
+     * pinhole at rest over meshes (nc_rt_bin_camera's binned triangles serve
+     * them otherwise); tests compare the two. */
+    int no_bins;
     /* Per body, at the last frame: the roughness theta_bar (deg) its
      * material was rendered with after folding in the rocks not traced, or
      * -1 where nothing was folded (scene.h, render.boulder_fold). */

@@ -56,6 +56,26 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out);
 int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s);
 /* Closest hits; coherent = camera rays. */
 void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit, int coherent);
+/* Camera rays through binned triangles (rt_bins.h) for this pass, when
+ * every camera ray leaves one point o (camera-relative scene frame) along
+ * d00 + x ex + y ey through image point (x, y) (pixels, centres at
+ * integers) and every sample of pixel (px, py) lies within half a pixel of
+ * it; cam NULL turns them off. Returns 1 when nc_rt_intersect_block serves
+ * the pass (every body a mesh, no boulders traced, no triangle across the
+ * plane through o parallel to the image), 0 when it does not, or a negative
+ * error code. The lists are built on pool's threads (NULL: the caller's
+ * alone), the same for any number. Call after nc_rt_update. */
+struct nc_rt_pinhole {
+    struct nc_vec3 o, d00, ex, ey;
+    int width_px, height_px;
+};
+struct nc_pool;
+int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct nc_pool *pool, int threads);
+/* Closest hits, as nc_rt_intersect16's, of n packets of camera rays from
+ * the pinhole of nc_rt_bin_camera (tnear 0), every lane in the 4x4 pixel
+ * block at (px0, py0) (multiples of 4). */
+void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
+                           int n);
 /* For a hit on an analytic body, recompute range t and unit normal n (scene
  * frame) in double precision for the exact camera-relative ray origin + t d (d unit):
  * the packet trace is float. Returns 1 if refined, 0 for meshes (the float

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "render/rt_bins.h"
 #include "render/rt_rocks.h"
 #include "render/shadow_grid.h"
 
@@ -35,6 +36,7 @@ struct rt_body {
     float *verts; /* anchor-relative vertices of every level, padded for Embree's 16-byte loads */
     float *vnormal; /* smooth shading: unit normals at the vertices, body frame (NULL: flat) */
     const unsigned *tri[NC_LOD_MAX_LEVELS]; /* each level's triangles (Embree's index buffer) */
+    float *facet_n[NC_LOD_MAX_LEVELS];      /* each level's facet normals, body frame (nc_rt_bin_camera) */
     unsigned inst_id;
     RTCGeometry inst;
     /* boulders (rt_rocks.h): tiles of their own, each instanced in the
@@ -76,6 +78,8 @@ struct nc_rt {
     unsigned ninst, inst_cap;
     struct nc_rt_stats stats;
     atomic_ulong shadow_culled, shadow_traced;
+    struct nc__bins bins; /* camera rays of this pass through bins (nc_rt_bin_camera) */
+    int bins_on;
 };
 
 static int rt_check(RTCDevice dev, const char *what)
@@ -214,6 +218,19 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
     if (closed < 0)
         return closed;
     b->closed[k] = closed;
+    /* The facets' normals for the camera-ray bins: (v1 - v0) x (v2 - v0) in
+     * double, as Embree's convention has it. */
+    if (!(b->facet_n[k] = malloc(3 * lv->nt * sizeof *b->facet_n[k])))
+        return nc_error(-ENOMEM, "out of memory for %zu facet normals", lv->nt);
+    for (size_t t = 0; t < lv->nt; t++) {
+        const unsigned *f = &lv->tri[3 * t];
+        const double *p0 = &m->v[3 * (size_t)f[0]], *p1 = &m->v[3 * (size_t)f[1]], *p2 = &m->v[3 * (size_t)f[2]];
+        const struct nc_vec3 n = nc_v3_cross(nc_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]),
+                                             nc_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]));
+        b->facet_n[k][3 * t + 0] = (float)n.x;
+        b->facet_n[k][3 * t + 1] = (float)n.y;
+        b->facet_n[k][3 * t + 2] = (float)n.z;
+    }
     return rt_check(rt->dev, "creating geometry");
 }
 
@@ -526,6 +543,60 @@ static void load_ray(struct RTCRay16 *r, const struct nc_ray16 *in)
     }
 }
 
+/* Lane i of hit: instance inst's primitive prim (a body's own triangle, or a
+ * rock of a tile) met at t, barycentric (u, v), geometric normal (x, y, z)
+ * unnormalised in the instanced geometry's frame (the body's). */
+static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float t, float u, float v, float x, float y,
+                    float z, const struct nc_ray16 *ray, struct nc_hit16 *hit, int i)
+{
+    const struct rt_body *b = &rt->body[rt->geom_to_body[inst]];
+    const float *R = b->rot;
+    if (b->vnormal && inst == b->inst_id) {
+        /* Smooth: the vertex normals at the hit's barycentric point, kept
+         * only where they face the ray as the facet does (else the facet's:
+         * a shading normal never shows a face the geometry hides). */
+        const unsigned *tr = b->tri[b->level] + 3 * (size_t)prim;
+        const float *n0 = b->vnormal + 3 * (size_t)tr[0], *n1 = b->vnormal + 3 * (size_t)tr[1],
+                    *n2 = b->vnormal + 3 * (size_t)tr[2];
+        float w = 1 - u - v;
+        float sx = w * n0[0] + u * n1[0] + v * n2[0], sy = w * n0[1] + u * n1[1] + v * n2[1],
+              sz = w * n0[2] + u * n1[2] + v * n2[2];
+        /* the ray in the body frame: R^T d */
+        float dx = R[0] * ray->dx[i] + R[3] * ray->dy[i] + R[6] * ray->dz[i],
+              dy = R[1] * ray->dx[i] + R[4] * ray->dy[i] + R[7] * ray->dz[i],
+              dz = R[2] * ray->dx[i] + R[5] * ray->dy[i] + R[8] * ray->dz[i];
+        float gd = x * dx + y * dy + z * dz, sd = sx * dx + sy * dy + sz * dz;
+        if ((gd < 0) == (sd < 0) && sx * x + sy * y + sz * z > 0)
+            x = sx, y = sy, z = sz;
+    }
+    /* Albedo variation: interpolated from the vertices on the ground,
+     * one factor per rock. */
+    float alb = 1.0f;
+    int32_t rock = -1;
+    if (inst == b->inst_id && b->src->albedo_vertex) {
+        const unsigned *tr = b->tri[b->level] + 3 * (size_t)prim;
+        const float *a = b->src->albedo_vertex;
+        alb = (1 - u - v) * a[tr[0]] + u * a[tr[1]] + v * a[tr[2]];
+    } else if (rt->inst_tile[inst]) {
+        size_t k = rt->inst_tile[inst]->index[prim];
+        alb = nc_albedo_var_rock(&b->src->albedo_var, k);
+        rock = (int32_t)k;
+    }
+    hit->albedo[i] = alb;
+    hit->rock[i] = rock;
+    hit->body[i] = (int)rt->geom_to_body[inst];
+    hit->t[i] = t;
+    hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;
+    hit->ny[i] = R[3] * x + R[4] * y + R[5] * z;
+    hit->nz[i] = R[6] * x + R[7] * y + R[8] * z;
+}
+
+static void put_miss(struct nc_hit16 *hit, int i)
+{
+    hit->body[i] = -1;
+    hit->nx[i] = hit->ny[i] = hit->nz[i] = 0.0f; /* defined for the packet-wide loops */
+}
+
 void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit, int coherent)
 {
     struct RTCRayHit16 rh __attribute__((aligned(64)));
@@ -540,52 +611,65 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
     rtcIntersect16(ray->valid, rt->top, &ctx, &rh);
     for (int i = 0; i < NC_PACKET; i++) {
         unsigned inst = rh.hit.instID[0][i];
-        if (!ray->valid[i] || rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID || inst >= rt->ninst) {
-            hit->body[i] = -1;
-            hit->nx[i] = hit->ny[i] = hit->nz[i] = 0.0f; /* defined for the packet-wide loops */
-            continue;
-        }
-        const struct rt_body *b = &rt->body[rt->geom_to_body[inst]];
-        const float *R = b->rot;
-        float x = rh.hit.Ng_x[i], y = rh.hit.Ng_y[i], z = rh.hit.Ng_z[i];
-        if (b->vnormal && inst == b->inst_id) {
-            /* Smooth: the vertex normals at the hit's barycentric point, kept
-             * only where they face the ray as the facet does (else the facet's:
-             * a shading normal never shows a face the geometry hides). */
-            const unsigned *t = b->tri[b->level] + 3 * (size_t)rh.hit.primID[i];
-            const float *n0 = b->vnormal + 3 * (size_t)t[0], *n1 = b->vnormal + 3 * (size_t)t[1],
-                        *n2 = b->vnormal + 3 * (size_t)t[2];
-            float u = rh.hit.u[i], v = rh.hit.v[i], w = 1 - u - v;
-            float sx = w * n0[0] + u * n1[0] + v * n2[0], sy = w * n0[1] + u * n1[1] + v * n2[1],
-                  sz = w * n0[2] + u * n1[2] + v * n2[2];
-            /* the ray in the body frame: R^T d */
-            float dx = R[0] * ray->dx[i] + R[3] * ray->dy[i] + R[6] * ray->dz[i],
-                  dy = R[1] * ray->dx[i] + R[4] * ray->dy[i] + R[7] * ray->dz[i],
-                  dz = R[2] * ray->dx[i] + R[5] * ray->dy[i] + R[8] * ray->dz[i];
-            float gd = x * dx + y * dy + z * dz, sd = sx * dx + sy * dy + sz * dz;
-            if ((gd < 0) == (sd < 0) && sx * x + sy * y + sz * z > 0)
-                x = sx, y = sy, z = sz;
-        }
-        /* Albedo variation: interpolated from the vertices on the ground,
-         * one factor per rock. */
-        float alb = 1.0f;
-        int32_t rock = -1;
-        if (inst == b->inst_id && b->src->albedo_vertex) {
-            const unsigned *t = b->tri[b->level] + 3 * (size_t)rh.hit.primID[i];
-            const float *a = b->src->albedo_vertex, u = rh.hit.u[i], v = rh.hit.v[i];
-            alb = (1 - u - v) * a[t[0]] + u * a[t[1]] + v * a[t[2]];
-        } else if (rt->inst_tile[inst]) {
-            size_t k = rt->inst_tile[inst]->index[rh.hit.primID[i]];
-            alb = nc_albedo_var_rock(&b->src->albedo_var, k);
-            rock = (int32_t)k;
-        }
-        hit->albedo[i] = alb;
-        hit->rock[i] = rock;
-        hit->body[i] = (int)rt->geom_to_body[inst];
-        hit->t[i] = rh.ray.tfar[i];
-        hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;
-        hit->ny[i] = R[3] * x + R[4] * y + R[5] * z;
-        hit->nz[i] = R[6] * x + R[7] * y + R[8] * z;
+        if (!ray->valid[i] || rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID || inst >= rt->ninst)
+            put_miss(hit, i);
+        else
+            put_hit(rt, inst, rh.hit.primID[i], rh.ray.tfar[i], rh.hit.u[i], rh.hit.v[i], rh.hit.Ng_x[i],
+                    rh.hit.Ng_y[i], rh.hit.Ng_z[i], ray, hit, i);
+    }
+}
+
+int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct nc_pool *pool, int threads)
+{
+    rt->bins_on = 0;
+    if (!cam)
+        return 0;
+    struct nc__bins_body bd[NC_MAX_BODIES];
+    for (int i = 0; i < rt->nbodies; i++) {
+        const struct rt_body *b = &rt->body[i];
+        if (b->analytic || (b->rocks.ntiles && b->rocks.traced))
+            return 0;
+        const struct nc_vec3 o = nc_v3_sub(b->origin_rel, cam->o);
+        bd[i] = (struct nc__bins_body){.v = b->src->mesh.v,
+                                       .tri = b->tri[b->level],
+                                       .ng = b->facet_n[b->level],
+                                       .nv = b->src->mesh.nv,
+                                       .nt = b->nt[b->level],
+                                       .R = b->R,
+                                       .origin = o,
+                                       .front_only = b->closed[b->level] && nc_v3_norm(o) > b->cull_radius_m};
+    }
+    const struct nc__bins_view v = {cam->d00, cam->ex, cam->ey, cam->width_px, cam->height_px};
+    int rc = nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, threads);
+    rt->bins_on = rc > 0;
+    return rc;
+}
+
+void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
+                           int n)
+{
+    for (int q0 = 0; q0 < n; q0 += NC_BINS_GROUP) {
+        const int m = n - q0 < NC_BINS_GROUP ? n - q0 : NC_BINS_GROUP;
+        int32_t slot[NC_BINS_GROUP][NC_PACKET];
+        float t[NC_BINS_GROUP][NC_PACKET];
+        nc__bins_intersect(&rt->bins, px0, py0, ray + q0, m, slot, t);
+        for (int q = 0; q < m; q++)
+            for (int i = 0; i < NC_PACKET; i++) {
+                struct nc_hit16 *h = &hit[q0 + q];
+                if (slot[q][i] < 0) {
+                    put_miss(h, i);
+                    continue;
+                }
+                const struct nc__bins_tri *ct = &rt->bins.cand[slot[q][i]];
+                uint32_t prim;
+                const struct rt_body *b = &rt->body[nc__bins_which(&rt->bins, slot[q][i], &prim)];
+                float u = 0, v = 0;
+                if (b->vnormal || b->src->albedo_vertex) {
+                    const float d[3] = {ray[q0 + q].dx[i], ray[q0 + q].dy[i], ray[q0 + q].dz[i]};
+                    nc__bins_uv(ct, d, &u, &v);
+                }
+                put_hit(rt, b->inst_id, prim, t[q][i], u, v, ct->ng[0], ct->ng[1], ct->ng[2], &ray[q0 + q], h, i);
+            }
     }
 }
 
@@ -863,9 +947,12 @@ void nc_rt_destroy(struct nc_rt *rt)
         rtcReleaseScene(rt->top);
     if (rt->dev)
         rtcReleaseDevice(rt->dev);
+    nc__bins_free(&rt->bins);
     for (int i = 0; i < rt->nbodies; i++) {
         free(rt->body[i].verts);
         free(rt->body[i].vnormal);
+        for (int k = 0; k < NC_LOD_MAX_LEVELS; k++)
+            free(rt->body[i].facet_n[k]);
         for (int g = 0; g < 2; g++)
             nc_shadow_grid_free(&rt->body[i].grids[g]);
     }
