@@ -277,5 +277,10 @@ int main(void)
     const struct nc_rt_pinhole p = pinhole_of(&s5.camera);
     CHECK(nc_rt_bin_camera(rt, &p, NULL, 1) == 0, "ellipsoid: the bins serve an analytic body");
     nc_rt_destroy(rt);
+    nc_scene_free(&s);
+    nc_scene_free(&s2);
+    nc_scene_free(&s3);
+    nc_scene_free(&s4);
+    nc_scene_free(&s5);
     return nc_test_end();
 }
