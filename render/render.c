@@ -648,7 +648,8 @@ __attribute__((target_clones("avx2", "default"))) static void camera_dirs(const 
  * opens fewer tree nodes and tests fewer triangles per packet. Embree gives
  * each ray its own closest hit whatever its packet-mates (an exact tie
  * between two triangles might resolve either way; test_determinism compares
- * the two packings bit for bit and has met none). */
+ * the two packings bit for bit and has met none). Where the bins of
+ * nc_rt_bin_camera serve the pass, the block's packets go to them as they are. */
 #define SLOT_GROUP 16
 static void trace_camera(const struct job *j, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
                          int ns)
@@ -1005,7 +1006,9 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
                   !memcmp(&j.row[y].d00, &j.row[ya].d00, sizeof j.row[ya].d00) &&
                   !memcmp(&j.row[y].ex, &j.row[ya].ex, sizeof j.row[ya].ex) &&
                   !memcmp(&j.row[y].ey, &j.row[ya].ey, sizeof j.row[ya].ey);
-    const struct nc_rt_pinhole pin = {j.row[ya].o, j.row[ya].d00, j.row[ya].ex, j.row[ya].ey, c->width_px, c->height_px};
+    const struct nc_rt_pinhole pin = {j.row[ya].o,    j.row[ya].d00, j.row[ya].ex,
+                                      j.row[ya].ey,   c->width_px,   c->height_px,
+                                      j.pass.N / j.pass.K};
     if ((rc = nc_rt_bin_camera(r->rt, pinhole ? &pin : NULL, r->pool, r->threads)) < 0) {
         free(j.row);
         return rc;

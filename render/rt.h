@@ -62,12 +62,15 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
  * integers) and every sample of pixel (px, py) lies within half a pixel of
  * it; cam NULL turns them off. Returns 1 when nc_rt_intersect_block serves
  * the pass (every body a mesh, no boulders traced, no triangle across the
- * plane through o parallel to the image), 0 when it does not, or a negative
+ * plane through o parallel to the image, and no more triangles than camera
+ * samples could reach the bodies: the lists cost about half of what Embree
+ * spends on a sample, per triangle), 0 when it does not, or a negative
  * error code. The lists are built on pool's threads (NULL: the caller's
  * alone), the same for any number. Call after nc_rt_update. */
 struct nc_rt_pinhole {
     struct nc_vec3 o, d00, ex, ey;
     int width_px, height_px;
+    int samples_per_pixel; /* this pass's */
 };
 struct nc_pool;
 int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct nc_pool *pool, int threads);

@@ -625,11 +625,19 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
     if (!cam)
         return 0;
     struct nc__bins_body bd[NC_MAX_BODIES];
+    /* Samples that can reach the bodies: each bounding sphere's image (a
+     * disk of its angular radius), at most the frame. */
+    const double frame = (double)cam->width_px * cam->height_px, px_per_rad = 1.0 / nc_v3_norm(cam->ex);
+    double samples = 0, triangles = 0;
     for (int i = 0; i < rt->nbodies; i++) {
         const struct rt_body *b = &rt->body[i];
         if (b->analytic || (b->rocks.ntiles && b->rocks.traced))
             return 0;
         const struct nc_vec3 o = nc_v3_sub(b->origin_rel, cam->o);
+        const double d = nc_v3_norm(o), R = b->src->bounding_radius_m;
+        const double r_px = d > R ? asin(R / d) * px_per_rad : INFINITY;
+        samples += fmin(frame, M_PI * r_px * r_px) * cam->samples_per_pixel;
+        triangles += (double)b->nt[b->level];
         bd[i] = (struct nc__bins_body){.v = b->src->mesh.v,
                                        .tri = b->tri[b->level],
                                        .ng = b->facet_n[b->level],
@@ -639,6 +647,8 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
                                        .origin = o,
                                        .front_only = b->closed[b->level] && nc_v3_norm(o) > b->cull_radius_m};
     }
+    if (triangles > samples)
+        return 0; /* Embree's tree is cheaper than listing them */
     const struct nc__bins_view v = {cam->d00, cam->ex, cam->ey, cam->width_px, cam->height_px};
     int rc = nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, threads);
     rt->bins_on = rc > 0;

@@ -25,7 +25,7 @@ static struct nc_rt_pinhole pinhole_of(const struct nc_camera *c)
     const struct nc_mat3 R = nc_quat_to_mat(c->attitude_q);
     return (struct nc_rt_pinhole){nc_v3(0, 0, 0), nc_mat_mul_v(&R, nc_camera_dir(c, 0, 0)),
                                   nc_mat_mul_v(&R, nc_v3(1.0 / c->fx_px, 0, 0)),
-                                  nc_mat_mul_v(&R, nc_v3(0, 1.0 / c->fy_px, 0)), c->width_px, c->height_px};
+                                  nc_mat_mul_v(&R, nc_v3(0, 1.0 / c->fy_px, 0)), c->width_px, c->height_px, 4};
 }
 
 /* Packet q of block (px0, py0): lane i is pixel (i & 3, i >> 2) of it, at a
@@ -142,7 +142,7 @@ static void check_grid(void)
     struct nc__bins_body body = {.v = v, .tri = tri, .ng = ng, .nv = (n + 1) * (n + 1), .nt = 2 * n * n,
                                  .R = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}, .origin = nc_v3(0, 0, 0), .front_only = 0};
     struct nc__bins_view view = {nc_v3(-W / 2.0 / f, -W / 2.0 / f, 1), nc_v3(1 / f, 0, 0), nc_v3(0, 1 / f, 0), W, W};
-    const struct nc_rt_pinhole p = {nc_v3(0, 0, 0), view.d00, view.ex, view.ey, W, W};
+    const struct nc_rt_pinhole p = {nc_v3(0, 0, 0), view.d00, view.ex, view.ey, W, W, 1};
     struct nc__bins b;
     memset(&b, 0, sizeof b);
     CHECK(nc__bins_build(&b, &view, &body, 1, NULL, 3) == 1, "grid: bins built");
@@ -277,6 +277,17 @@ int main(void)
     const struct nc_rt_pinhole p = pinhole_of(&s5.camera);
     CHECK(nc_rt_bin_camera(rt, &p, NULL, 1) == 0, "ellipsoid: the bins serve an analytic body");
     nc_rt_destroy(rt);
+    /* 81 920 triangles in a body 11 pixels across: listing them costs more
+     * than Embree's tree would on its few hundred samples. */
+    const char *far[] = {"camera.width_px=64", "camera.height_px=64", "camera.pixel_pitch_m=2.2e-5",
+                         "bodies.0.shape.subdivisions=6", "camera.position_m=[0,-60000,0]"};
+    struct nc_scene s6;
+    nc_test_scene(nc_default_scene_yaml, far, 5, &s6);
+    CHECK(nc_rt_create(&s6, 1, &rt) == 0, "far: nc_rt_create");
+    const struct nc_rt_pinhole pf = pinhole_of(&s6.camera);
+    CHECK(nc_rt_bin_camera(rt, &pf, NULL, 1) == 0, "far: the bins list 81 920 triangles for a body 11 pixels wide");
+    nc_rt_destroy(rt);
+    nc_scene_free(&s6);
     nc_scene_free(&s);
     nc_scene_free(&s2);
     nc_scene_free(&s3);
