@@ -1008,7 +1008,7 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
                   !memcmp(&j.row[y].ey, &j.row[ya].ey, sizeof j.row[ya].ey);
     const struct nc_rt_pinhole pin = {j.row[ya].o,    j.row[ya].d00, j.row[ya].ex,
                                       j.row[ya].ey,   c->width_px,   c->height_px,
-                                      j.pass.N / j.pass.K};
+                                      j.pass.N};
     if ((rc = nc_rt_bin_camera(r->rt, pinhole ? &pin : NULL, r->pool, r->threads)) < 0) {
         free(j.row);
         return rc;

@@ -70,7 +70,7 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
 struct nc_rt_pinhole {
     struct nc_vec3 o, d00, ex, ey;
     int width_px, height_px;
-    int samples_per_pixel; /* this pass's */
+    int samples_per_pixel; /* the frame's, over all its passes: the choice is the same for each */
 };
 struct nc_pool;
 int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct nc_pool *pool, int threads);
