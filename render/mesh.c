@@ -10,27 +10,13 @@
 #include <strings.h>
 
 #include "core/error.h"
+#include "core/grow.h"
 
 void nc_mesh_free(struct nc_mesh *m)
 {
     free(m->v);
     free(m->tri);
     memset(m, 0, sizeof *m);
-}
-
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 0;
-    size_t c = *cap ? *cap : 1024;
-    while (c < need)
-        c *= 2;
-    void *q = realloc(*p, c * elem);
-    if (!q)
-        return -ENOMEM;
-    *p = q;
-    *cap = c;
-    return 0;
 }
 
 static int check_mesh(const char *path, const struct nc_mesh *m)
@@ -113,7 +99,7 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
         while (isspace((unsigned char)*s))
             s++;
         if (s[0] == 'v' && isspace((unsigned char)s[1])) {
-            if (grow((void **)&m.v, &vcap, 3 * (m.nv + 1), sizeof *m.v) < 0)
+            if (nc_grow((void **)&m.v, &vcap, 3 * (m.nv + 1), sizeof *m.v) < 0)
                 goto nomem;
             char *end = (char *)s + 1;
             for (int k = 0; k < 3; k++) {
@@ -153,8 +139,8 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
                               path, lineno, n);
                 goto out;
             }
-            if (grow((void **)&m.tri, &tcap, 3 * (m.nt + 1), sizeof *m.tri) < 0 ||
-                grow((void **)&face_line, &flcap, m.nt + 1, sizeof *face_line) < 0)
+            if (nc_grow((void **)&m.tri, &tcap, 3 * (m.nt + 1), sizeof *m.tri) < 0 ||
+                nc_grow((void **)&face_line, &flcap, m.nt + 1, sizeof *face_line) < 0)
                 goto nomem;
             for (int k = 0; k < 3; k++) {
                 if (idx[k] < 1 || idx[k] > (long)UINT32_MAX) {

@@ -23,21 +23,13 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/grow.h"
 #include "core/pool.h"
 
+/* nc_grow, reported. */
 static int grow(void **p, size_t *cap, size_t n, size_t size)
 {
-    if (n <= *cap)
-        return 0;
-    size_t c = *cap ? *cap : 4096;
-    while (c < n)
-        c *= 2;
-    void *q = realloc(*p, c * size);
-    if (!q)
-        return nc_error(-ENOMEM, "out of memory for %zu camera-ray bin entries", c);
-    *p = q;
-    *cap = c;
-    return 0;
+    return nc_grow(p, cap, n, size) < 0 ? nc_error(-ENOMEM, "out of memory for %zu camera-ray bin entries", n) : 0;
 }
 
 static void cross(const double *a, const double *b, double *c)
@@ -234,14 +226,10 @@ int nc__bins_build(struct nc__bins *b, const struct nc__bins_view *view, const s
     if (T > UINT32_MAX)
         return 0;
     int rc = 0;
-    if (T > b->tri_cap) {
-        size_t cap = b->tri_cap, cap2 = b->tri_cap, cap3 = b->tri_cap;
-        if ((rc = grow((void **)&b->cand, &cap, T, sizeof *b->cand)) < 0 ||
-            (rc = grow((void **)&b->tri, &cap2, T, sizeof *b->tri)) < 0 ||
-            (rc = grow((void **)&b->range, &cap3, T, sizeof *b->range)) < 0)
-            return rc;
-        b->tri_cap = cap < cap2 ? (cap < cap3 ? cap : cap3) : (cap2 < cap3 ? cap2 : cap3);
-    }
+    if ((rc = grow((void **)&b->cand, &b->cand_cap, T, sizeof *b->cand)) < 0 ||
+        (rc = grow((void **)&b->tri, &b->tri_cap, T, sizeof *b->tri)) < 0 ||
+        (rc = grow((void **)&b->range, &b->range_cap, T, sizeof *b->range)) < 0)
+        return rc;
     if ((rc = grow((void **)&b->vp, &b->vp_cap, b->v_off[nbodies], sizeof *b->vp)) < 0 ||
         (rc = grow((void **)&b->kept, &b->kept_cap, (size_t)b->nparts, sizeof *b->kept)) < 0 ||
         (rc = grow((void **)&b->count, &b->count_cap, (size_t)b->nparts * b->nblocks, sizeof *b->count)) < 0 ||

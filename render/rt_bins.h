@@ -73,7 +73,7 @@ struct nc__bins {
     uint32_t *start;           /* block k's candidate slots: list[start[k] .. start[k + 1]) */
     uint32_t *list;
     float (*vp)[6]; /* per vertex: position from the rays' origin (3), image x, y, depth sign */
-    size_t tri_cap, count_cap, start_cap, list_cap, vp_cap, kept_cap;
+    size_t cand_cap, tri_cap, range_cap, count_cap, start_cap, list_cap, vp_cap, kept_cap;
     int phase;
     _Atomic int next, straddle;
 };

@@ -79,7 +79,6 @@ struct nc_rt {
     struct nc_rt_stats stats;
     atomic_ulong shadow_culled, shadow_traced;
     struct nc__bins bins; /* camera rays of this pass through bins (nc_rt_bin_camera) */
-    int bins_on;
 };
 
 static int rt_check(RTCDevice dev, const char *what)
@@ -621,7 +620,6 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
 
 int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct nc_pool *pool, int threads)
 {
-    rt->bins_on = 0;
     if (!cam)
         return 0;
     struct nc__bins_body bd[NC_MAX_BODIES];
@@ -650,9 +648,7 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
     if (triangles > samples)
         return 0; /* Embree's tree is cheaper than listing them */
     const struct nc__bins_view v = {cam->d00, cam->ex, cam->ey, cam->width_px, cam->height_px};
-    int rc = nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, threads);
-    rt->bins_on = rc > 0;
-    return rc;
+    return nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, threads);
 }
 
 void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
