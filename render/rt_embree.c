@@ -328,8 +328,12 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
     struct nc_rt *rt = calloc(1, sizeof *rt);
     if (!rt)
         return nc_error(-ENOMEM, "out of memory");
-    char cfg[64];
-    snprintf(cfg, sizeof cfg, "threads=%d,set_affinity=0", threads > 0 ? threads : 0);
+    /* NAVCAM_EMBREE: more device options, e.g. isa=avx2 to run Embree's
+     * 8-wide kernels on a CPU that has 16-wide ones (tests/CMakeLists.txt) */
+    char cfg[256];
+    const char *extra = getenv("NAVCAM_EMBREE");
+    snprintf(cfg, sizeof cfg, "threads=%d,set_affinity=0%s%.160s", threads > 0 ? threads : 0,
+             extra && *extra ? "," : "", extra ? extra : "");
     rt->dev = rtcNewDevice(cfg);
     if (!rt->dev) {
         free(rt);
@@ -539,6 +543,17 @@ static void load_ray(struct RTCRay16 *r, const struct nc_ray16 *in)
         r->mask[i] = 0xffffffffu;
         r->id[i] = (unsigned)i;
         r->flags[i] = 0;
+        if (in->valid[i] != -1) {
+            /* Where the CPU has no 16-wide kernels (no AVX-512), Embree
+             * traces a 16-ray packet as a ray stream that ignores the valid
+             * mask and skips only rays with tnear > tfar: an inactive lane
+             * (left over from a miss, or culled) must be a finite empty ray. */
+            r->org_x[i] = r->org_y[i] = r->org_z[i] = 0.0f;
+            r->dir_x[i] = r->dir_y[i] = 0.0f;
+            r->dir_z[i] = 1.0f;
+            r->tnear[i] = 1.0f;
+            r->tfar[i] = 0.0f;
+        }
     }
 }
 
