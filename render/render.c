@@ -122,7 +122,9 @@ static inline uint64_t mix64(uint64_t z)
 static inline double hash01(uint64_t seed, uint64_t a, uint64_t b)
 {
     uint64_t z = mix64(seed * 0x9e3779b97f4a7c15ull + mix64(a * 0xd6e8feb86659fd93ull + b + 1));
-    return (double)(z >> 11) * 0x1.0p-53;
+    /* (z >> 11) 2^-53 exactly, from two parts a signed 32-bit conversion
+     * takes (AVX2 has no 64-bit one): the same bits, vectorised */
+    return (double)(int32_t)(z >> 33) * 0x1.0p-31 + (double)(int32_t)((z >> 11) & 0x3fffff) * 0x1.0p-53;
 }
 
 static uint64_t gcd64(uint64_t u, uint64_t v)
@@ -593,10 +595,10 @@ struct image_points {
 
 /* The jitter of each lane's sample g[i] within its stratum (jx, jy hold
  * the stratum's corner): two hashes of (seed, pixel, sample) added, for all
- * lanes at once (64-bit multiplies: AVX-512 where the CPU has it). Integer
- * arithmetic, an exact conversion and an exact scaling by 2^-53, so one
+ * lanes at once (64-bit multiplies: AVX-512 or AVX2 where the CPU has it).
+ * Integer arithmetic and an exact conversion to [0, 1) (hash01), so one
  * rounding (the sum's) on any path, contracted or not: the same bits. */
-__attribute__((target_clones("arch=x86-64-v4", "default"))) static void jitter16(uint64_t seed, const uint64_t *pid,
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void jitter16(uint64_t seed, const uint64_t *pid,
                                                                             const int *g, struct image_points *ip)
 {
     for (int i = 0; i < NC_PACKET; i++) {

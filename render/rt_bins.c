@@ -60,6 +60,79 @@ static void block_span(double x0, double x1, double pad, int n, int *lo, int *hi
 
 static size_t part_begin(size_t n, int p, int nparts) { return n * (size_t)p / (size_t)nparts; }
 
+void nc__bins_clusters(const double *v, const unsigned *tri, size_t nt, struct nc__bins_cluster *out)
+{
+    for (size_t t0 = 0; t0 < nt; t0 += NC_BINS_CLUSTER) {
+        const int m = nt - t0 < NC_BINS_CLUSTER ? (int)(nt - t0) : NC_BINS_CLUSTER;
+        struct nc__bins_cluster *o = &out[t0 / NC_BINS_CLUSTER];
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, a[3] = {0, 0, 0};
+        double un[NC_BINS_CLUSTER][3], alt = INFINITY, r2 = 0, cmin = 1; /* unit normals; smallest altitude */
+        for (int t = 0; t < m; t++) {
+            const double *p[3];
+            double e[3][3], len2[3];
+            for (int k = 0; k < 3; k++)
+                p[k] = &v[3 * (size_t)tri[3 * (t0 + t) + k]];
+            for (int k = 0; k < 3; k++) {
+                for (int q = 0; q < 3; q++) {
+                    e[k][q] = p[(k + 1) % 3][q] - p[k][q];
+                    lo[q] = fmin(lo[q], p[k][q]), hi[q] = fmax(hi[q], p[k][q]);
+                }
+                len2[k] = e[k][0] * e[k][0] + e[k][1] * e[k][1] + e[k][2] * e[k][2];
+            }
+            double n[3];
+            cross(e[0], e[1], n);
+            const double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            alt = fmin(alt, len > 0 ? len / sqrt(max3(len2[0], len2[1], len2[2])) : 0.0);
+            for (int q = 0; q < 3; q++)
+                a[q] += un[t][q] = len > 0 ? n[q] / len : 0.0;
+        }
+        for (int q = 0; q < 3; q++)
+            o->c[q] = 0.5 * (lo[q] + hi[q]);
+        const double al = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        for (int t = 0; t < m; t++) {
+            for (int k = 0; k < 3; k++) {
+                const double *p = &v[3 * (size_t)tri[3 * (t0 + t) + k]];
+                const double dx = p[0] - o->c[0], dy = p[1] - o->c[1], dz = p[2] - o->c[2];
+                r2 = fmax(r2, dx * dx + dy * dy + dz * dz);
+            }
+            cmin = fmin(cmin, al > 0 ? (un[t][0] * a[0] + un[t][1] * a[1] + un[t][2] * a[2]) / al : -1.0);
+        }
+        o->r = sqrt(r2) * (1 + 1e-12);
+        /* The cone: the mean direction opened to the widest normal; none if
+         * a triangle is degenerate (cluster_live divides by its altitude). */
+        const double th = acos(fmax(-1.0, fmin(1.0, cmin))) + 1e-9;
+        for (int q = 0; q < 3; q++)
+            o->a[q] = al > 0 ? a[q] / al : 0.0;
+        o->cos_t = alt > 0 ? cos(th) : -1.0;
+        o->sin_t = sin(th);
+        o->alt = alt;
+    }
+}
+
+/* Whether cluster cl of body bd can hold a triangle the build lists: its
+ * sphere reaches into the image's planes, and, where only front faces count,
+ * some triangle of it may face the origin. A triangle faces away when the
+ * origin is on the back of its plane; with the float vertices (rounded by
+ * up to 2^-24 relative, at distance L) the build's sign test moves that
+ * plane by at most 3 x 2^-24 L^2 / altitude (the triple product
+ * det(v0, v1, v2) = 2 area x distance, each vertex's error times the cross
+ * product of the other two, at most L x the longest edge): the cone must
+ * put the whole sphere further than twice that behind the planes. */
+static int cluster_live(const struct nc__bins *b, const struct nc__bins_body *bd, const struct nc__bins_cluster *cl)
+{
+    const struct nc_vec3 c = nc_v3_add(nc_mat_mul_v(&bd->R, nc_v3(cl->c[0], cl->c[1], cl->c[2])), bd->origin);
+    const double L = nc_v3_norm(c);
+    for (int k = 0; k < 4; k++)
+        if (b->side[k][0] * c.x + b->side[k][1] * c.y + b->side[k][2] * c.z < -(cl->r + 1e-6 * (L + cl->r)))
+            return 0;
+    if (!bd->front_only || !(cl->cos_t > 0) || !(L > cl->r))
+        return 1;
+    const struct nc_vec3 a = nc_mat_mul_v(&bd->R, nc_v3(cl->a[0], cl->a[1], cl->a[2]));
+    const double cphi = nc_v3_dot(a, c) / L, sphi = sqrt(fmax(0.0, 1.0 - cphi * cphi));
+    const double h = L * (cphi * cl->cos_t - sphi * cl->sin_t) - cl->r; /* the planes' least distance in front of the origin */
+    return !(h > 6.0 * 0x1p-24 * (L + cl->r) * (L + cl->r) / cl->alt + 1e-3);
+}
+
 /* The body holding global index i of a table of offsets. */
 static int body_of(const size_t *off, int nbodies, size_t i)
 {
@@ -69,9 +142,15 @@ static int body_of(const size_t *off, int nbodies, size_t i)
     return k;
 }
 
-/* Part p's vertices: positions from the rays' origin and image points. */
+/* Part p's vertices: positions from the rays' origin and image points;
+ * and its share of the clusters. */
 static void vertices(struct nc__bins *b, int p)
 {
+    const size_t cend = part_begin(b->c_off[b->nbodies], p + 1, b->nparts);
+    for (size_t g = part_begin(b->c_off[b->nbodies], p, b->nparts); g < cend; g++) {
+        const int k = body_of(b->c_off, b->nbodies, g);
+        b->cl_live[g] = !b->body[k].cl || cluster_live(b, &b->body[k], &b->body[k].cl[g - b->c_off[k]]);
+    }
     const size_t end = part_begin(b->v_off[b->nbodies], p + 1, b->nparts);
     for (size_t g = part_begin(b->v_off[b->nbodies], p, b->nparts); g < end; g++) {
         const int k = body_of(b->v_off, b->nbodies, g);
@@ -102,7 +181,13 @@ static void triangles(struct nc__bins *b, int p)
     for (size_t g = slot; g < end; g++) {
         const int k = body_of(b->t_off, b->nbodies, g);
         const struct nc__bins_body *bd = &b->body[k];
-        const unsigned *f = &bd->tri[3 * (g - b->t_off[k])];
+        const size_t t = g - b->t_off[k];
+        if (!b->cl_live[b->c_off[k] + t / NC_BINS_CLUSTER]) { /* to the cluster's last triangle */
+            const size_t last = b->t_off[k] + (t / NC_BINS_CLUSTER + 1) * NC_BINS_CLUSTER - 1;
+            g = last < b->t_off[k + 1] - 1 ? last : b->t_off[k + 1] - 1;
+            continue;
+        }
+        const unsigned *f = &bd->tri[3 * t];
         const float *A = b->vp[b->v_off[k] + f[0]], *B = b->vp[b->v_off[k] + f[1]], *C = b->vp[b->v_off[k] + f[2]];
         const double a[3] = {A[0], A[1], A[2]}, bb[3] = {B[0], B[1], B[2]}, c[3] = {C[0], C[1], C[2]};
         const double ab[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, ac[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
@@ -137,7 +222,7 @@ static void triangles(struct nc__bins *b, int p)
             ct->n[r] = (float)(n[r] / len);
         }
         ct->nv0 = (float)(nv0 / len);
-        memcpy(ct->ng, &bd->ng[3 * (g - b->t_off[k])], sizeof ct->ng);
+        memcpy(ct->ng, &bd->ng[3 * t], sizeof ct->ng);
         b->tri[slot] = (uint32_t)g;
         int16_t *rg = b->range[slot++];
         rg[0] = (int16_t)x0, rg[1] = (int16_t)x1, rg[2] = (int16_t)y0, rg[3] = (int16_t)y1;
@@ -216,11 +301,26 @@ int nc__bins_build(struct nc__bins *b, const struct nc__bins_view *view, const s
      * 0.01 pixel for the float image points. */
     const double px_per_rad = fmax(1.0 / nc_v3_norm(view->ex), 1.0 / nc_v3_norm(view->ey));
     b->pad_px = 0.01 + 1e-6 * px_per_rad;
-    b->v_off[0] = b->t_off[0] = 0;
+    /* The planes bounding every block's samples (one more pixel each way),
+     * normals inwards: no camera ray meets a point behind one. */
+    const double xa = -1.5 - b->pad_px, xb = NC_BINS_BLOCK * bw + 0.5 + b->pad_px, ya = xa,
+                 yb = NC_BINS_BLOCK * bh + 0.5 + b->pad_px, corner[5][2] = {{xa, ya}, {xb, ya}, {xb, yb}, {xa, yb}, {xa, ya}};
+    struct nc_vec3 ray[5], mid = nc_v3(0, 0, 0); /* the corners' rays; inside every plane */
+    for (int k = 0; k < 5; k++)
+        ray[k] = nc_v3_add(view->d00, nc_v3_add(nc_v3_scale(view->ex, corner[k][0]), nc_v3_scale(view->ey, corner[k][1])));
+    for (int k = 0; k < 4; k++)
+        mid = nc_v3_add(mid, ray[k]);
+    for (int k = 0; k < 4; k++) {
+        struct nc_vec3 n = nc_v3_unit(nc_v3_cross(ray[k], ray[k + 1]));
+        n = nc_v3_scale(n, nc_v3_dot(n, mid) < 0 ? -1.0 : 1.0);
+        b->side[k][0] = n.x, b->side[k][1] = n.y, b->side[k][2] = n.z;
+    }
+    b->v_off[0] = b->t_off[0] = b->c_off[0] = 0;
     for (int k = 0; k < nbodies; k++) {
         b->body[k] = bodies[k];
         b->v_off[k + 1] = b->v_off[k] + bodies[k].nv;
         b->t_off[k + 1] = b->t_off[k] + bodies[k].nt;
+        b->c_off[k + 1] = b->c_off[k] + (bodies[k].nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
     }
     const size_t T = b->t_off[nbodies];
     if (T > UINT32_MAX)
@@ -233,7 +333,8 @@ int nc__bins_build(struct nc__bins *b, const struct nc__bins_view *view, const s
     if ((rc = grow((void **)&b->vp, &b->vp_cap, b->v_off[nbodies], sizeof *b->vp)) < 0 ||
         (rc = grow((void **)&b->kept, &b->kept_cap, (size_t)b->nparts, sizeof *b->kept)) < 0 ||
         (rc = grow((void **)&b->count, &b->count_cap, (size_t)b->nparts * b->nblocks, sizeof *b->count)) < 0 ||
-        (rc = grow((void **)&b->start, &b->start_cap, b->nblocks + 1, sizeof *b->start)) < 0)
+        (rc = grow((void **)&b->start, &b->start_cap, b->nblocks + 1, sizeof *b->start)) < 0 ||
+        (rc = grow((void **)&b->cl_live, &b->cl_live_cap, b->c_off[nbodies], sizeof *b->cl_live)) < 0)
         return rc;
     atomic_store(&b->straddle, 0);
     run(b, pool, PHASE_VERTICES);
@@ -414,5 +515,6 @@ void nc__bins_free(struct nc__bins *b)
     free(b->start);
     free(b->list);
     free(b->vp);
+    free(b->cl_live);
     memset(b, 0, sizeof *b);
 }

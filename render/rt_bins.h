@@ -19,11 +19,30 @@
 
 #define NC_BINS_BLOCK 4 /* pixels a block side (render.c's 4x4 blocks) */
 
+/* Bounds of a run of NC_BINS_CLUSTER consecutive triangles (the last run
+ * may be shorter), body frame: a sphere holding them and a cone holding
+ * their facet normals, widened by a margin for the float vertices. A run
+ * wholly outside the image, or whose triangles all face away from the rays'
+ * origin, is skipped whole; no triangle listed otherwise is lost. Meshes
+ * whose triangle order follows the surface (a subdivided solid's does)
+ * give tight runs; others only cost the test. */
+#define NC_BINS_CLUSTER 64
+struct nc__bins_cluster {
+    double c[3], r;            /* sphere: centre, radius (m) */
+    double a[3], cos_t, sin_t; /* cone: unit axis, half-angle (cos_t <= 0: no cone) */
+    double alt;                /* the smallest altitude of its triangles, m */
+};
+
+/* The clusters of triangles tri[0 .. nt) of vertices v, into
+ * out[(nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER]. */
+void nc__bins_clusters(const double *v, const unsigned *tri, size_t nt, struct nc__bins_cluster *out);
+
 /* A triangle mesh as shown this pass. */
 struct nc__bins_body {
     const double *v;       /* body-frame vertices, m (x, y, z each) */
     const unsigned *tri;   /* the triangles shown: 3 vertex indices each */
     const float *ng;       /* and their normals in the body frame, 3 each (copied to the hits) */
+    const struct nc__bins_cluster *cl; /* their clusters (nc__bins_clusters; NULL: none skipped) */
     size_t nv, nt;
     struct nc_mat3 R;      /* body -> scene */
     struct nc_vec3 origin; /* body origin relative to the rays' origin, scene frame, m */
@@ -59,8 +78,10 @@ struct nc__bins {
     /* The build's input. */
     struct nc__bins_body body[NC_MAX_BODIES];
     int nbodies;
-    size_t v_off[NC_MAX_BODIES + 1], t_off[NC_MAX_BODIES + 1]; /* bodies' first vertex, triangle */
+    size_t v_off[NC_MAX_BODIES + 1], t_off[NC_MAX_BODIES + 1], c_off[NC_MAX_BODIES + 1]; /* bodies' first vertex, triangle, cluster */
     double Mi[3][3]; /* scene direction -> (x s, y s, s) of image point (x, y) */
+    double side[4][3]; /* unit normals of the planes through the origin bounding the blocks' samples, inwards */
+    uint8_t *cl_live;  /* per cluster: may hold a listed triangle */
     double pad_px;
     /* Part p of the build takes the triangles [t_off end * p / nparts, ...
      * (p + 1) / nparts) and lists those it keeps from slot (its first
@@ -73,7 +94,7 @@ struct nc__bins {
     uint32_t *start;           /* block k's candidate slots: list[start[k] .. start[k + 1]) */
     uint32_t *list;
     float (*vp)[6]; /* per vertex: position from the rays' origin (3), image x, y, depth sign */
-    size_t cand_cap, tri_cap, range_cap, count_cap, start_cap, list_cap, vp_cap, kept_cap;
+    size_t cand_cap, tri_cap, range_cap, count_cap, start_cap, list_cap, vp_cap, kept_cap, cl_live_cap;
     int phase;
     _Atomic int next, straddle;
 };

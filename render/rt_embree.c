@@ -37,6 +37,7 @@ struct rt_body {
     float *vnormal; /* smooth shading: unit normals at the vertices, body frame (NULL: flat) */
     const unsigned *tri[NC_LOD_MAX_LEVELS]; /* each level's triangles (Embree's index buffer) */
     float *facet_n[NC_LOD_MAX_LEVELS];      /* each level's facet normals, body frame (nc_rt_bin_camera) */
+    struct nc__bins_cluster *cluster[NC_LOD_MAX_LEVELS]; /* and its triangles' clusters */
     unsigned inst_id;
     RTCGeometry inst;
     /* boulders (rt_rocks.h): tiles of their own, each instanced in the
@@ -230,6 +231,10 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
         b->facet_n[k][3 * t + 1] = (float)n.y;
         b->facet_n[k][3 * t + 2] = (float)n.z;
     }
+    const size_t ncl = (lv->nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
+    if (!(b->cluster[k] = malloc((ncl ? ncl : 1) * sizeof *b->cluster[k])))
+        return nc_error(-ENOMEM, "out of memory for %zu triangle clusters", ncl);
+    nc__bins_clusters(m->v, lv->tri, lv->nt, b->cluster[k]);
     return rt_check(rt->dev, "creating geometry");
 }
 
@@ -654,6 +659,7 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
         bd[i] = (struct nc__bins_body){.v = b->src->mesh.v,
                                        .tri = b->tri[b->level],
                                        .ng = b->facet_n[b->level],
+                                       .cl = b->cluster[b->level],
                                        .nv = b->src->mesh.nv,
                                        .nt = b->nt[b->level],
                                        .R = b->R,
@@ -972,8 +978,10 @@ void nc_rt_destroy(struct nc_rt *rt)
     for (int i = 0; i < rt->nbodies; i++) {
         free(rt->body[i].verts);
         free(rt->body[i].vnormal);
-        for (int k = 0; k < NC_LOD_MAX_LEVELS; k++)
+        for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
             free(rt->body[i].facet_n[k]);
+            free(rt->body[i].cluster[k]);
+        }
         for (int g = 0; g < 2; g++)
             nc_shadow_grid_free(&rt->body[i].grids[g]);
     }

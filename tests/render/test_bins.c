@@ -2,7 +2,8 @@
  * against Embree: the same first hits, ranges and normals ray by ray on
  * procedural asteroids (flat, smooth with albedo variation, two bodies), a
  * grid whose lines run through the pixel centres (no ray slips between
- * triangles), the AVX-512 and plain tests bit for bit, the cases the bins
+ * triangles), the AVX-512 and plain tests bit for bit, clusters of
+ * triangles skipped whole without changing the lists, the cases the bins
  * refuse, and whole frames. */
 #include <math.h>
 #include <stdlib.h>
@@ -194,6 +195,46 @@ static void check_grid(void)
     free(ng);
 }
 
+/* Clusters skipped whole (outside the image, or facing away) lose no
+ * listed triangle: the lists with and without them are the same entry for
+ * entry, from views where they skip most of the mesh (min_skip: the share
+ * of clusters at least skipped). */
+static void check_clusters(const struct nc_scene *s, double min_skip, const char *what)
+{
+    const struct nc_mesh *m = &s->body[0].mesh;
+    const struct nc_rt_pinhole p = pinhole_of(&s->camera);
+    const struct nc__bins_view view = {p.d00, p.ex, p.ey, p.width_px, p.height_px};
+    const size_t ncl = (m->nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
+    struct nc__bins_cluster *cl = malloc(ncl * sizeof *cl);
+    float *ng = calloc(3 * m->nt, sizeof *ng);
+    nc__bins_clusters(m->v, m->tri, m->nt, cl);
+    struct nc__bins_body body = {.v = m->v, .tri = m->tri, .ng = ng, .nv = m->nv, .nt = m->nt,
+                                 .R = nc_quat_to_mat(s->body[0].attitude_q),
+                                 .origin = nc_v3_sub(s->body[0].position_m, s->camera.position_m), .front_only = 1};
+    struct nc__bins all, some;
+    memset(&all, 0, sizeof all);
+    memset(&some, 0, sizeof some);
+    CHECK(nc__bins_build(&all, &view, &body, 1, NULL, 2) == 1, "%s: bins without clusters", what);
+    body.cl = cl;
+    CHECK(nc__bins_build(&some, &view, &body, 1, NULL, 3) == 1, "%s: bins with clusters", what);
+    size_t live = 0, differ = 0;
+    for (size_t k = 0; k < ncl; k++)
+        live += some.cl_live[k];
+    const size_t n = all.start[all.nblocks];
+    differ += memcmp(all.start, some.start, (all.nblocks + 1) * sizeof *all.start) != 0;
+    for (size_t i = 0; i < n && !differ; i++)
+        differ += all.tri[all.list[i]] != some.tri[some.list[i]] ||
+                  memcmp(&all.cand[all.list[i]], &some.cand[some.list[i]], sizeof *all.cand) != 0;
+    printf("%s: %zu of %zu clusters skipped, %zu list entries, %s\n", what, ncl - live, ncl, n,
+           differ ? "lists differ" : "the same lists");
+    CHECK(!differ, "%s: the clusters change the lists", what);
+    CHECK(ncl - live >= min_skip * ncl, "%s: only %zu of %zu clusters skipped", what, ncl - live, ncl);
+    nc__bins_free(&all);
+    nc__bins_free(&some);
+    free(cl);
+    free(ng);
+}
+
 /* Whole frames: bins and Embree give the same image to float precision. */
 static void check_frames(const struct nc_scene *s)
 {
@@ -235,6 +276,7 @@ int main(void)
     nc_test_scene(nc_default_scene_yaml, crop, 3, &s);
     compare_rays(&s, 0, "default scene, 256x256 crop");
     compare_rays(&s, 1, "default scene, pixel centres");
+    check_clusters(&s, 0.35, "clusters, the body in the frame (back faces)");
     check_frames(&s);
     /* Smooth normals and albedo variation (the barycentric points) at 128x128, the whole body. */
     const char *smooth[] = {"camera.width_px=128", "camera.height_px=128", "camera.pixel_pitch_m=2.2e-5",
@@ -249,6 +291,14 @@ int main(void)
     struct nc_scene s3;
     nc_test_scene(nc_default_scene_yaml, near, 4, &s3);
     compare_rays(&s3, 0, "camera near the surface");
+    /* 1 km from the centre, turned and rolled: most of the body out of the frame. */
+    const char *close[] = {"camera.width_px=200", "camera.height_px=150", "bodies.0.shape.subdivisions=6",
+                           "camera.position_m=[200,-1000,300]", "camera.look_at_m=[50,0,120]",
+                           "camera.up=[0.3,0,1]", "bodies.0.attitude_q=[0.9,0.1,0.3,0.3]"};
+    struct nc_scene s7;
+    nc_test_scene(nc_default_scene_yaml, close, 7, &s7);
+    check_clusters(&s7, 0.8, "clusters, the body beyond the frame");
+    nc_scene_free(&s7);
     /* Two meshes, the small one in front of the large one. */
     static const char two[] =
         "bodies:\n"
