@@ -21,9 +21,9 @@
 
 /* Bounds of a run of NC_BINS_CLUSTER consecutive triangles (the last run
  * may be shorter), body frame: a sphere holding them and a cone holding
- * their facet normals, widened by a margin for the float vertices. A run
- * wholly outside the image, or whose triangles all face away from the rays'
- * origin, is skipped whole; no triangle listed otherwise is lost. Meshes
+ * their facet normals. A run wholly outside the image, or whose triangles
+ * all face away from the rays' origin by more than the float vertices can
+ * move them, is skipped whole; no triangle listed otherwise is lost. Meshes
  * whose triangle order follows the surface (a subdivided solid's does)
  * give tight runs; others only cost the test. */
 #define NC_BINS_CLUSTER 64
