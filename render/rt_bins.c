@@ -39,6 +39,7 @@ static void cross(const double *a, const double *b, double *c)
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+static inline double len2(const double *a) { return a[0] * a[0] + a[1] * a[1] + a[2] * a[2]; }
 static inline double min3(double a, double b, double c) { return a < b ? (a < c ? a : c) : (b < c ? b : c); }
 static inline double max3(double a, double b, double c) { return a > b ? (a > c ? a : c) : (b > c ? b : c); }
 
@@ -60,7 +61,7 @@ static void block_span(double x0, double x1, double pad, int n, int *lo, int *hi
 
 static size_t part_begin(size_t n, int p, int nparts) { return n * (size_t)p / (size_t)nparts; }
 
-void nc__bins_clusters(const double *v, const unsigned *tri, size_t nt, struct nc__bins_cluster *out)
+void nc__bins_facets(const double *v, const unsigned *tri, size_t nt, float *ng, struct nc__bins_cluster *out)
 {
     for (size_t t0 = 0; t0 < nt; t0 += NC_BINS_CLUSTER) {
         const int m = nt - t0 < NC_BINS_CLUSTER ? (int)(nt - t0) : NC_BINS_CLUSTER;
@@ -69,26 +70,24 @@ void nc__bins_clusters(const double *v, const unsigned *tri, size_t nt, struct n
         double un[NC_BINS_CLUSTER][3], alt = INFINITY, r2 = 0, cmin = 1; /* unit normals; smallest altitude */
         for (int t = 0; t < m; t++) {
             const double *p[3];
-            double e[3][3], len2[3];
+            double e[3][3], n[3]; /* v1 - v0, v2 - v0, v2 - v1 */
             for (int k = 0; k < 3; k++)
                 p[k] = &v[3 * (size_t)tri[3 * (t0 + t) + k]];
-            for (int k = 0; k < 3; k++) {
-                for (int q = 0; q < 3; q++) {
-                    e[k][q] = p[(k + 1) % 3][q] - p[k][q];
-                    lo[q] = fmin(lo[q], p[k][q]), hi[q] = fmax(hi[q], p[k][q]);
-                }
-                len2[k] = e[k][0] * e[k][0] + e[k][1] * e[k][1] + e[k][2] * e[k][2];
+            for (int q = 0; q < 3; q++) {
+                e[0][q] = p[1][q] - p[0][q], e[1][q] = p[2][q] - p[0][q], e[2][q] = p[2][q] - p[1][q];
+                lo[q] = fmin(lo[q], min3(p[0][q], p[1][q], p[2][q])), hi[q] = fmax(hi[q], max3(p[0][q], p[1][q], p[2][q]));
             }
-            double n[3];
             cross(e[0], e[1], n);
-            const double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            alt = fmin(alt, len > 0 ? len / sqrt(max3(len2[0], len2[1], len2[2])) : 0.0);
-            for (int q = 0; q < 3; q++)
+            const double len = sqrt(len2(n));
+            alt = fmin(alt, len > 0 ? len / sqrt(max3(len2(e[0]), len2(e[1]), len2(e[2]))) : 0.0);
+            for (int q = 0; q < 3; q++) {
+                ng[3 * (t0 + t) + q] = (float)n[q];
                 a[q] += un[t][q] = len > 0 ? n[q] / len : 0.0;
+            }
         }
         for (int q = 0; q < 3; q++)
             o->c[q] = 0.5 * (lo[q] + hi[q]);
-        const double al = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        const double al = sqrt(len2(a));
         for (int t = 0; t < m; t++) {
             for (int k = 0; k < 3; k++) {
                 const double *p = &v[3 * (size_t)tri[3 * (t0 + t) + k]];
@@ -215,7 +214,7 @@ static void triangles(struct nc__bins *b, int p)
         cross(bb, c, e[0]);
         cross(c, a, e[1]);
         cross(a, bb, e[2]);
-        const double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const double len = sqrt(len2(n));
         for (int r = 0; r < 3; r++) {
             for (int q = 0; q < 3; q++)
                 ct->e[r][q] = (float)e[r][q];

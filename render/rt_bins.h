@@ -33,16 +33,17 @@ struct nc__bins_cluster {
     double alt;                /* the smallest altitude of its triangles, m */
 };
 
-/* The clusters of triangles tri[0 .. nt) of vertices v, into
- * out[(nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER]. */
-void nc__bins_clusters(const double *v, const unsigned *tri, size_t nt, struct nc__bins_cluster *out);
+/* Triangles tri[0 .. nt) of vertices v: their normals (v1 - v0) x (v2 - v0)
+ * into ng[3 nt] (computed in double, as Embree's convention has it) and
+ * their clusters into out[(nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER]. */
+void nc__bins_facets(const double *v, const unsigned *tri, size_t nt, float *ng, struct nc__bins_cluster *out);
 
 /* A triangle mesh as shown this pass. */
 struct nc__bins_body {
     const double *v;       /* body-frame vertices, m (x, y, z each) */
     const unsigned *tri;   /* the triangles shown: 3 vertex indices each */
-    const float *ng;       /* and their normals in the body frame, 3 each (copied to the hits) */
-    const struct nc__bins_cluster *cl; /* their clusters (nc__bins_clusters; NULL: none skipped) */
+    const float *ng;       /* and their normals in the body frame, 3 each (nc__bins_facets; copied to the hits) */
+    const struct nc__bins_cluster *cl; /* their clusters (nc__bins_facets; NULL: none skipped) */
     size_t nv, nt;
     struct nc_mat3 R;      /* body -> scene */
     struct nc_vec3 origin; /* body origin relative to the rays' origin, scene frame, m */

@@ -218,23 +218,12 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
     if (closed < 0)
         return closed;
     b->closed[k] = closed;
-    /* The facets' normals for the camera-ray bins: (v1 - v0) x (v2 - v0) in
-     * double, as Embree's convention has it. */
-    if (!(b->facet_n[k] = malloc(3 * lv->nt * sizeof *b->facet_n[k])))
-        return nc_error(-ENOMEM, "out of memory for %zu facet normals", lv->nt);
-    for (size_t t = 0; t < lv->nt; t++) {
-        const unsigned *f = &lv->tri[3 * t];
-        const double *p0 = &m->v[3 * (size_t)f[0]], *p1 = &m->v[3 * (size_t)f[1]], *p2 = &m->v[3 * (size_t)f[2]];
-        const struct nc_vec3 n = nc_v3_cross(nc_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]),
-                                             nc_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]));
-        b->facet_n[k][3 * t + 0] = (float)n.x;
-        b->facet_n[k][3 * t + 1] = (float)n.y;
-        b->facet_n[k][3 * t + 2] = (float)n.z;
-    }
+    /* The facets' normals and clusters for the camera-ray bins. */
     const size_t ncl = (lv->nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
-    if (!(b->cluster[k] = malloc((ncl ? ncl : 1) * sizeof *b->cluster[k])))
-        return nc_error(-ENOMEM, "out of memory for %zu triangle clusters", ncl);
-    nc__bins_clusters(m->v, lv->tri, lv->nt, b->cluster[k]);
+    if (!(b->facet_n[k] = malloc((3 * lv->nt + 3) * sizeof *b->facet_n[k])) ||
+        !(b->cluster[k] = malloc((ncl + 1) * sizeof *b->cluster[k])))
+        return nc_error(-ENOMEM, "out of memory for the normals of %zu facets", lv->nt);
+    nc__bins_facets(m->v, lv->tri, lv->nt, b->facet_n[k], b->cluster[k]);
     return rt_check(rt->dev, "creating geometry");
 }
 

@@ -207,7 +207,7 @@ static void check_clusters(const struct nc_scene *s, double min_skip, const char
     const size_t ncl = (m->nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
     struct nc__bins_cluster *cl = malloc(ncl * sizeof *cl);
     float *ng = calloc(3 * m->nt, sizeof *ng);
-    nc__bins_clusters(m->v, m->tri, m->nt, cl);
+    nc__bins_facets(m->v, m->tri, m->nt, ng, cl);
     struct nc__bins_body body = {.v = m->v, .tri = m->tri, .ng = ng, .nv = m->nv, .nt = m->nt,
                                  .R = nc_quat_to_mat(s->body[0].attitude_q),
                                  .origin = nc_v3_sub(s->body[0].position_m, s->camera.position_m), .front_only = 1};

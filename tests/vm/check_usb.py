@@ -6,7 +6,8 @@ A: EDGES edges on the adapter's input gave EDGES frames (file output and a
    V4L2 reader); each frame's trigger time, the adapter's timestamp mapped
    from its clock (1000.5 s ahead, 150 ppm fast) to CLOCK_MONOTONIC, lies
    within the driver's stated bound of the write() that made the edge, and
-   that bound is under 5 ms; the strobe output went high once per exposure;
+   that bound is under 5 ms; the strobe output went high once per exposure,
+   within it (late by the edge's round trip), and stayed high towards its end;
    the udev rule gave the device node to group plugdev and navcam serve
    opened it without root. Prints the edge-to-frame latency.
 B: a storm of 20000 pulses: every edge the adapter read reached NavCam or
@@ -62,11 +63,14 @@ strobe = csv_rows(os.path.join(out, "a/strobe.csv"))
 rises = [t for t, v in strobe[1:] if v == 1]
 check(strobe[0][1] == 0, "A: strobe low before the first exposure")
 check(len(rises) == len(recs), f"A: {len(rises)} strobe pulses for {len(recs)} exposures")
-check(all(level_at(strobe, (r["exposure_start_mono_ns"] + r["exposure_end_mono_ns"]) // 2) == 1 for r in recs),
-      "A: strobe high at mid-exposure of every frame")
 if len(rises) == len(recs):
-    # The strobe can start only once the edge has reached NavCam and the
-    # window has gone back to the adapter (two USB trips; docs/usb-trigger.md).
+    # With delay_s 0 the strobe can start only once the edge has reached
+    # NavCam and the window has gone back to the adapter (two USB trips and
+    # thread wake-ups under TCG: 2 to 34 ms seen; docs/usb-trigger.md): it
+    # must rise inside its exposure and stay high from then towards its end.
+    check(all(r["exposure_start_mono_ns"] - bound_ns <= t < r["exposure_end_mono_ns"] - 2e6 and
+              level_at(strobe, (t + r["exposure_end_mono_ns"]) // 2) == 1 for t, r in zip(rises, recs)),
+          "A: every strobe pulse rises within its exposure and is high halfway from there to its end")
     on = [(t - r["exposure_start_mono_ns"]) / 1e6 for t, r in zip(rises, recs)]
     print("A: strobe on %.2f..%.2f ms after the exposure started (edge to NavCam to adapter, TCG guest)"
           % (min(on), max(on)))
