@@ -10,7 +10,12 @@
 #include <stdint.h>
 
 #define NC_NOISE_RMS 0.27
+#define NC_NOISE_GRAD_RMS 0.704
 
 double nc_noise3(uint64_t seed, double x, double y, double z);
+/* The same value (bit for bit) and its gradient g, per lattice period.
+ * Each component of g has RMS NC_NOISE_GRAD_RMS over uniform points
+ * (measured over a million: 0.7044; test_noise checks it). */
+double nc_noise3_grad(uint64_t seed, double x, double y, double z, double g[3]);
 
 #endif

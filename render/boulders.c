@@ -7,10 +7,12 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/noise.h"
 #include "core/rng.h"
 
 /* Stream tags, so that shapes and faces never share a stream. */
 #define TAG_SHAPE 0x5348415045ull
+#define TAG_RELIEF 0x52454c49454full
 #define OCTAVE_MIN NC_BOULDER_OCTAVE_MIN
 #define OCTAVE_MAX NC_BOULDER_OCTAVE_MAX
 
@@ -187,18 +189,59 @@ static int sort_octave(struct nc_boulder *r, size_t n)
     return 0;
 }
 
+/* Octave o of the relief: frequency 2^(o+1) per rock unit (wavelength
+ * D/4, D/8, ... with D = 2 units), amplitude wavelength^H. */
+static double relief_freq(int o) { return (double)(2 << o); }
+static double relief_weight(int o) { return pow(1 / relief_freq(o), NC_ROCK_RELIEF_HURST); }
+
+/* Each octave's gradient scale, so that the sum's gradient along a face has
+ * RMS magnitude tan(deg): the octaves are independent, and a plane keeps
+ * two of the gradient's three components (each of RMS NC_NOISE_GRAD_RMS
+ * per period). */
+static void relief_scales(double deg, double *a)
+{
+    double s2 = 0;
+    for (int o = 0; o < NC_ROCK_RELIEF_OCTAVES; o++)
+        s2 += pow(relief_weight(o) * relief_freq(o), 2);
+    for (int o = 0; o < NC_ROCK_RELIEF_OCTAVES; o++)
+        a[o] = tan(deg * M_PI / 180) / (M_SQRT2 * NC_NOISE_GRAD_RMS * sqrt(s2)) * relief_weight(o) * relief_freq(o);
+}
+
+void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double p[3], double footprint,
+                       double g[3])
+{
+    g[0] = g[1] = g[2] = 0;
+    if (!(f->relief[0] > 0))
+        return;
+    uint64_t seed = 0;
+    for (int o = 0; o < NC_ROCK_RELIEF_OCTAVES; o++) {
+        const double fr = relief_freq(o), span = footprint > 0 ? 1 / (fr * footprint) : INFINITY; /* a wavelength */
+        const double fade = span >= 4 ? 1 : 0.5 * (span - 2);
+        if (!(fade > 0))
+            break; /* the finer octaves fade sooner */
+        if (o == 0)
+            seed = nc_rng_seed(f->params.seed, TAG_RELIEF, (uint64_t)k);
+        const double a = fade * f->relief[o];
+        double go[3];
+        nc_noise3_grad(seed + (uint64_t)o, fr * p[0], fr * p[1], fr * p[2], go);
+        g[0] += a * go[0], g[1] += a * go[1], g[2] += a * go[2];
+    }
+}
+
 int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params *p, size_t max_rocks,
                          struct nc_boulder_field *out)
 {
     memset(out, 0, sizeof *out);
     if (!(p->slope > 0) || !(p->c_per_km2 >= 0) || !(p->d_min_m > 0) || !(p->d_max_m > p->d_min_m) ||
         p->shapes < 1 || p->shapes > NC_ROCK_SHAPES_MAX || !(p->burial_min >= 0) ||
-        !(p->burial_max >= p->burial_min) || !(p->burial_max <= 1))
+        !(p->burial_max >= p->burial_min) || !(p->burial_max <= 1) || !(p->roughness_deg >= 0) ||
+        !(p->roughness_deg <= 45))
         return nc_error(NC_ERANGE, "boulders: need slope > 0, density >= 0, 0 < min diameter < max diameter, "
-                                   "1..%d shapes, 0 <= burial <= 1", NC_ROCK_SHAPES_MAX);
+                                   "1..%d shapes, 0 <= burial <= 1, 0 <= roughness <= 45 deg", NC_ROCK_SHAPES_MAX);
     if (p->d_min_m < exp2(OCTAVE_MIN) || p->d_max_m > exp2(OCTAVE_MAX + 1))
         return nc_error(NC_ERANGE, "boulders: diameters from %g to %g m", exp2(OCTAVE_MIN), exp2(OCTAVE_MAX + 1));
     out->params = *p;
+    relief_scales(p->roughness_deg, out->relief);
     out->nshapes = p->shapes;
     if (!(out->shape = calloc((size_t)p->shapes, sizeof *out->shape)))
         return nc_error(-ENOMEM, "out of memory");

@@ -22,6 +22,7 @@
 
 #define NC_ROCK_PLANES 32
 #define NC_ROCK_SHAPES_MAX 256
+#define NC_ROCK_RELIEF_OCTAVES 3 /* nc_boulder_relief */
 
 /* A rock in its own frame, in units of half its longest dimension: the
  * points x with n . x <= d for every plane k (n = (nx[k], ny[k], nz[k])
@@ -54,6 +55,7 @@ struct nc_boulder_params {
     double d_min_m, d_max_m;
     double burial_min, burial_max; /* buried fraction of each rock's height, drawn uniformly */
     int shapes;        /* distinct rock shapes, 1..NC_ROCK_SHAPES_MAX */
+    double roughness_deg; /* the faces' relief: RMS slope, 0..45 deg (0: flat faces) */
     uint64_t seed;
 };
 
@@ -74,7 +76,9 @@ struct nc_boulder_field {
     struct nc_rock_shape *shape;
     int nshapes;
     struct nc_boulder_params params;
-    double area_m2; /* the surface they lie on */
+    double area_m2;    /* the surface they lie on */
+    /* nc_boulder_relief's octaves' gradient scales for roughness_deg (0: none) */
+    double relief[NC_ROCK_RELIEF_OCTAVES];
 };
 
 /* Presets from the literature (docs/terrain.md gives the sources): "bennu",
@@ -86,6 +90,21 @@ int nc_boulder_preset(const char *name, struct nc_boulder_params *p);
  * diameter does not fill the memory. */
 int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params *p, size_t max_rocks,
                          struct nc_boulder_field *out);
+/* Relief on the rocks' faces, for shading: a height field over each rock's
+ * own frame, fBm of gradient noise (core/noise.h) in NC_ROCK_RELIEF_OCTAVES
+ * octaves of wavelength D/4, D/8, D/16 (D the rock's longest dimension),
+ * amplitude going as wavelength^NC_ROCK_RELIEF_HURST (the roughness
+ * exponent of fracture surfaces, about 0.8), seeded per rock, scaled so
+ * that its gradient along a face has RMS magnitude tan(roughness_deg). g:
+ * the gradient at p (the rock's frame, in units of half its longest
+ * dimension; dimensionless). footprint: the size of a pixel there, same
+ * units (0: none): an octave is whole where its wavelength spans 4
+ * footprints or more, fades linearly to nothing at 2 (a pixel cannot show
+ * it; the material's theta_bar stands for what is finer). A function of the
+ * rock, the point and the footprint alone. Zero where roughness_deg is 0. */
+#define NC_ROCK_RELIEF_HURST 0.8
+void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double p[3], double footprint,
+                       double g[3]);
 /* How many rocks have a diameter of at least d_m (a prefix of the list). */
 size_t nc_boulders_at_least(const struct nc_boulder_field *f, double d_m);
 /* The cover of the rocks rock[from .. n): the sum of the disks of their

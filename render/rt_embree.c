@@ -509,6 +509,7 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
              * sphere), like the level of detail a function of the pose. */
             nc__rt_rocks_cut(&b->rocks, nc_scene_boulder_min_px(s, i) * px_m);
             nc__rt_rocks_place(&b->rocks, &R, b->origin_rel);
+            b->rocks.px_rad = 1 / fmax(s->camera.fx_px, s->camera.fy_px);
             rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
             rt->stats.boulders_traced[i] = b->rocks.traced;
             rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
@@ -551,6 +552,48 @@ static void load_ray(struct RTCRay16 *r, const struct nc_ray16 *in)
     }
 }
 
+/* The shading normal of rock k of tile tl, hit at t along lane i of ray:
+ * its face's normal n (x, y, z: unnormalised, body frame) tilted by the
+ * relief's gradient along the face (nc_boulder_relief), kept only where it
+ * faces the ray as n does (a shading normal never shows a face the
+ * geometry hides). */
+static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *tl, size_t k, float t,
+                        const struct nc_ray16 *ray, int i, float *x, float *y, float *z)
+{
+    const float *R = b->rot, *M = tl->rocks->rock[k].M, *c = tl->rocks->rock[k].c;
+    /* the hit from the tile's origin (scene frame), into the body frame
+     * (R^T), from the rock's centre, into the rock's frame (M) */
+    const double h[3] = {ray->ox[i] + (double)t * ray->dx[i] - tl->place_m[0],
+                         ray->oy[i] + (double)t * ray->dy[i] - tl->place_m[1],
+                         ray->oz[i] + (double)t * ray->dz[i] - tl->place_m[2]};
+    double rel[3], p[3], g[3], gb[3], n[3] = {*x, *y, *z}, db[3];
+    for (int j = 0; j < 3; j++) {
+        rel[j] = R[j] * h[0] + R[3 + j] * h[1] + R[6 + j] * h[2] - c[j];
+        db[j] = R[j] * ray->dx[i] + R[3 + j] * ray->dy[i] + R[6 + j] * ray->dz[i];
+    }
+    for (int j = 0; j < 3; j++)
+        p[j] = M[3 * j] * rel[0] + M[3 * j + 1] * rel[1] + M[3 * j + 2] * rel[2];
+    /* the gradient, with a pixel's footprint at the hit's distance along
+     * the ray, turned into the body frame: M^T over its scale */
+    const double half = 1 / sqrt((double)M[0] * M[0] + (double)M[1] * M[1] + (double)M[2] * M[2]);
+    const double dist = t * sqrt((double)ray->dx[i] * ray->dx[i] + (double)ray->dy[i] * ray->dy[i] +
+                                 (double)ray->dz[i] * ray->dz[i]);
+    nc_boulder_relief(&b->src->boulders, k, p, dist * tl->rocks->px_rad / half, g);
+    const double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double gn = 0, nd = 0;
+    for (int j = 0; j < 3; j++) {
+        gb[j] = half * (M[j] * g[0] + M[3 + j] * g[1] + M[6 + j] * g[2]);
+        n[j] /= nn;
+        gn += gb[j] * n[j];
+    }
+    for (int j = 0; j < 3; j++) {
+        n[j] -= gb[j] - gn * n[j]; /* the height field's normal: n minus the gradient along the face */
+        nd += n[j] * db[j];
+    }
+    if (nd < 0)
+        *x = (float)n[0], *y = (float)n[1], *z = (float)n[2];
+}
+
 /* Lane i of hit: instance inst's primitive prim (a body's own triangle, or a
  * rock of a tile) met at t, barycentric (u, v), geometric normal (x, y, z)
  * unnormalised in the instanced geometry's frame (the body's). */
@@ -586,9 +629,12 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
         const float *a = b->src->albedo_vertex;
         alb = (1 - u - v) * a[tr[0]] + u * a[tr[1]] + v * a[tr[2]];
     } else if (rt->inst_tile[inst]) {
-        size_t k = rt->inst_tile[inst]->index[prim];
+        const struct nc__rt_rock_tile *tl = rt->inst_tile[inst];
+        size_t k = tl->index[prim];
         alb = nc_albedo_var_rock(&b->src->albedo_var, k);
         rock = (int32_t)k;
+        if (b->src->boulders.relief[0] > 0)
+            rock_relief(b, tl, k, t, ray, i, &x, &y, &z);
     }
     hit->albedo[i] = alb;
     hit->rock[i] = rock;

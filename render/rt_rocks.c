@@ -384,7 +384,8 @@ void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct 
             continue;
         const struct nc_vec3 T =
             nc_v3_add(nc_mat_mul_v(R, nc_v3(tl->origin_m[0], tl->origin_m[1], tl->origin_m[2])), origin_rel);
-        xfm[9] = (float)T.x, xfm[10] = (float)T.y, xfm[11] = (float)T.z;
+        xfm[9] = tl->place_m[0] = (float)T.x, xfm[10] = tl->place_m[1] = (float)T.y;
+        xfm[11] = tl->place_m[2] = (float)T.z;
         rtcSetGeometryTransform(tl->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(tl->inst);
     }

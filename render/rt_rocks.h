@@ -33,7 +33,8 @@ struct nc__rt_rock_tile {
     int octave; /* in the field's octave table */
     RTCScene scene;
     RTCGeometry geom, inst;
-    unsigned inst_id; /* in the top-level scene */
+    unsigned inst_id;   /* in the top-level scene */
+    float place_m[3];   /* the instance's translation: its origin from the camera, scene frame */
     int enabled;
 };
 
@@ -56,6 +57,7 @@ struct nc__rt_rocks {
     double min_d_m;   /* the cut: the smallest diameter traced */
     size_t traced;    /* rocks at or above the cut: rock[0 .. traced) */
     double cut_cover; /* nc_boulders_cover() of the rocks below the cut */
+    double px_rad;    /* the camera's pixel, rad (the finest axis): the relief's footprint */
 };
 
 /* Lane i of an Embree ray packet of width N (RTCRayN: origin, tnear,

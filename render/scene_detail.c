@@ -100,7 +100,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
 #define MAX_BOULDERS 16000000
 
 /* `boulders:` of a body (docs/terrain.md): a preset or C and slope, the
- * diameter range, burial, shapes, seed. */
+ * diameter range, burial, shapes, the faces' roughness, seed. */
 static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
 {
     struct nc_cfg_node *map;
@@ -141,6 +141,8 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
         return rc;
     if (rc)
         p.shapes = (int)v;
+    if ((rc = nc_cfg_double(map, "roughness_deg", 0, 45, &p.roughness_deg)) < 0)
+        return rc;
     if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
         return rc;
     if ((rc = nc_boulders_generate(&b->mesh, &p, MAX_BOULDERS, &b->boulders)) < 0) {

@@ -1,0 +1,211 @@
+/* test_rock_relief.c - relief on the rocks' faces (boulders.roughness_deg,
+ * nc_boulder_relief): its gradient along a face has the stated RMS slope;
+ * rendered, it changes the rocks' pixels and nothing else (shadows and
+ * ground are the flat-faced rocks' bit for bit), gives them texture, and is
+ * the same on 1 and 2 threads; a point of a rock is shaded with the same
+ * normal seen from two camera positions. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/rng.h"
+#include "render/boulders.h"
+#include "render/render.h"
+#include "render/rt.h"
+#include "testutil.h"
+
+/* The RMS magnitude of the gradient along random planes through random
+ * points of random rocks. */
+static void check_slope(const struct nc_boulder_field *f, double deg)
+{
+    uint64_t s = 11;
+    double sum2 = 0, diff = 0;
+    const int n = 200000;
+    for (int i = 0; i < n; i++) {
+        size_t k = (size_t)(nc_rng_uniform(&s) * (double)f->n);
+        struct nc_vec3 u = nc_rng_dir(&s), nrm = nc_rng_dir(&s);
+        double r = nc_rng_uniform(&s), p[3] = {r * u.x, r * u.y, r * u.z}, g[3], g2[3];
+        nc_boulder_relief(f, k, p, 0, g);
+        nc_boulder_relief(f, (k + 1) % f->n, p, 0, g2); /* another rock at the same point */
+        double gn = g[0] * nrm.x + g[1] * nrm.y + g[2] * nrm.z;
+        sum2 += g[0] * g[0] + g[1] * g[1] + g[2] * g[2] - gn * gn;
+        diff += g[0] != g2[0];
+    }
+    double rms = sqrt(sum2 / n), want = tan(deg * M_PI / 180);
+    printf("slope: RMS %.4f along a face (tan %g deg = %.4f); rocks differ at %.0f of %d points\n", rms, deg, want,
+           diff, n);
+    CHECK(fabs(rms / want - 1) < 0.03, "RMS slope %g, configured tan %g deg = %g", rms, deg, want);
+    CHECK(diff > 0.99 * n, "two rocks share their relief at %.0f of %d points", n - diff, n);
+}
+
+/* A close frame of the test asteroid: 0.15 m pixels, rocks of 2 m and more. */
+static void render_close(double deg, int threads, struct nc_scene *s, struct nc_frame *f)
+{
+    char rocks[160];
+    snprintf(rocks, sizeof rocks, "bodies[0].boulders={preset: bennu, min_diameter_m: 2, seed: 3, roughness_deg: %g}",
+             deg);
+    const char *sets[] = {rocks, "camera.position_m=[0, -400, 0]", "render.samples_per_pixel=1"};
+    nc_test_scene(nc_test_asteroid_yaml, sets, 3, s);
+    struct nc_renderer r;
+    const int W = s->camera.width_px, H = s->camera.height_px;
+    CHECK(nc_renderer_init(&r, s, threads) == 0 && nc_frame_alloc(f, W, H) == 0 &&
+              (f->rock_id = malloc((size_t)W * H * sizeof *f->rock_id)) != NULL && nc_render_frame(&r, s, f) == 0,
+          "%s", nc_errmsg());
+    nc_renderer_free(&r);
+}
+
+/* Texture on a face: over neighbouring pixel pairs (along rows and
+ * columns) on the same rock whose flat-faced radiance is equal and lit (one
+ * face: a Lambert face under a distant Sun is uniform), the RMS relative
+ * difference of frame f; their count in *pairs. */
+static double face_texture(const struct nc_frame *flat, const struct nc_frame *f, size_t *pairs)
+{
+    const int W = flat->width_px, H = flat->height_px;
+    double s2 = 0;
+    size_t n = 0;
+    for (int y = 0; y + 1 < H; y++)
+        for (int x = 0; x + 1 < W; x++)
+            for (int d = 0; d < 2; d++) {
+                size_t i = (size_t)y * W + x, j = d ? i + (size_t)W : i + 1;
+                if (flat->rock_id[i] < 0 || flat->rock_id[i] != flat->rock_id[j] || !(flat->radiance[i] > 0) ||
+                    flat->radiance[i] != flat->radiance[j])
+                    continue;
+                double r = 2 * (f->radiance[i] - f->radiance[j]) / (f->radiance[i] + f->radiance[j] + 1e-30);
+                s2 += r * r, n++;
+            }
+    *pairs = n;
+    return n ? sqrt(s2 / n) : 0;
+}
+
+/* The mean radiance of the pixels that show a rock in the flat frame. */
+static double rock_mean(const struct nc_frame *flat, const struct nc_frame *f)
+{
+    double s = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < (size_t)flat->width_px * flat->height_px; i++)
+        if (flat->rock_id[i] >= 0)
+            s += f->radiance[i], n++;
+    return n ? s / n : 0;
+}
+
+static void check_render(void)
+{
+    struct nc_scene flat, rough, rough1;
+    struct nc_frame a, b, c;
+    render_close(0, 2, &flat, &a);
+    render_close(25, 2, &rough, &b);
+    render_close(25, 1, &rough1, &c);
+    size_t n = (size_t)a.width_px * a.height_px, rock = 0, ground = 0, rock_changed = 0, ground_changed = 0,
+           id_changed = 0;
+    for (size_t i = 0; i < n; i++) {
+        id_changed += a.rock_id[i] != b.rock_id[i];
+        if (a.rock_id[i] >= 0)
+            rock++, rock_changed += a.radiance[i] != b.radiance[i];
+        else
+            ground++, ground_changed += a.radiance[i] != b.radiance[i];
+    }
+    printf("render: %zu rock pixels, %zu changed; %zu ground or sky pixels, %zu changed; %zu rock ids changed\n", rock,
+           rock_changed, ground, ground_changed, id_changed);
+    CHECK(rock > n / 20 && rock_changed > rock / 2, "%zu of %zu rock pixels changed", rock_changed, rock);
+    CHECK(ground_changed == 0 && id_changed == 0, "the relief moved %zu ground pixels and %zu rock ids",
+          ground_changed, id_changed);
+    CHECK(!memcmp(b.radiance, c.radiance, n * sizeof *b.radiance), "1 and 2 threads differ");
+    int finite = 1;
+    for (size_t i = 0; i < n; i++)
+        finite &= isfinite(b.radiance[i]) && b.radiance[i] >= 0;
+    CHECK(finite, "a non-finite or negative pixel");
+    size_t pairs;
+    double tex_a = face_texture(&a, &a, &pairs), tex_b = face_texture(&a, &b, &pairs);
+    double mean = rock_mean(&a, &b) / rock_mean(&a, &a) - 1;
+    printf("texture: %zu neighbouring pixel pairs on one lit face: RMS relative difference %.4f flat, %.4f at 25 "
+           "deg; the rocks' mean radiance %+.2f %%\n", pairs, tex_a, tex_b, 100 * mean);
+    CHECK(pairs > 1000 && tex_a == 0 && tex_b > 0.02, "face texture %g flat, %g rough over %zu pairs", tex_a, tex_b,
+          pairs);
+    CHECK(fabs(mean) < 0.1, "the relief changes the rocks' mean by %+.2f %%", 100 * mean);
+    nc_frame_free(&a), nc_frame_free(&b), nc_frame_free(&c);
+    nc_scene_free(&flat), nc_scene_free(&rough1);
+
+    /* One point of the largest rock seen from straight above and from 60 m
+     * aside: the same shading normal (a function of the rock and the point,
+     * not of the camera). */
+    const struct nc_boulder_field *f = &rough.body[0].boulders;
+    size_t big = 0;
+    for (size_t i = 1; i < f->n; i++)
+        if (f->rock[i].half_m > f->rock[big].half_m)
+            big = i;
+    const struct nc_boulder *r = &f->rock[big];
+    struct nc_vec3 c0 = nc_v3(r->centre_m[0], r->centre_m[1], r->centre_m[2]), up = nc_v3_unit(c0);
+    struct nc_vec3 side = nc_v3_unit(nc_v3_cross(up, nc_v3(0, 0, 1)));
+    struct nc_vec3 cam[2] = {nc_v3_add(c0, nc_v3_scale(up, 50)), c0}, hitp = c0;
+    struct nc_vec3 nrm[2];
+    int32_t id[2];
+    for (int v = 0; v < 2; v++) {
+        rough.camera.position_m = cam[v];
+        struct nc_rt *rt;
+        CHECK(nc_rt_create(&rough, 1, &rt) == 0, "%s", nc_errmsg());
+        struct nc_vec3 d = v == 0 ? nc_v3_scale(up, -1) : nc_v3_unit(nc_v3_sub(hitp, cam[v]));
+        struct nc_ray16 ray = {0};
+        ray.dx[0] = (float)d.x, ray.dy[0] = (float)d.y, ray.dz[0] = (float)d.z;
+        ray.tfar[0] = 1e4f;
+        ray.valid[0] = -1;
+        struct nc_hit16 h;
+        nc_rt_intersect16(rt, &ray, &h, 0);
+        nrm[v] = nc_v3_unit(nc_v3(h.nx[0], h.ny[0], h.nz[0]));
+        id[v] = h.rock[0];
+        if (v == 0) { /* the point hit, and a camera 60 m aside looking at it */
+            hitp = nc_v3_add(cam[0], nc_v3_scale(d, h.t[0]));
+            cam[1] = nc_v3_add(hitp, nc_v3_add(nc_v3_scale(up, 40), nc_v3_scale(side, 60)));
+        }
+        nc_rt_destroy(rt);
+    }
+    double ang = acos(fmin(1, nc_v3_dot(nrm[0], nrm[1])));
+    printf("rock %zu: the normal at one point differs by %.2g rad between two cameras\n", big, ang);
+    CHECK(id[0] == (int32_t)big && id[1] == (int32_t)big, "the rays hit rocks %d and %d, not %zu", id[0], id[1], big);
+    CHECK(ang < 2e-3, "the shading normal moved by %g rad with the camera", ang);
+    nc_scene_free(&rough);
+}
+
+int main(void)
+{
+    struct nc_asteroid_params p = {.radii_m = {280, 230, 200}, .subdivisions = 4, .seed = 3, .craters = 20,
+                                   .lump_amplitude = 0.1};
+    struct nc_mesh m;
+    CHECK(nc_mesh_asteroid(&p, &m) == 0, "asteroid: %s", nc_errmsg());
+    struct nc_boulder_params bp = {.d_min_m = 1, .d_max_m = 64, .burial_min = 0.1, .burial_max = 0.5, .shapes = 48,
+                                   .seed = 5};
+    CHECK(nc_boulder_preset("bennu", &bp) == 0, "%s", nc_errmsg());
+    for (double deg = 10; deg <= 40; deg += 15) {
+        struct nc_boulder_field f;
+        bp.roughness_deg = deg;
+        CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) == 0 && f.n > 1000, "%s", nc_errmsg());
+        check_slope(&f, deg);
+        nc_boulders_free(&f);
+    }
+    bp.roughness_deg = 0;
+    struct nc_boulder_field f;
+    CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) == 0, "%s", nc_errmsg());
+    double g[3] = {1, 1, 1}, q[3] = {0.3, -0.2, 0.5};
+    nc_boulder_relief(&f, 0, q, 0, g);
+    CHECK(g[0] == 0 && g[1] == 0 && g[2] == 0, "flat faces have a gradient");
+    nc_boulders_free(&f);
+    /* The pixel's footprint: every octave whole where the finest spans 4
+     * footprints, none where the coarsest spans 2, in between less. */
+    bp.roughness_deg = 25;
+    CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) == 0, "%s", nc_errmsg());
+    double g0[3], g1[3], g2[3], g3[3];
+    nc_boulder_relief(&f, 7, q, 0, g0);
+    nc_boulder_relief(&f, 7, q, 0.125 / 4, g1);
+    nc_boulder_relief(&f, 7, q, 0.125 / 3, g2);
+    nc_boulder_relief(&f, 7, q, 0.5 / 2, g3);
+    CHECK(!memcmp(g0, g1, sizeof g0) && memcmp(g0, g2, sizeof g0) && g3[0] == 0 && g3[1] == 0 && g3[2] == 0,
+          "the footprint's fade: (%g %g %g) whole, (%g %g %g) at 4 footprints, (%g %g %g) at 3, (%g %g %g) at none",
+          g0[0], g0[1], g0[2], g1[0], g1[1], g1[2], g2[0], g2[1], g2[2], g3[0], g3[1], g3[2]);
+    nc_boulders_free(&f);
+    bp.roughness_deg = 46;
+    CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) < 0 && nc_test_contains(nc_errmsg(), "roughness"),
+          "a roughness of 46 deg: %s", nc_errmsg());
+    nc_mesh_free(&m);
+    check_render();
+    return nc_test_end();
+}
