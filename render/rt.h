@@ -61,12 +61,13 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
  * d00 + x ex + y ey through image point (x, y) (pixels, centres at
  * integers) and every sample of pixel (px, py) lies within half a pixel of
  * it; cam NULL turns them off. Returns 1 when nc_rt_intersect_block serves
- * the pass (every body a mesh, no boulders traced, no triangle across the
- * plane through o parallel to the image, and no more triangles than camera
+ * the pass (every body a mesh, no triangle across the plane through o
+ * parallel to the image, and no more triangles than camera
  * samples could reach the bodies: the lists cost about half of what Embree
  * spends on a sample, per triangle), 0 when it does not, or a negative
  * error code. The lists are built on pool's threads (NULL: the caller's
- * alone), the same for any number. Call after nc_rt_update. */
+ * alone), the same for any number. Boulders are traced in front of the
+ * lists' hits, through the rocks alone. Call after nc_rt_update. */
 struct nc_rt_pinhole {
     struct nc_vec3 o, d00, ex, ey;
     int width_px, height_px;
@@ -90,8 +91,9 @@ int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
 /* Shadow rays that need no tracing: from[i] >= 0 says ray i leaves the outer
  * side of body from[i] (a surface point whose normal faces both camera and
- * ray). Rays proven to meet nothing (shadow_grid.h for the body's own shape,
- * the bounding spheres for the others) are made inactive; returns how many. */
+ * ray). Rays proven to meet nothing (shadow_grid.h for the body's own mesh,
+ * the bounding spheres for the others, and where boulders are traced, a
+ * trace through the rocks alone) are made inactive; returns how many. */
 int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from);
 /* Add to the shadow-ray counts of nc_rt_get_stats (callers add a tile's
  * worth at a time: the counters are shared by every render thread). */

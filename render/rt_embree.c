@@ -70,6 +70,12 @@ struct rt_body {
 struct nc_rt {
     RTCDevice dev;
     RTCScene top;
+    /* Every body's rock tiles alone (NULL: no boulders), and whether any
+     * rock is traced at the last update. A shadow ray that a body's grid
+     * proves clear of its mesh, and a camera ray whose mesh hit came from
+     * the bins, need only test the rocks (rt_rocks.h). */
+    RTCScene solo;
+    int rocks_on;
     struct rt_body body[NC_MAX_BODIES];
     int nbodies;
     /* Instance ID -> body (the body's own, or a tile of its rocks) and the
@@ -284,12 +290,10 @@ static int body_init(struct nc_rt *rt, unsigned index, const struct nc_body *src
             return rc;
         if (src->smooth_normals && (rc = vertex_normals(b, m)) < 0)
             return rc;
-        if (src->boulders.n) { /* rocks shadow the body: no grid proves a point lit */
+        if (src->boulders.n) { /* the grid proves rays clear of the mesh; the rocks are traced */
             if ((rc = nc__rt_rocks_init(rt->dev, &src->boulders, &b->rocks)) < 0 ||
-                (rc = nc__rt_rocks_attach(&b->rocks, rt->dev, rt->top)) < 0)
+                (rc = nc__rt_rocks_attach(&b->rocks, rt->dev, rt->top, rt->solo)) < 0)
                 return rc;
-            for (int k = 0; k < b->nlevels; k++)
-                b->closed[k] = 0;
             for (size_t t = 0; t < b->rocks.ntiles && rc == 0; t++)
                 rc = register_inst(rt, b->rocks.tile[t].inst_id, index, &b->rocks.tile[t]);
             if (rc < 0)
@@ -335,6 +339,11 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
     }
     rt->top = rtcNewScene(rt->dev);
     rtcSetSceneBuildQuality(rt->top, RTC_BUILD_QUALITY_LOW);
+    for (int i = 0; i < s->nbodies && !rt->solo; i++)
+        if (s->body[i].boulders.n) {
+            rt->solo = rtcNewScene(rt->dev);
+            rtcSetSceneBuildQuality(rt->solo, RTC_BUILD_QUALITY_LOW);
+        }
     int rc = 0;
     for (int i = 0; i < s->nbodies && rc == 0; i++) {
         rc = body_init(rt, (unsigned)i, &s->body[i], s->render.lod_error_px);
@@ -438,6 +447,7 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
 {
     const struct nc_vec3 cam = s->camera.position_m;
     int rc;
+    rt->rocks_on = 0;
     for (int i = 0; i < rt->nbodies; i++) {
         struct rt_body *b = &rt->body[i];
         const struct nc_body *src = &s->body[i];
@@ -513,11 +523,14 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
             rt->stats.boulders_traced[i] = b->rocks.traced;
             rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
+            rt->rocks_on |= b->rocks.traced > 0;
         }
         if ((rc = update_grid(b, s)) < 0)
             return rc;
     }
     rtcCommitScene(rt->top);
+    if (rt->solo)
+        rtcCommitScene(rt->solo);
     return rt_check(rt->dev, "committing the scene");
 }
 
@@ -684,7 +697,7 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
     double samples = 0, triangles = 0;
     for (int i = 0; i < rt->nbodies; i++) {
         const struct rt_body *b = &rt->body[i];
-        if (b->analytic || (b->rocks.ntiles && b->rocks.traced))
+        if (b->analytic)
             return 0;
         const struct nc_vec3 o = nc_v3_sub(b->origin_rel, cam->o);
         const double d = nc_v3_norm(o), R = b->src->bounding_radius_m;
@@ -705,6 +718,30 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
         return 0; /* Embree's tree is cheaper than listing them */
     const struct nc__bins_view v = {cam->d00, cam->ex, cam->ey, cam->width_px, cam->height_px};
     return nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, threads);
+}
+
+/* The rocks in front of a packet of camera rays whose meshes the bins
+ * traced: each lane through the rocks alone, up to its mesh hit. */
+static void rocks_over(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit)
+{
+    struct RTCRayHit16 rh __attribute__((aligned(64)));
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    load_ray(&rh.ray, ray);
+    for (int i = 0; i < NC_PACKET; i++) {
+        if (ray->valid[i] == -1 && hit->body[i] >= 0)
+            rh.ray.tfar[i] = hit->t[i];
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(ray->valid, rt->solo, &ctx, &rh);
+    for (int i = 0; i < NC_PACKET; i++) {
+        const unsigned inst = rh.hit.instID[0][i];
+        if (ray->valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID && inst < rt->ninst)
+            put_hit(rt, inst, rh.hit.primID[i], rh.ray.tfar[i], rh.hit.u[i], rh.hit.v[i], rh.hit.Ng_x[i],
+                    rh.hit.Ng_y[i], rh.hit.Ng_z[i], ray, hit, i);
+    }
 }
 
 void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
@@ -732,6 +769,8 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
                 }
                 put_hit(rt, b->inst_id, prim, t[q][i], u, v, ct->ng[0], ct->ng[1], ct->ng[2], &ray[q0 + q], h, i);
             }
+        for (int q = 0; q < m && rt->rocks_on; q++)
+            rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
     }
 }
 
@@ -795,7 +834,7 @@ static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct
 
 int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
 {
-    int culled = 0;
+    int culled = 0, proven[NC_PACKET] = {0};
     int last = -1, ok = 0; /* the direction test, redone when body or direction changes */
     float ld[3] = {0, 0, 0};
     for (int i = 0; i < NC_PACKET; i++) {
@@ -809,12 +848,28 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
                 ok = !b->analytic && b->grid_level == b->level &&
                      nc_shadow_grid_dir_ok(b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(nc_v3(ld[0], ld[1], ld[2]))));
             }
-            if (proven_lit(rt, from[i], ok, ray, i)) {
-                ray->valid[i] = 0;
-                culled++;
-            }
+            if (proven_lit(rt, from[i], ok, ray, i))
+                proven[i] = -1, culled++;
         }
     }
+    if (culled && rt->rocks_on) {
+        /* Clear of every mesh, but rocks may stand in the way: the proven
+         * rays through the rocks alone; one that meets a rock stays to be
+         * traced whole. */
+        struct RTCRay16 r __attribute__((aligned(64)));
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        struct nc_ray16 pr = *ray;
+        memcpy(pr.valid, proven, sizeof proven);
+        load_ray(&r, &pr);
+        rtcOccluded16(proven, rt->solo, &ctx, &r);
+        for (int i = 0; i < NC_PACKET; i++)
+            if (proven[i] && r.tfar[i] == -INFINITY)
+                proven[i] = 0, culled--;
+    }
+    for (int i = 0; i < NC_PACKET; i++)
+        if (proven[i])
+            ray->valid[i] = 0;
     return culled;
 }
 
@@ -1007,6 +1062,8 @@ void nc_rt_destroy(struct nc_rt *rt)
     }
     if (rt->top)
         rtcReleaseScene(rt->top);
+    if (rt->solo)
+        rtcReleaseScene(rt->solo);
     if (rt->dev)
         rtcReleaseDevice(rt->dev);
     nc__bins_free(&rt->bins);

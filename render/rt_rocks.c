@@ -340,14 +340,17 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
     return rc;
 }
 
-int nc__rt_rocks_attach(struct nc__rt_rocks *r, RTCDevice dev, RTCScene top)
+int nc__rt_rocks_attach(struct nc__rt_rocks *r, RTCDevice dev, RTCScene top, RTCScene solo)
 {
     for (size_t t = 0; t < r->ntiles; t++) {
         struct nc__rt_rock_tile *tl = &r->tile[t];
-        if (!(tl->inst = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_INSTANCE)))
+        if (!(tl->inst = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_INSTANCE)) ||
+            !(tl->inst_solo = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_INSTANCE)))
             return nc_error(NC_ERENDER, "embree: cannot create a boulder tile's instance");
         rtcSetGeometryInstancedScene(tl->inst, tl->scene);
+        rtcSetGeometryInstancedScene(tl->inst_solo, tl->scene);
         tl->inst_id = rtcAttachGeometry(top, tl->inst);
+        rtcAttachGeometryByID(solo, tl->inst_solo, tl->inst_id);
     }
     return 0;
 }
@@ -367,6 +370,7 @@ void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m)
         int on = 2.0 * r->field->rock[oc->first].half_m >= min_d_m; /* its octave's largest rock */
         if (on != tl->enabled) {
             (on ? rtcEnableGeometry : rtcDisableGeometry)(tl->inst);
+            (on ? rtcEnableGeometry : rtcDisableGeometry)(tl->inst_solo);
             tl->enabled = on;
         }
     }
@@ -388,6 +392,8 @@ void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct 
         xfm[11] = tl->place_m[2] = (float)T.z;
         rtcSetGeometryTransform(tl->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(tl->inst);
+        rtcSetGeometryTransform(tl->inst_solo, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+        rtcCommitGeometry(tl->inst_solo);
     }
 }
 
@@ -397,6 +403,8 @@ void nc__rt_rocks_free(struct nc__rt_rocks *r)
         struct nc__rt_rock_tile *tl = &r->tile[t];
         if (tl->inst)
             rtcReleaseGeometry(tl->inst);
+        if (tl->inst_solo)
+            rtcReleaseGeometry(tl->inst_solo);
         if (tl->geom)
             rtcReleaseGeometry(tl->geom);
         if (tl->scene)

@@ -32,8 +32,8 @@ struct nc__rt_rock_tile {
     unsigned n;
     int octave; /* in the field's octave table */
     RTCScene scene;
-    RTCGeometry geom, inst;
-    unsigned inst_id;   /* in the top-level scene */
+    RTCGeometry geom, inst, inst_solo; /* its instances in the top-level scene and in the rocks' alone */
+    unsigned inst_id;                  /* in both */
     float place_m[3];   /* the instance's translation: its origin from the camera, scene frame */
     int enabled;
 };
@@ -95,8 +95,11 @@ static inline void nc__rt_user_hit(const struct RTCIntersectFunctionNArguments *
 
 /* The tiles of field f, every rock traced until the first cut. */
 int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc__rt_rocks *r);
-/* Each tile's instance, attached to top (tile[k].inst_id). */
-int nc__rt_rocks_attach(struct nc__rt_rocks *r, RTCDevice dev, RTCScene top);
+/* Each tile's instances, attached to top (tile[k].inst_id) and under the
+ * same ID to solo, the scene of every body's rocks alone (shadow rays a
+ * body's grid proves clear of its mesh; camera rays whose mesh hits come
+ * from the bins). */
+int nc__rt_rocks_attach(struct nc__rt_rocks *r, RTCDevice dev, RTCScene top, RTCScene solo);
 /* Trace only rocks of diameter min_d_m or more (0: all). */
 void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m);
 /* The enabled tiles' instances for the body's pose: R body -> scene,

@@ -87,6 +87,16 @@ void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f)
     nc_renderer_free(&r);
 }
 
+void nc_test_asteroid_mesh(int subdivisions, int craters, struct nc_mesh *m)
+{
+    struct nc_asteroid_params p = {.radii_m = {280, 230, 200}, .subdivisions = subdivisions, .seed = 3,
+                                   .craters = craters, .lump_amplitude = 0.1};
+    if (nc_mesh_asteroid(&p, m) < 0) {
+        fprintf(stderr, "asteroid: %s\n", nc_errmsg());
+        exit(2);
+    }
+}
+
 int nc_test_contains(const char *haystack, const char *needle) { return strstr(haystack, needle) != NULL; }
 
 double nc_test_fit_slope(const double *d, size_t n, double lo, double hi)

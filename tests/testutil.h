@@ -37,6 +37,9 @@ void nc_test_scene(const char *yaml, const char *const *sets, int nsets, struct 
 int nc_test_scene_rc(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s);
 /* Render the scene with the given thread count into a newly allocated frame. */
 void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f);
+/* The lumpy test asteroid's mesh (radii 280, 230, 200 m, seed 3) at this
+ * many subdivisions and craters; a failure ends the test. */
+void nc_test_asteroid_mesh(int subdivisions, int craters, struct nc_mesh *m);
 int nc_test_contains(const char *haystack, const char *needle);
 /* The slope b of a cumulative power law N(>D) ~ D^-b truncated to [lo, hi],
  * fitted by maximum likelihood to n diameters. */

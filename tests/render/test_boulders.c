@@ -452,10 +452,8 @@ static void check_frame_count(void)
 
 int main(void)
 {
-    struct nc_asteroid_params p = {.radii_m = {280, 230, 200}, .subdivisions = 5, .seed = 3, .craters = 40,
-                                   .lump_amplitude = 0.1};
     struct nc_mesh m;
-    CHECK(nc_mesh_asteroid(&p, &m) == 0, "asteroid: %s", nc_errmsg());
+    nc_test_asteroid_mesh(5, 40, &m);
     check_population(&m);
     check_determinism(&m);
     nc_mesh_free(&m);

@@ -129,12 +129,8 @@ static void check_render(void)
     /* One point of the largest rock seen from straight above and from 60 m
      * aside: the same shading normal (a function of the rock and the point,
      * not of the camera). */
-    const struct nc_boulder_field *f = &rough.body[0].boulders;
-    size_t big = 0;
-    for (size_t i = 1; i < f->n; i++)
-        if (f->rock[i].half_m > f->rock[big].half_m)
-            big = i;
-    const struct nc_boulder *r = &f->rock[big];
+    const size_t big = 0; /* the list starts with the largest rock */
+    const struct nc_boulder *r = &rough.body[0].boulders.rock[big];
     struct nc_vec3 c0 = nc_v3(r->centre_m[0], r->centre_m[1], r->centre_m[2]), up = nc_v3_unit(c0);
     struct nc_vec3 side = nc_v3_unit(nc_v3_cross(up, nc_v3(0, 0, 1)));
     struct nc_vec3 cam[2] = {nc_v3_add(c0, nc_v3_scale(up, 50)), c0}, hitp = c0;
@@ -168,10 +164,8 @@ static void check_render(void)
 
 int main(void)
 {
-    struct nc_asteroid_params p = {.radii_m = {280, 230, 200}, .subdivisions = 4, .seed = 3, .craters = 20,
-                                   .lump_amplitude = 0.1};
     struct nc_mesh m;
-    CHECK(nc_mesh_asteroid(&p, &m) == 0, "asteroid: %s", nc_errmsg());
+    nc_test_asteroid_mesh(4, 20, &m);
     struct nc_boulder_params bp = {.d_min_m = 1, .d_max_m = 64, .burial_min = 0.1, .burial_max = 0.5, .shapes = 48,
                                    .seed = 5};
     CHECK(nc_boulder_preset("bennu", &bp) == 0, "%s", nc_errmsg());
