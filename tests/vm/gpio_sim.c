@@ -11,7 +11,9 @@
  *   gpio_sim watch VALUEFILE OUT.csv STOPFILE
  *       Read an output line's sysfs `value` every 100 us until STOPFILE
  *       exists; one line per change: "mono_ns,value" (the first line is the
- *       initial value).
+ *       initial value). Where two reads lie more than 5 ms apart (a stalled
+ *       TCG guest: a pulse between them went unseen), OUT.csv.gaps gets a
+ *       line "from_ns,to_ns".
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -79,13 +81,16 @@ static int edges(const char *pull, int n, double period_ms, const char *out)
 
 static int watch(const char *value, const char *out, const char *stop)
 {
+    char gaps_path[4096];
+    snprintf(gaps_path, sizeof gaps_path, "%s.gaps", out);
     int fd = open(value, O_RDONLY);
-    FILE *csv = fopen(out, "w");
-    if (fd < 0 || !csv) {
-        perror(fd < 0 ? value : out);
+    FILE *csv = fopen(out, "w"), *gaps = fopen(gaps_path, "w");
+    if (fd < 0 || !csv || !gaps) {
+        perror(fd < 0 ? value : !csv ? out : gaps_path);
         return 1;
     }
     int last = -1;
+    int64_t prev = 0;
     for (unsigned k = 0;; k++) {
         char c[4];
         if (pread(fd, c, sizeof c, 0) < 1) {
@@ -93,6 +98,9 @@ static int watch(const char *value, const char *out, const char *stop)
             return 1;
         }
         int64_t t = now_ns();
+        if (k > 0 && t - prev > 5000000)
+            fprintf(gaps, "%lld,%lld\n", (long long)prev, (long long)t);
+        prev = t;
         int v = c[0] == '1';
         if (v != last) {
             fprintf(csv, "%lld,%d\n", (long long)t, v);
@@ -103,6 +111,7 @@ static int watch(const char *value, const char *out, const char *stop)
         usleep(100);
     }
     fclose(csv);
+    fclose(gaps);
     close(fd);
     return 0;
 }
