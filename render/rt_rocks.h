@@ -4,7 +4,9 @@
  * (one user geometry whose primitives are its rocks, each referring to its
  * shared shape: 48 bytes in the list, 64 here and 4 of index, plus the
  * tree's share) with its rocks stored relative to the tile's own origin,
- * and an instance in the top-level scene. The tiles' trees are built once:
+ * and two instances: in the top-level scene, and in the scene of the rocks
+ * alone (rt_embree.c: rays proven clear of the meshes, or whose mesh hits
+ * came from the bins, test only the rocks). The tiles' trees are built once:
  * a pose only moves their instances (the float translation from the camera
  * to a tile's origin costs 6e-8 of that distance, a record 6e-8 of its
  * distance from the origin: under 1e-4 of the rock's own size), so nothing
@@ -34,7 +36,7 @@ struct nc__rt_rock_tile {
     RTCScene scene;
     RTCGeometry geom, inst, inst_solo; /* its instances in the top-level scene and in the rocks' alone */
     unsigned inst_id;                  /* in both */
-    float place_m[3];   /* the instance's translation: its origin from the camera, scene frame */
+    float place_m[3];                  /* the instances' translation: its origin from the camera, scene frame */
     int enabled;
 };
 
