@@ -343,19 +343,19 @@ struct tile_counts {
 static void unoccluded16(struct job *j, struct nc_ray16 *shadow, const int *from, int any, int *lit,
                          struct tile_counts *cnt)
 {
-    int occluded[NC_PACKET];
-    int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, shadow, from);
+    int occluded[NC_PACKET] = {0}, blocked[NC_PACKET] = {0}, left = 0;
+    int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, shadow, from, blocked);
     cnt->shadow_culled += (unsigned long)culled;
     cnt->shadow_traced += (unsigned long)(any - culled);
-    if (culled == any) {
-        memset(occluded, 0, sizeof occluded); /* every ray proven: nothing to trace */
-    } else {
+    for (int i = 0; i < NC_PACKET; i++)
+        left |= shadow->valid[i];
+    if (left) { /* else every ray proven lit, or blocked by a rock */
         if (j->r->ray_hook)
             j->r->ray_hook(j->r->ray_hook_user, 1, shadow);
         nc_rt_occluded16(j->rt, shadow, occluded);
     }
     for (int i = 0; i < NC_PACKET; i++)
-        lit[i] = lit[i] && !occluded[i];
+        lit[i] = lit[i] && !occluded[i] && !blocked[i];
 }
 
 /* Direct sunlight at the surface points of s seen along their rays: r[i]

@@ -89,12 +89,14 @@ int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct
                  struct nc_vec3 *n);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
-/* Shadow rays that need no tracing: from[i] >= 0 says ray i leaves the outer
- * side of body from[i] (a surface point whose normal faces both camera and
- * ray). Rays proven to meet nothing (shadow_grid.h for the body's own mesh,
- * the bounding spheres for the others, and where boulders are traced, a
- * trace through the rocks alone) are made inactive; returns how many. */
-int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from);
+/* Shadow rays that need no full trace: from[i] >= 0 says ray i leaves the
+ * outer side of body from[i] (a surface point whose normal faces both
+ * camera and ray). Rays proven clear of every mesh (shadow_grid.h for the
+ * body's own, the bounding spheres for the others) are made inactive; where
+ * boulders are traced they are traced through the rocks alone first, and
+ * one that meets a rock is marked in blocked[i] (which the caller zeroes).
+ * Returns how many were proven to meet nothing. */
+int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked);
 /* Add to the shadow-ray counts of nc_rt_get_stats (callers add a tile's
  * worth at a time: the counters are shared by every render thread). */
 void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced);

@@ -832,7 +832,7 @@ static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct
     return 1;
 }
 
-int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
+int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked)
 {
     int culled = 0, proven[NC_PACKET] = {0};
     int last = -1, ok = 0; /* the direction test, redone when body or direction changes */
@@ -854,8 +854,7 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
     }
     if (culled && rt->rocks_on) {
         /* Clear of every mesh, but rocks may stand in the way: the proven
-         * rays through the rocks alone; one that meets a rock stays to be
-         * traced whole. */
+         * rays through the rocks alone. */
         struct RTCRay16 r __attribute__((aligned(64)));
         struct RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
@@ -865,7 +864,7 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from)
         rtcOccluded16(proven, rt->solo, &ctx, &r);
         for (int i = 0; i < NC_PACKET; i++)
             if (proven[i] && r.tfar[i] == -INFINITY)
-                proven[i] = 0, culled--;
+                blocked[i] = 1, culled--;
     }
     for (int i = 0; i < NC_PACKET; i++)
         if (proven[i])
