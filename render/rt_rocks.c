@@ -23,117 +23,133 @@ static void rock_bounds(const struct RTCBoundsFunctionArguments *a)
     }
 }
 
-/* Four planes at a time (GCC/Clang vector extensions: SSE on x86-64, NEON
- * on arm64, plain code elsewhere). */
-typedef float v4f __attribute__((vector_size(16)));
-typedef int v4i __attribute__((vector_size(16)));
+/* Eight lanes at a time (GCC/Clang vector extensions: one AVX2 register
+ * where the CPU has it, two SSE or NEON ones otherwise; no FMA, so the
+ * same bits on any). */
+#define LANES 8
+typedef float vlf __attribute__((vector_size(4 * LANES)));
+typedef int vli __attribute__((vector_size(4 * LANES)));
 
-static inline v4f load4(const float *p)
+static inline int any_lane(const vli *m)
 {
-    v4f v;
-    memcpy(&v, p, sizeof v);
-    return v;
+    int x[LANES], a = 0;
+    memcpy(x, m, sizeof x);
+    for (int i = 0; i < LANES; i++)
+        a |= x[i];
+    return a;
 }
 
-static inline v4f select4(v4i m, v4f a, v4f b)
-{
-    return (v4f)(((v4i)a & m) | ((v4i)b & ~m));
-}
+/* m ? a : b, lane by lane */
+#define SELECT(m, a, b) ((vlf)(((vli)(a) & (m)) | ((vli)(b) & ~(m))))
 
-static inline float hmax4(v4f v)
-{
-    float x[4];
-    memcpy(x, &v, sizeof x);
-    float a = x[0] > x[1] ? x[0] : x[1], b = x[2] > x[3] ? x[2] : x[3];
-    return a > b ? a : b;
-}
+/* LANES rays: origin, tnear, direction, tfar, valid (-1: on). */
+struct lanes {
+    vlf o[3], tnear, d[3], tfar;
+    vli valid;
+};
 
-static inline float hmin4(v4f v)
-{
-    float x[4];
-    memcpy(x, &v, sizeof x);
-    float a = x[0] < x[1] ? x[0] : x[1], b = x[2] < x[3] ? x[2] : x[3];
-    return a < b ? a : b;
-}
-
-/* The entry of ray (o, d) into rock i within (tnear, tfar): t and the
- * entering plane's normal in the tile's frame; 0 if none (a ray from inside
- * the rock sees nothing of it: rocks are closed and one-sided), or if the
- * rock is below the cut. Planes go four at a time, the box's six first, and
- * the test stops as soon as the ray's interval in the rock is empty. */
-static int rock_hit(const struct nc__rt_rocks *r, size_t i, const float o[3], const float d[3], float tnear,
-                    float tfar, float *t_out, float n_out[3])
+/* The entries of the lanes of p into rock k (list index i) within (tnear,
+ * tfar): for lane l hit (bit l of the result), t[l] and the entering plane
+ * (its index in the shape) plane[l]. None if the rock is below the cut; a
+ * lane from inside the rock sees nothing of it (rocks are closed and
+ * one-sided). Each lane first meets the sphere through the box's corners
+ * (the ray's point nearest the centre, relative to it: no cancellation of
+ * two large squares when the origin is kilometres away), then the planes
+ * clip it (the box's six first), and the test stops when no lane's
+ * interval is left. */
+__attribute__((target_clones("avx2", "default"))) static unsigned
+rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, const struct lanes *p, float *t,
+         int *plane)
 {
     if (i >= r->traced) /* the list is sorted by size: below the cut */
         return 0;
-    const struct nc__rt_rock *k = &r->rock[i];
     const float *M = k->M;
-    const float rel[3] = {o[0] - k->c[0], o[1] - k->c[1], o[2] - k->c[2]};
     const struct nc_rock_shape *sh = &r->field->shape[k->shape];
-    /* The sphere through the box's corners first (|half| rock units, each
-     * 1/|row of M| metres): a ray the tree's box let through that passes
-     * outside it costs no transform. */
-    const float dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], tc = -(rel[0] * d[0] + rel[1] * d[1] + rel[2] * d[2]) / dd;
-    /* the ray's point nearest the centre, relative to it (no cancellation
-     * of two large squares: the origin may be kilometres away) */
-    const float q[3] = {rel[0] + tc * d[0], rel[1] + tc * d[1], rel[2] + tc * d[2]};
+    const vlf rel[3] = {p->o[0] - k->c[0], p->o[1] - k->c[1], p->o[2] - k->c[2]};
+    const vlf dd = p->d[0] * p->d[0] + p->d[1] * p->d[1] + p->d[2] * p->d[2];
+    const vlf tc = -(rel[0] * p->d[0] + rel[1] * p->d[1] + rel[2] * p->d[2]) / dd;
+    const vlf q[3] = {rel[0] + tc * p->d[0], rel[1] + tc * p->d[1], rel[2] + tc * p->d[2]};
     const float m2 = M[0] * M[0] + M[1] * M[1] + M[2] * M[2];
     const float h2 = sh->half[0] * sh->half[0] + sh->half[1] * sh->half[1] + sh->half[2] * sh->half[2];
-    if ((q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) * m2 > 1.01f * h2)
+    vli live = (p->valid == -1) & ~((q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) * m2 > 1.01f * h2);
+    if (!any_lane(&live))
         return 0;
-    float ol[3], dl[3];
-    for (int j = 0; j < 3; j++) { /* t is unchanged by the scale */
+    vlf ol[3], dl[3]; /* in the rock's frame: t is unchanged by the scale */
+    for (int j = 0; j < 3; j++) {
         ol[j] = M[3 * j] * rel[0] + M[3 * j + 1] * rel[1] + M[3 * j + 2] * rel[2];
-        dl[j] = M[3 * j] * d[0] + M[3 * j + 1] * d[1] + M[3 * j + 2] * d[2];
+        dl[j] = M[3 * j] * p->d[0] + M[3 * j + 1] * p->d[1] + M[3 * j + 2] * p->d[2];
     }
-    const v4f ninf = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, pinf = -ninf;
-    v4f t0 = {tnear, tnear, tnear, tnear}, t1 = {tfar, tfar, tfar, tfar};
-    v4f tk[NC_ROCK_PLANES / 4];
-    v4i enters[NC_ROCK_PLANES / 4];
-    for (int g = 0; g < NC_ROCK_PLANES / 4; g++) {
-        v4f nx = load4(sh->nx + 4 * g), ny = load4(sh->ny + 4 * g), nz = load4(sh->nz + 4 * g);
-        v4f den = nx * dl[0] + ny * dl[1] + nz * dl[2];
-        v4f num = load4(sh->d + 4 * g) - (nx * ol[0] + ny * ol[1] + nz * ol[2]);
-        v4f t = num / den;
-        v4i in = den < 0, out = den > 0, miss = (den == 0) & (num < 0); /* parallel, outside */
-        v4f te = select4(in, t, ninf), tx = select4(out, t, pinf);
-        t0 = select4(te > t0, te, t0);
-        t1 = select4(tx < t1, tx, t1);
-        tk[g] = t;
-        enters[g] = in;
-        if ((miss[0] | miss[1] | miss[2] | miss[3]) || !(hmax4(t0) < hmin4(t1)))
+    vlf t0 = p->tnear, t1 = p->tfar;
+    vli enter = live & 0; /* the plane t0 came from */
+    for (int g = 0; g < sh->nplanes; g++) {
+        const vlf den = sh->nx[g] * dl[0] + sh->ny[g] * dl[1] + sh->nz[g] * dl[2];
+        const vlf num = sh->d[g] - (sh->nx[g] * ol[0] + sh->ny[g] * ol[1] + sh->nz[g] * ol[2]);
+        const vlf tg = num / den;
+        const vli in = (den < 0) & (tg > t0), out = (den > 0) & (tg < t1);
+        live &= ~((den == 0) & (num < 0)); /* parallel, outside */
+        t0 = SELECT(in, tg, t0);
+        enter = (in & g) | (enter & ~in);
+        t1 = SELECT(out, tg, t1);
+        if (g % 4 == 3 && (live &= t0 < t1, !any_lane(&live)))
             return 0;
     }
-    const float te = hmax4(t0);
-    if (!(te > tnear))
-        return 0; /* no plane entered past tnear: the ray starts inside */
-    int enter = 0;
-    while (!(enters[enter / 4][enter % 4] && tk[enter / 4][enter % 4] == te))
-        enter++;
-    const float p[3] = {sh->nx[enter], sh->ny[enter], sh->nz[enter]};
-    for (int j = 0; j < 3; j++) /* R p, up to the scale */
-        n_out[j] = M[j] * p[0] + M[3 + j] * p[1] + M[6 + j] * p[2];
-    *t_out = te;
-    return 1;
+    live &= (t0 < t1) & (t0 > p->tnear); /* no plane entered past tnear: the lane starts inside */
+    int lv[LANES], en[LANES];
+    float tt[LANES];
+    memcpy(lv, &live, sizeof lv);
+    memcpy(en, &enter, sizeof en);
+    memcpy(tt, &t0, sizeof tt);
+    unsigned hit = 0;
+    for (int l = 0; l < LANES; l++)
+        if (lv[l]) {
+            hit |= 1u << l;
+            t[l] = tt[l];
+            plane[l] = en[l];
+        }
+    return hit;
 }
 
 /* The rocks' packet callbacks: prim against the valid lanes of ray (width
- * N); a hit is written through hit (intersection) or, without it, ends the
- * lane (occlusion: tfar = -inf). */
+ * N), LANES at a time; a hit is written through hit (intersection) or,
+ * without it, ends the lane (occlusion: tfar = -inf). */
 static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const int *valid, float *ray, unsigned N,
                         const struct RTCIntersectFunctionNArguments *hit)
 {
-    for (unsigned i = 0; i < N; i++) {
-        if (valid[i] != -1)
+    static const int comp[8] = {0, 1, 2, 3, 4, 5, 6, 8}; /* RTCRayN: org, tnear, dir, time, tfar */
+    const size_t i = tl->index[prim];
+    const struct nc__rt_rock *k = &tl->rocks->rock[i];
+    const struct nc_rock_shape *sh = &tl->rocks->field->shape[k->shape];
+    for (unsigned l0 = 0; l0 < N; l0 += LANES) {
+        struct lanes p;
+        float *f[8] = {(float *)&p.o[0], (float *)&p.o[1], (float *)&p.o[2], (float *)&p.tnear,
+                       (float *)&p.d[0], (float *)&p.d[1], (float *)&p.d[2], (float *)&p.tfar};
+        int *v = (int *)&p.valid, any = 0;
+        const unsigned m = N - l0 < LANES ? N - l0 : LANES;
+        memset(&p, 0, sizeof p);
+        memcpy(v, valid + l0, m * sizeof *v);
+        for (unsigned l = 0; l < m; l++)
+            any |= v[l];
+        if (!any)
             continue;
-        struct nc__rt_lane l = nc__rt_lane(ray, N, i);
-        float t, n[3];
-        if (!rock_hit(tl->rocks, tl->index[prim], l.o, l.d, l.tnear, l.tfar, &t, n))
-            continue;
-        if (hit)
-            nc__rt_user_hit(hit, i, t, n);
-        else
-            ray[8 * N + i] = -INFINITY;
+        for (int c = 0; c < 8; c++)
+            memcpy(f[c], ray + comp[c] * N + l0, m * sizeof *ray);
+        float t[LANES];
+        int plane[LANES];
+        const unsigned lanes = rock_hit(tl->rocks, k, i, &p, t, plane);
+        for (unsigned l = 0; l < LANES && lanes; l++) {
+            if (!(lanes >> l & 1))
+                continue;
+            if (!hit) {
+                ray[8 * N + l0 + l] = -INFINITY;
+                continue;
+            }
+            const int e = plane[l];
+            const float *M = k->M, n[3] = {sh->nx[e], sh->ny[e], sh->nz[e]};
+            float nt[3]; /* R n, up to the scale: the tile's frame */
+            for (int j = 0; j < 3; j++)
+                nt[j] = M[j] * n[0] + M[3 + j] * n[1] + M[6 + j] * n[2];
+            nc__rt_user_hit(hit, l0 + l, t[l], nt);
+        }
     }
 }
 
