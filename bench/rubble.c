@@ -5,7 +5,8 @@
  * (over a million rocks), seen along -y from far (6 km: the whole body),
  * medium (1.5 km: the body fills the frame) and close (300 m above the
  * surface, 7 cm pixels). Per range: the frame time of each (median of N
- * frames after one untimed), their ratio; the same with the rocks under
+ * frames; bare, every rock and cut interleaved frame by frame after one
+ * untimed round), their ratio; the same with the rocks under
  * one pixel at the nearest range left out (render.boulder_min_px: 1, the
  * default for this Hapke material), the rocks that leaves and how the
  * frame's brightness moves with them folded into the roughness (cut_flux:
@@ -74,20 +75,31 @@ static double sum(const struct nc_frame *f)
     return s;
 }
 
-static double frame_ms(struct setup *u, int frames)
+/* Frame times, median ms: [0] the bare scene, [1] the rubble one with every
+ * rock traced, [2] with the default cut, interleaved frame by frame so that
+ * the machine's noise hits all three alike. A first round is not timed
+ * (levels and cuts picked, their trees built); a switch of the cut after it
+ * only enables or disables tiles' instances. */
+static void frames_ms(struct setup *bare, struct setup *rubble, int frames, double ms[3])
 {
-    if (nc_render_frame(&u->r, &u->s, &u->f) < 0) /* a level or cut picked: its tree built */
-        die();
-    double *t = calloc((size_t)frames, sizeof *t);
-    for (int i = 0; i < frames; i++) {
-        double a = now_ms();
-        if (nc_render_frame(&u->r, &u->s, &u->f) < 0)
-            die();
-        t[i] = now_ms() - a;
+    double *t = calloc(3 * (size_t)frames, sizeof *t);
+    if (!t) {
+        fprintf(stderr, "bench_rubble: out of memory\n");
+        exit(1);
     }
-    double m = median(t, frames);
+    for (int i = -1; i < frames; i++)
+        for (int k = 0; k < 3; k++) {
+            struct setup *u = k ? rubble : bare;
+            rubble->s.render.boulder_min_px = k == 2;
+            double a = now_ms();
+            if (nc_render_frame(&u->r, &u->s, &u->f) < 0)
+                die();
+            if (i >= 0)
+                t[k * frames + i] = now_ms() - a;
+        }
+    for (int k = 0; k < 3; k++)
+        ms[k] = median(t + k * frames, frames);
     free(t);
-    return m;
 }
 
 /* A pose update that moves the anchor: the camera steps a quarter of its
@@ -141,11 +153,18 @@ int main(int argc, char **argv)
     for (int k = 0; k < 3; k++) {
         place(&bare.s, ranges[k].y_m);
         place(&rubble.s, ranges[k].y_m);
+        double ms[3];
+        frames_ms(&bare, &rubble, frames, ms);
+        const double b = ms[0], r = ms[1], c = ms[2];
         rubble.s.render.boulder_min_px = 0;
-        double b = frame_ms(&bare, frames), r = frame_ms(&rubble, frames), all = sum(&rubble.f);
+        if (nc_render_frame(&rubble.r, &rubble.s, &rubble.f) < 0)
+            die();
+        const double all = sum(&rubble.f);
         double re = reanchor_ms(&rubble, fabs(ranges[k].y_m)), re_bare = reanchor_ms(&bare, fabs(ranges[k].y_m));
         rubble.s.render.boulder_min_px = 1;
-        double c = frame_ms(&rubble, frames), flux = sum(&rubble.f) / all - 1;
+        if (nc_render_frame(&rubble.r, &rubble.s, &rubble.f) < 0)
+            die();
+        double flux = sum(&rubble.f) / all - 1;
         double theta = rubble.r.fold_theta_bar_deg[0];
         struct nc_rt_stats st;
         nc_rt_get_stats(rubble.r.rt, &st);
