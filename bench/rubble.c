@@ -77,10 +77,12 @@ static double sum(const struct nc_frame *f)
 
 /* Frame times, median ms: [0] the bare scene, [1] the rubble one with every
  * rock traced, [2] with the default cut, interleaved frame by frame so that
- * the machine's noise hits all three alike. A first round is not timed
+ * the machine's noise hits all three alike; and the total radiance of the
+ * last frames [1] and [2] in flux[0], flux[1]. A first round is not timed
  * (levels and cuts picked, their trees built); a switch of the cut after it
- * only enables or disables tiles' instances. */
-static void frames_ms(struct setup *bare, struct setup *rubble, int frames, double ms[3])
+ * only enables or disables tiles' instances and folds the material's
+ * roughness again. */
+static void frames_ms(struct setup *bare, struct setup *rubble, int frames, double ms[3], double flux[2])
 {
     double *t = calloc(3 * (size_t)frames, sizeof *t);
     if (!t) {
@@ -96,6 +98,8 @@ static void frames_ms(struct setup *bare, struct setup *rubble, int frames, doub
                 die();
             if (i >= 0)
                 t[k * frames + i] = now_ms() - a;
+            if (k && i == frames - 1)
+                flux[k - 1] = sum(&u->f);
         }
     for (int k = 0; k < 3; k++)
         ms[k] = median(t + k * frames, frames);
@@ -153,21 +157,15 @@ int main(int argc, char **argv)
     for (int k = 0; k < 3; k++) {
         place(&bare.s, ranges[k].y_m);
         place(&rubble.s, ranges[k].y_m);
-        double ms[3];
-        frames_ms(&bare, &rubble, frames, ms);
-        const double b = ms[0], r = ms[1], c = ms[2];
-        rubble.s.render.boulder_min_px = 0;
-        if (nc_render_frame(&rubble.r, &rubble.s, &rubble.f) < 0)
-            die();
-        const double all = sum(&rubble.f);
-        double re = reanchor_ms(&rubble, fabs(ranges[k].y_m)), re_bare = reanchor_ms(&bare, fabs(ranges[k].y_m));
-        rubble.s.render.boulder_min_px = 1;
-        if (nc_render_frame(&rubble.r, &rubble.s, &rubble.f) < 0)
-            die();
-        double flux = sum(&rubble.f) / all - 1;
-        double theta = rubble.r.fold_theta_bar_deg[0];
+        double ms[3], fl[2];
+        frames_ms(&bare, &rubble, frames, ms, fl); /* ends on the cut's frame */
+        const double b = ms[0], r = ms[1], c = ms[2], all = fl[0], flux = fl[1] / all - 1;
+        const double theta = rubble.r.fold_theta_bar_deg[0];
         struct nc_rt_stats st;
         nc_rt_get_stats(rubble.r.rt, &st);
+        rubble.s.render.boulder_min_px = 0; /* the pose updates with every rock */
+        double re = reanchor_ms(&rubble, fabs(ranges[k].y_m)), re_bare = reanchor_ms(&bare, fabs(ranges[k].y_m));
+        rubble.s.render.boulder_min_px = 1;
         rubble.s.render.boulder_fold = 0;
         if (nc_render_frame(&rubble.r, &rubble.s, &rubble.f) < 0)
             die();

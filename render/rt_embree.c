@@ -124,6 +124,20 @@ static int register_inst(struct nc_rt *rt, unsigned id, int body, const struct n
 
 /* ---- analytic ellipsoid (user geometry) ---------------------------------- */
 
+/* Lane i of an Embree ray packet of width N (RTCRayN: origin, tnear,
+ * direction, time, tfar, ... by component), as a user geometry reads it. */
+struct lane {
+    float o[3], d[3], tnear, tfar;
+};
+
+static inline struct lane lane_of(const float *ray, unsigned N, unsigned i)
+{
+    return (struct lane){.o = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]},
+                         .d = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]},
+                         .tnear = ray[3 * N + i],
+                         .tfar = ray[8 * N + i]};
+}
+
 static void ell_bounds(const struct RTCBoundsFunctionArguments *a)
 {
     const struct rt_body *b = a->geometryUserPtr;
@@ -168,7 +182,7 @@ static void ell_intersect(const struct RTCIntersectFunctionNArguments *a)
     for (unsigned i = 0; i < N; i++) {
         if (a->valid[i] != -1)
             continue;
-        struct nc__rt_lane l = nc__rt_lane(ray, N, i);
+        struct lane l = lane_of(ray, N, i);
         double t = ell_hit(b, l.o, l.d, l.tnear, l.tfar);
         if (!(t < INFINITY))
             continue;
@@ -189,7 +203,7 @@ static void ell_occluded(const struct RTCOccludedFunctionNArguments *a)
     for (unsigned i = 0; i < N; i++) {
         if (a->valid[i] != -1)
             continue;
-        struct nc__rt_lane l = nc__rt_lane(ray, N, i);
+        struct lane l = lane_of(ray, N, i);
         if (ell_hit(b, l.o, l.d, l.tnear, l.tfar) < INFINITY)
             ray[8 * N + i] = -INFINITY;
     }

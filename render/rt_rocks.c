@@ -80,7 +80,7 @@ rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, co
         dl[j] = M[3 * j] * p->d[0] + M[3 * j + 1] * p->d[1] + M[3 * j + 2] * p->d[2];
     }
     vlf t0 = p->tnear, t1 = p->tfar;
-    vli enter = live & 0; /* the plane t0 came from */
+    vli enter = {0}; /* the plane t0 came from */
     for (int g = 0; g < sh->nplanes; g++) {
         const vlf den = sh->nx[g] * dl[0] + sh->ny[g] * dl[1] + sh->nz[g] * dl[2];
         const vlf num = sh->d[g] - (sh->nx[g] * ol[0] + sh->ny[g] * ol[1] + sh->nz[g] * ol[2]);

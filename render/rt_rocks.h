@@ -62,21 +62,6 @@ struct nc__rt_rocks {
     double px_rad;    /* the camera's pixel, rad (the finest axis): the relief's footprint */
 };
 
-/* Lane i of an Embree ray packet of width N (RTCRayN: origin, tnear,
- * direction, time, tfar, ... by component), as a user geometry reads it.
- * Shared by the analytic ellipsoid (rt_embree.c) and the rocks. */
-struct nc__rt_lane {
-    float o[3], d[3], tnear, tfar;
-};
-
-static inline struct nc__rt_lane nc__rt_lane(const float *ray, unsigned N, unsigned i)
-{
-    return (struct nc__rt_lane){.o = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]},
-                                .d = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]},
-                                .tnear = ray[3 * N + i],
-                                .tfar = ray[8 * N + i]};
-}
-
 /* A user geometry's hit for lane i of a's packet: tfar = t, geometric
  * normal n (unnormalised, the geometry's frame), ids from a. Shared by the
  * analytic ellipsoid (rt_embree.c) and the rocks. */
