@@ -221,6 +221,10 @@ int main(int argc, char **argv)
                            k < 0 ? "the material has no roughness parameter" : "render.boulder_fold is false");
                 else
                     printf("\n");
+                if (st.boulder_mesh_px[i] > 0)
+                    printf("  rough rocks spanning %g px or more traced as detailed surfaces (%zu triangles a "
+                           "shape, %.3g effective)\n", st.boulder_mesh_px[i], nc_rt_rock_mesh_triangles(r.rt, i),
+                           (double)nc_rt_rock_mesh_triangles(r.rt, i) * (double)st.boulders_traced[i]);
             }
         if (scale > 0)
             printf("  16-bit preview: 65535 = %.6g %s\n", scale, nc_quantity_units(q));

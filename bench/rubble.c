@@ -2,7 +2,9 @@
  *
  * The default scene (its asteroid, Hapke, shadows, 4 samples per pixel,
  * 1024x1024) bare and covered with the Bennu boulder preset down to 0.45 m
- * (over a million rocks), seen along -y from far (6 km: the whole body),
+ * (over a million rocks, faces 20 deg rough; those of 64 pixels or more at
+ * their distance traced as detailed surfaces of 5120 triangles: the
+ * effective triangles are the rocks times that), seen along -y from far (6 km: the whole body),
  * medium (1.5 km: the body fills the frame) and close (300 m above the
  * surface, 7 cm pixels). Per range: the frame time of each (median of N
  * frames; bare, every rock and cut interleaved frame by frame after one
@@ -16,7 +18,8 @@
  * scene and its renderer take beyond the bare ones.
  * Usage: bench_rubble [--frames N] [--threads N]
  * One line per range:
- *   range=far ... bare_ms=... rubble_ms=... ratio=... memory_mb=... cut_ms=... cut_ratio=... traced=...
+ *   range=far ... bare_ms=... rubble_ms=... ratio=... memory_mb=... rocks=... effective_triangles=...
+ *   cut_ms=... cut_ratio=... traced=...
  *   theta_bar=... cut_flux=... unfolded_flux=... reanchor_ms=...
  */
 #include <math.h>
@@ -135,14 +138,17 @@ int main(int argc, char **argv)
         return status;
     struct setup bare, rubble;
     setup(NULL, 0, threads, &bare);
-    const char *sets[] = {"bodies.0.boulders={preset: bennu, min_diameter_m: 0.45}"};
+    const char *sets[] = {"bodies.0.boulders={preset: bennu, min_diameter_m: 0.45, roughness_deg: 20}"};
     double t0 = now_ms();
     setup(sets, 1, threads, &rubble);
     const struct nc_boulder_field *f = &rubble.s.body[0].boulders;
-    printf("bench_rubble: %zu triangles; %zu rocks of 0.45 to 64 m (Bennu preset), %d shapes, set up in %.0f ms; "
+    const double tri = (double)nc_rt_rock_mesh_triangles(rubble.r.rt, 0);
+    printf("bench_rubble: %zu triangles; %zu rocks of 0.45 to 64 m (Bennu preset, faces 20 deg rough), %d shapes, "
+           "each a detailed surface of %.0f triangles from %g px: %.3g effective triangles; set up in %.0f ms; "
            "%dx%d, %d samples/pixel, %d threads, median of %d frames\n",
-           rubble.s.body[0].mesh.nt, f->n, f->nshapes, now_ms() - t0, rubble.s.camera.width_px,
-           rubble.s.camera.height_px, rubble.s.render.samples_per_pixel, rubble.r.threads, frames);
+           rubble.s.body[0].mesh.nt, f->n, f->nshapes, tri, rubble.s.render.boulder_mesh_px, tri * (double)f->n,
+           now_ms() - t0, rubble.s.camera.width_px, rubble.s.camera.height_px, rubble.s.render.samples_per_pixel,
+           rubble.r.threads, frames);
     /* the surface along -y: the body's extent there */
     double surface = 0;
     for (size_t i = 0; i < rubble.s.body[0].mesh.nv; i++) {
@@ -171,9 +177,11 @@ int main(int argc, char **argv)
             die();
         double unfolded = sum(&rubble.f) / all - 1;
         rubble.s.render.boulder_fold = 1;
-        printf("range=%s distance_m=%.0f bare_ms=%.1f rubble_ms=%.1f ratio=%.2f memory_mb=%.1f rocks=%zu cut_ms=%.1f "
+        printf("range=%s distance_m=%.0f bare_ms=%.1f rubble_ms=%.1f ratio=%.2f memory_mb=%.1f rocks=%zu "
+               "effective_triangles=%.3g cut_ms=%.1f "
                "cut_ratio=%.2f traced=%zu min_d_m=%.3f theta_bar=%.2f cut_flux=%+.4f unfolded_flux=%+.4f reanchor_ms=%.1f reanchor_bare_ms=%.1f\n",
-               ranges[k].name, fabs(ranges[k].y_m), b, r, r / b, rubble.mem_mb - bare.mem_mb, f->n, c, c / b,
+               ranges[k].name, fabs(ranges[k].y_m), b, r, r / b, rubble.mem_mb - bare.mem_mb, f->n,
+               tri * (double)f->n, c, c / b,
                st.boulders_traced[0], st.boulder_min_m[0], theta, flux, unfolded, re, re_bare);
         fflush(stdout);
     }

@@ -146,9 +146,10 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     info->stars_ms = t2 - ts0;
     nc_frame_flip(&f, scene->camera.flip_rows, scene->camera.flip_cols);
     /* Levels of detail and the smallest boulder traced (0: every rock). */
-    char lod[40], rocks[40];
+    char lod[40], rocks[40], mesh[40];
     snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r->rt));
     snprintf(rocks, sizeof rocks, "%.17g", nc_rt_boulder_min_m(r->rt));
+    snprintf(mesh, sizeof mesh, "%.17g", nc_rt_boulder_mesh_px(r->rt));
     /* How each mesh is shaded: name=flat or name=smooth, comma-separated. */
     char normals[NC_MAX_BODIES * 72] = "";
     for (int i = 0, o = 0; i < scene->nbodies; i++)
@@ -163,8 +164,9 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
                           r->fold_theta_bar_deg[i]);
     char flip[40];
     snprintf(flip, sizeof flip, "rows=%d columns=%d", scene->camera.flip_rows, scene->camera.flip_cols);
-    struct nc_image_attr extra[24] = {{"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}};
-    int nextra = 2;
+    struct nc_image_attr extra[24] = {
+        {"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {"navcam:boulder_mesh_px", mesh}};
+    int nextra = 3;
     if (suninfo[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:sun_view", suninfo};
     if (starinfo[0])

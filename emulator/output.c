@@ -91,7 +91,7 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
         "\"sun\": [%.17g, %.17g, %.17g], \"sun_is_position\": %s, \"body\": %s, "
         "\"body_position_m\": [%.17g, %.17g, %.17g], \"body_attitude_q\": [%.17g, %.17g, %.17g, %.17g]}, "
         "\"exposure_s\": %.17g, \"gain_db\": %.17g, \"time_samples\": %d, \"lod_error_m\": %.17g, "
-        "\"boulder_min_m\": %.17g, \"rock_fold_theta_bar_deg\": %.17g, "
+        "\"boulder_min_m\": %.17g, \"boulder_mesh_px\": %.17g, \"rock_fold_theta_bar_deg\": %.17g, "
         "\"render\": {\"quality\": \"%s\", \"samples_per_pixel\": %d, \"bounces\": %d, \"soft_shadows\": %s}, %s%s"
         "\"width_px\": %d, \"height_px\": %d, \"adc_bits\": %d}",
         (unsigned long long)r->frame, r->request_sequence, r->trigger_source, (long long)r->trigger_sim_ns,
@@ -101,7 +101,7 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
         p->sun.x, p->sun.y, p->sun.z, p->sun_is_position ? "true" : "false", p->has_body ? "true" : "false",
         p->body_position_m.x, p->body_position_m.y, p->body_position_m.z, p->body_attitude_q.w, p->body_attitude_q.x,
         p->body_attitude_q.y, p->body_attitude_q.z, r->exposure_s, r->gain_db, r->time_samples, r->lod_error_m, r->boulder_min_m,
-        r->rock_fold_theta_bar_deg, r->quality_auto ? "auto" : "manual", r->samples_per_pixel, r->bounces,
+        r->boulder_mesh_px, r->rock_fold_theta_bar_deg, r->quality_auto ? "auto" : "manual", r->samples_per_pixel, r->bounces,
         r->soft_shadows ? "true" : "false", stars, ms, r->width_px,
         r->height_px, r->adc_bits);
     return n >= 0 && (size_t)n < len ? n : -1;

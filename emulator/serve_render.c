@@ -147,7 +147,7 @@ struct staged {
     enum nc_pose_quality q;
     int64_t gap, t0, t1; /* render start and end, CLOCK_MONOTONIC */
     int rc, ts, buf;
-    double lod_error_m, boulder_min_m, rock_fold_theta_bar_deg;
+    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg;
     struct nc_sky_stats stars;
     struct nc_sun_view sun;
     struct nc_render_settings used; /* render.quality: auto's choice, or the scene's */
@@ -212,6 +212,7 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = x->pose,
         .pose_quality = x->q, .pose_gap_ns = x->gap, .exposure_s = j->exposure_s, .gain_db = j->gain_db,
         .time_samples = x->ts, .lod_error_m = x->lod_error_m, .boulder_min_m = x->boulder_min_m,
+        .boulder_mesh_px = x->boulder_mesh_px,
         .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .samples_per_pixel = x->used.samples_per_pixel,
         .bounces = x->used.bounces, .soft_shadows = x->used.soft_shadows, .quality_auto = x->used.quality_auto,
         .stars_on = e->sky.on, .star_limit_mag = x->stars.limit_mag, .stars_drawn = x->stars.drawn,
@@ -320,6 +321,7 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         x.t1 = nc_mono_ns();
         x.lod_error_m = nc_rt_lod_error_m(e->renderer.rt);
         x.boulder_min_m = nc_rt_boulder_min_m(e->renderer.rt);
+        x.boulder_mesh_px = nc_rt_boulder_mesh_px(e->renderer.rt);
         x.rock_fold_theta_bar_deg = nc_render_fold_theta_bar_deg(&e->renderer, at.nbodies);
         if (overlap) {
             atomic_store(&e->readout_end_ns, 0); /* the next exposure may start rendering */

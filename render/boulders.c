@@ -13,6 +13,7 @@
 /* Stream tags, so that shapes and faces never share a stream. */
 #define TAG_SHAPE 0x5348415045ull
 #define TAG_RELIEF 0x52454c49454full
+#define TAG_MESH 0x4d455348ull
 #define OCTAVE_MIN NC_BOULDER_OCTAVE_MIN
 #define OCTAVE_MAX NC_BOULDER_OCTAVE_MAX
 
@@ -226,6 +227,36 @@ void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double 
         nc_noise3_grad(seed + (uint64_t)o, fr * p[0], fr * p[1], fr * p[2], go);
         g[0] += a * go[0], g[1] += a * go[1], g[2] += a * go[2];
     }
+}
+
+int nc_rock_shape_mesh(const struct nc_boulder_field *f, int s, int subdivisions, struct nc_mesh *out)
+{
+    if (s < 0 || s >= f->nshapes || !(f->relief[0] > 0))
+        return nc_error(NC_ERANGE, "rock shape %d: no such shape, or flat faces (roughness_deg 0)", s);
+    const struct nc_asteroid_params ap = {.radii_m = {1, 1, 1}, .subdivisions = subdivisions};
+    int rc = nc_mesh_asteroid(&ap, out); /* no lumps, no craters: an icosphere */
+    if (rc < 0)
+        return rc;
+    const struct nc_rock_shape *sh = &f->shape[s];
+    const uint64_t seed = nc_rng_seed(f->params.seed, TAG_MESH, (uint64_t)s);
+    for (size_t i = 0; i < out->nv; i++) {
+        double *v = out->v + 3 * i, n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]), u[3], t = INFINITY;
+        for (int k = 0; k < 3; k++)
+            u[k] = v[k] / n;
+        for (int g = 0; g < sh->nplanes; g++) { /* the nearest plane along u (the centre is inside all) */
+            double c = sh->nx[g] * u[0] + sh->ny[g] * u[1] + sh->nz[g] * u[2];
+            if (c > 0)
+                t = fmin(t, sh->d[g] / c);
+        }
+        double p[3] = {t * u[0], t * u[1], t * u[2]}, h = 0;
+        for (int o = 0; o < NC_ROCK_RELIEF_OCTAVES; o++) {
+            const double fr = relief_freq(o); /* height (a / fr) noise: gradient a grad(noise), as the shading's */
+            h += f->relief[o] / fr * nc_noise3(seed + (uint64_t)o, fr * p[0], fr * p[1], fr * p[2]);
+        }
+        for (int k = 0; k < 3; k++) /* only inward: the surface stays within the planes */
+            v[k] = p[k] + fmin(h, 0) * u[k];
+    }
+    return 0;
 }
 
 int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params *p, size_t max_rocks,

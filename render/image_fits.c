@@ -56,6 +56,7 @@ static const char *const fits_keys[][2] = {
     {"navcam:fits_row_order", "ROWORDER"},
     {"navcam:lod_error_m", "LODERR"},
     {"navcam:boulder_min_m", "ROCKMIN"},
+    {"navcam:boulder_mesh_px", "ROCKMESH"},
     {"navcam:normals", "NORMALS"},
     {"navcam:rock_fold_theta_bar_deg", "ROCKFOLD"},
     {"navcam:stars", "STARS"},

@@ -46,6 +46,9 @@ struct nc_rt_stats {
     /* ... and the cover of the rocks left out (nc_boulders_cover), which
      * the reflectance folds in (nc_material_fold_rocks). */
     double boulder_cut_cover[NC_MAX_BODIES];
+    /* ... and render.boulder_mesh_px where its rocks have detailed
+     * surfaces (rough faces), else 0. */
+    double boulder_mesh_px[NC_MAX_BODIES];
     /* Since creation, as the renderer reports them (nc_rt_count_shadow_rays):
      * shadow rays proven unoccluded (nc_rt_shadow_cull16), and traced. */
     unsigned long shadow_rays_culled, shadow_rays_traced;
@@ -107,6 +110,11 @@ double nc_rt_lod_error_m(const struct nc_rt *rt);
 /* The largest of the bodies' smallest boulder diameters traced at the last
  * update, metres (0: every rock of every body, or no boulders). */
 double nc_rt_boulder_min_m(const struct nc_rt *rt);
+/* The largest of the bodies' boulder_mesh_px at the last update (0: no rock
+ * is traced as a detailed surface). */
+double nc_rt_boulder_mesh_px(const struct nc_rt *rt);
+/* Triangles of each detailed rock surface of body b (0: none). */
+size_t nc_rt_rock_mesh_triangles(const struct nc_rt *rt, int b);
 
 /* For benchmarks: Embree alone on pre-built native packets. The packets are
  * converted once (untimed); nc_rt_batch_trace() then only resets each packet

@@ -533,8 +533,9 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
              * sphere), like the level of detail a function of the pose. */
             nc__rt_rocks_cut(&b->rocks, nc_scene_boulder_min_px(s, i) * px_m);
             nc__rt_rocks_place(&b->rocks, &R, b->origin_rel);
-            b->rocks.px_rad = 1 / fmax(s->camera.fx_px, s->camera.fy_px);
+            nc__rt_rocks_mesh_px(&b->rocks, s->render.boulder_mesh_px, 1 / fmax(s->camera.fx_px, s->camera.fy_px));
             rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
+            rt->stats.boulder_mesh_px[i] = b->rocks.mesh_k2 > 0 ? s->render.boulder_mesh_px : 0;
             rt->stats.boulders_traced[i] = b->rocks.traced;
             rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
             rt->rocks_on |= b->rocks.traced > 0;
@@ -660,7 +661,7 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
         size_t k = tl->index[prim];
         alb = nc_albedo_var_rock(&b->src->albedo_var, k);
         rock = (int32_t)k;
-        if (b->src->boulders.relief[0] > 0)
+        if (b->src->boulders.relief[0] > 0 && u == 0) /* u 1: the detailed surface's, relief and all */
             rock_relief(b, tl, k, t, ray, i, &x, &y, &z);
     }
     hit->albedo[i] = alb;
@@ -931,6 +932,19 @@ double nc_rt_boulder_min_m(const struct nc_rt *rt)
     for (int i = 0; i < rt->nbodies; i++)
         d = fmax(d, rt->stats.boulder_min_m[i]);
     return d;
+}
+
+double nc_rt_boulder_mesh_px(const struct nc_rt *rt)
+{
+    double d = 0;
+    for (int i = 0; i < rt->nbodies; i++)
+        d = fmax(d, rt->stats.boulder_mesh_px[i]);
+    return d;
+}
+
+size_t nc_rt_rock_mesh_triangles(const struct nc_rt *rt, int b)
+{
+    return b >= 0 && b < rt->nbodies ? rt->body[b].rocks.mesh_triangles : 0;
 }
 
 /* ---- raw batches (benchmarks) --------------------------------------------- */

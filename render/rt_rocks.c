@@ -56,10 +56,12 @@ struct lanes {
  * (the ray's point nearest the centre, relative to it: no cancellation of
  * two large squares when the origin is kilometres away), then the planes
  * clip it (the box's six first), and the test stops when no lane's
- * interval is left. */
+ * interval is left. With mesh set (a rock traced as its detailed surface,
+ * which lies within the planes), a lane from inside counts from tnear, and
+ * t_out[l] is where the lane leaves. */
 __attribute__((target_clones("avx2", "default"))) static unsigned
-rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, const struct lanes *p, float *t,
-         int *plane)
+rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, const struct lanes *p, int mesh,
+         float *t, float *t_out, int *plane)
 {
     if (i >= r->traced) /* the list is sorted by size: below the cut */
         return 0;
@@ -93,17 +95,21 @@ rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, co
         if (g % 4 == 3 && (live &= t0 < t1, !any_lane(&live)))
             return 0;
     }
-    live &= (t0 < t1) & (t0 > p->tnear); /* no plane entered past tnear: the lane starts inside */
+    live &= t0 < t1;
+    if (!mesh)
+        live &= t0 > p->tnear; /* no plane entered past tnear: the lane starts inside */
     int lv[LANES], en[LANES];
-    float tt[LANES];
+    float tt[LANES], te[LANES];
     memcpy(lv, &live, sizeof lv);
     memcpy(en, &enter, sizeof en);
     memcpy(tt, &t0, sizeof tt);
+    memcpy(te, &t1, sizeof te);
     unsigned hit = 0;
     for (int l = 0; l < LANES; l++)
         if (lv[l]) {
             hit |= 1u << l;
             t[l] = tt[l];
+            t_out[l] = te[l];
             plane[l] = en[l];
         }
     return hit;
@@ -111,14 +117,23 @@ rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, co
 
 /* The rocks' packet callbacks: prim against the valid lanes of ray (width
  * N), LANES at a time; a hit is written through hit (intersection) or,
- * without it, ends the lane (occlusion: tfar = -inf). */
+ * without it, ends the lane (occlusion: tfar = -inf). A rock resolved by
+ * enough pixels at its distance from the camera (the same for every ray of
+ * a frame: camera, shadow) is traced as its detailed surface, its hits
+ * marked by u = 1 (no shading relief: the relief is in the geometry). */
 static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const int *valid, float *ray, unsigned N,
                         const struct RTCIntersectFunctionNArguments *hit)
 {
     static const int comp[8] = {0, 1, 2, 3, 4, 5, 6, 8}; /* RTCRayN: org, tnear, dir, time, tfar */
     const size_t i = tl->index[prim];
-    const struct nc__rt_rock *k = &tl->rocks->rock[i];
-    const struct nc_rock_shape *sh = &tl->rocks->field->shape[k->shape];
+    const struct nc__rt_rocks *r = tl->rocks;
+    const struct nc__rt_rock *k = &r->rock[i];
+    const struct nc_rock_shape *sh = &r->field->shape[k->shape];
+    int mesh = 0;
+    if (r->mesh_k2 > 0) { /* (2 half)^2 >= k2 dist^2, half = 1 / |M's row| */
+        const float *M = k->M, dx = k->c[0] - tl->cam_m[0], dy = k->c[1] - tl->cam_m[1], dz = k->c[2] - tl->cam_m[2];
+        mesh = 4.0f >= r->mesh_k2 * (dx * dx + dy * dy + dz * dz) * (M[0] * M[0] + M[1] * M[1] + M[2] * M[2]);
+    }
     for (unsigned l0 = 0; l0 < N; l0 += LANES) {
         struct lanes p;
         float *f[8] = {(float *)&p.o[0], (float *)&p.o[1], (float *)&p.o[2], (float *)&p.tnear,
@@ -133,22 +148,30 @@ static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const 
             continue;
         for (int c = 0; c < 8; c++)
             memcpy(f[c], ray + comp[c] * N + l0, m * sizeof *ray);
-        float t[LANES];
+        float t[LANES], t1[LANES];
         int plane[LANES];
-        const unsigned lanes = rock_hit(tl->rocks, k, i, &p, t, plane);
+        const unsigned lanes = rock_hit(r, k, i, &p, mesh, t, t1, plane);
         for (unsigned l = 0; l < LANES && lanes; l++) {
             if (!(lanes >> l & 1))
                 continue;
+            float n[3];
+            if (mesh) {
+                const float o[3] = {p.o[0][l], p.o[1][l], p.o[2][l]}, d[3] = {p.d[0][l], p.d[1][l], p.d[2][l]};
+                if (!nc__rt_rock_mesh_hit(r, k, o, d, p.tnear[l], p.tfar[l], t[l], t1[l], &t[l], hit ? n : NULL))
+                    continue;
+            } else if (hit)
+                n[0] = sh->nx[plane[l]], n[1] = sh->ny[plane[l]], n[2] = sh->nz[plane[l]];
             if (!hit) {
                 ray[8 * N + l0 + l] = -INFINITY;
                 continue;
             }
-            const int e = plane[l];
-            const float *M = k->M, n[3] = {sh->nx[e], sh->ny[e], sh->nz[e]};
+            const float *M = k->M;
             float nt[3]; /* R n, up to the scale: the tile's frame */
             for (int j = 0; j < 3; j++)
                 nt[j] = M[j] * n[0] + M[3 + j] * n[1] + M[6 + j] * n[2];
             nc__rt_user_hit(hit, l0 + l, t[l], nt);
+            if (mesh)
+                ((float *)hit->rayhit)[12 * N + 3 * N + l0 + l] = 1.0f; /* u: a detailed surface's hit */
         }
     }
 }
@@ -278,6 +301,9 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
 {
     memset(r, 0, sizeof *r);
     r->field = f;
+    int rc = nc__rt_rock_meshes(dev, r);
+    if (rc < 0)
+        return rc;
     if (!(r->rock = aligned_alloc(64, (f->n ? f->n : 1) * sizeof *r->rock)) ||
         !(r->index = malloc((f->n ? f->n : 1) * sizeof *r->index)))
         return nc_error(-ENOMEM, "out of memory for %zu boulders", f->n);
@@ -311,7 +337,6 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
         return nc_error(-ENOMEM, "out of memory for %zu boulders' tiles", f->n);
     }
     size_t at = 0;
-    int rc = 0;
     for (int k = 0; k < f->noctaves && rc == 0; k++) {
         const struct nc_boulder_octave *oc = &f->octave[k];
         const double S = tile_size_m(oc->j);
@@ -406,6 +431,8 @@ void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct 
             nc_v3_add(nc_mat_mul_v(R, nc_v3(tl->origin_m[0], tl->origin_m[1], tl->origin_m[2])), origin_rel);
         xfm[9] = tl->place_m[0] = (float)T.x, xfm[10] = tl->place_m[1] = (float)T.y;
         xfm[11] = tl->place_m[2] = (float)T.z;
+        const struct nc_vec3 cam = nc_mat_tmul_v(R, nc_v3_scale(T, -1)); /* R^T (camera - tile origin) */
+        tl->cam_m[0] = (float)cam.x, tl->cam_m[1] = (float)cam.y, tl->cam_m[2] = (float)cam.z;
         rtcSetGeometryTransform(tl->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
         rtcCommitGeometry(tl->inst);
         rtcSetGeometryTransform(tl->inst_solo, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
@@ -426,6 +453,7 @@ void nc__rt_rocks_free(struct nc__rt_rocks *r)
         if (tl->scene)
             rtcReleaseScene(tl->scene);
     }
+    nc__rt_rock_meshes_free(r);
     free(r->tile);
     free(r->rock);
     free(r->index);

@@ -37,6 +37,7 @@ struct nc__rt_rock_tile {
     RTCGeometry geom, inst, inst_solo; /* its instances in the top-level scene and in the rocks' alone */
     unsigned inst_id;                  /* in both */
     float place_m[3];                  /* the instances' translation: its origin from the camera, scene frame */
+    float cam_m[3];                    /* the camera from its origin, body frame */
     int enabled;
 };
 
@@ -60,6 +61,14 @@ struct nc__rt_rocks {
     size_t traced;    /* rocks at or above the cut: rock[0 .. traced) */
     double cut_cover; /* nc_boulders_cover() of the rocks below the cut */
     double px_rad;    /* the camera's pixel, rad (the finest axis): the relief's footprint */
+    /* Rocks resolved by render.boulder_mesh_px pixels or more at their
+     * centre's distance from the camera are traced as their shape's
+     * detailed surface (nc_rock_shape_mesh: the relief in geometry, within
+     * the planes), the others as flat-faced polyhedra. mesh[] is NULL for
+     * flat-faced rocks (roughness_deg 0). */
+    RTCScene *mesh;
+    size_t mesh_triangles; /* each shape's surface */
+    float mesh_k2;         /* (boulder_mesh_px * px_rad)^2, 0: no rock is */
 };
 
 /* A user geometry's hit for lane i of a's packet: tfar = t, geometric
@@ -87,11 +96,31 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
  * body's grid proves clear of its mesh; camera rays whose mesh hits come
  * from the bins). */
 int nc__rt_rocks_attach(struct nc__rt_rocks *r, RTCDevice dev, RTCScene top, RTCScene solo);
+/* Rocks spanning mesh_px pixels (of px_rad) or more at their distance from
+ * the camera are traced as detailed surfaces (0: none). */
+static inline void nc__rt_rocks_mesh_px(struct nc__rt_rocks *r, double mesh_px, double px_rad)
+{
+    r->px_rad = px_rad;
+    r->mesh_k2 = r->mesh ? (float)(mesh_px * px_rad * mesh_px * px_rad) : 0.0f;
+}
 /* Trace only rocks of diameter min_d_m or more (0: all). */
 void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m);
 /* The enabled tiles' instances for the body's pose: R body -> scene,
  * origin_rel the body origin relative to the camera (scene frame). */
 void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct nc_vec3 origin_rel);
 void nc__rt_rocks_free(struct nc__rt_rocks *r);
+
+/* rt_rock_mesh.c: each shape's detailed surface (r->mesh), built when the
+ * rocks' faces are rough; and their release. */
+int nc__rt_rock_meshes(RTCDevice dev, struct nc__rt_rocks *r);
+void nc__rt_rock_meshes_free(struct nc__rt_rocks *r);
+/* The ray o + t d (tile frame) through rock k's detailed surface within
+ * [t0, t1], its interval in the rock's planes, widened by 1e-3 of the
+ * rock's half size (where the surface lies on a plane, the float rays
+ * through the two may part by a few ulps) and kept within (tnear, tfar):
+ * whether it meets it, and where (*t) with which geometric normal n (rock
+ * frame, unnormalised); occlusion only if n is NULL. */
+int nc__rt_rock_mesh_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, const float o[3],
+                         const float d[3], float tnear, float tfar, float t0, float t1, float *t, float *n);
 
 #endif

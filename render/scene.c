@@ -226,6 +226,7 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     r->lod_error_px = 0;
     r->boulder_min_px = -1;
     r->boulder_fold = 1;
+    r->boulder_mesh_px = 64;
     r->soft_shadows = 0;
     r->bounces = 0;
     r->roulette_after = 2;
@@ -250,7 +251,8 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
         r->threads = (int)v;
     if ((rc = nc_cfg_double(map, "lod_error_px", 0, 100, &r->lod_error_px)) < 0)
         return rc;
-    if ((rc = nc_cfg_double(map, "boulder_min_px", 0, 1000, &r->boulder_min_px)) < 0)
+    if ((rc = nc_cfg_double(map, "boulder_min_px", 0, 1000, &r->boulder_min_px)) < 0 ||
+        (rc = nc_cfg_double(map, "boulder_mesh_px", 0, 100000, &r->boulder_mesh_px)) < 0)
         return rc;
     static const char *const bools[] = {"false", "true", NULL};
     if ((rc = nc_cfg_enum(map, "boulder_fold", bools, &r->boulder_fold)) < 0 ||

@@ -69,6 +69,11 @@ struct nc_render_settings {
      * reflectance, 0 for others (nc_scene_boulder_min_px). */
     double boulder_min_px;
     int boulder_fold; /* 1 (default): fold the rocks not traced into the reflectance */
+    /* Rough-faced boulders spanning at least this many pixels at their
+     * distance from the camera are traced as detailed surfaces (the relief
+     * in geometry), the others as flat-faced polyhedra with the relief in
+     * their shading; 0 = never. */
+    double boulder_mesh_px;
     int soft_shadows; /* 1: shadow rays toward points of the solar disk (penumbrae); 0: its centre */
     /* Indirect light: path vertices after the camera ray's (0: direct
      * sunlight only), and how many are traced before Russian roulette. */

@@ -39,20 +39,32 @@ static void check_slope(const struct nc_boulder_field *f, double deg)
     CHECK(diff > 0.99 * n, "two rocks share their relief at %.0f of %d points", n - diff, n);
 }
 
-/* A close frame of the test asteroid: 0.15 m pixels, rocks of 2 m and more. */
-static void render_close(double deg, int threads, struct nc_scene *s, struct nc_frame *f)
+/* A close frame of the test asteroid: 0.15 m pixels, rocks of 2 m and more,
+ * those of mesh_px pixels or more as detailed surfaces (0: none). */
+static void render_close(double deg, double mesh_px, int threads, struct nc_scene *s, struct nc_frame *f)
 {
-    char rocks[160];
+    char rocks[160], mesh[64];
     snprintf(rocks, sizeof rocks, "bodies[0].boulders={preset: bennu, min_diameter_m: 2, seed: 3, roughness_deg: %g}",
              deg);
-    const char *sets[] = {rocks, "camera.position_m=[0, -400, 0]", "render.samples_per_pixel=1"};
-    nc_test_scene(nc_test_asteroid_yaml, sets, 3, s);
+    snprintf(mesh, sizeof mesh, "render.boulder_mesh_px=%g", mesh_px);
+    const char *sets[] = {rocks, "camera.position_m=[0, -400, 0]", "render.samples_per_pixel=1", mesh};
+    nc_test_scene(nc_test_asteroid_yaml, sets, 4, s);
     struct nc_renderer r;
     const int W = s->camera.width_px, H = s->camera.height_px;
     CHECK(nc_renderer_init(&r, s, threads) == 0 && nc_frame_alloc(f, W, H) == 0 &&
               (f->rock_id = malloc((size_t)W * H * sizeof *f->rock_id)) != NULL && nc_render_frame(&r, s, f) == 0,
           "%s", nc_errmsg());
     nc_renderer_free(&r);
+}
+
+/* Three close frames: a reference (deg0, mesh0 on 2 threads) and the case
+ * (deg1, mesh1) on 2 threads and on 1. */
+static void render_trio(double deg0, double mesh0, double deg1, double mesh1, struct nc_scene s[3],
+                        struct nc_frame f[3])
+{
+    render_close(deg0, mesh0, 2, &s[0], &f[0]);
+    render_close(deg1, mesh1, 2, &s[1], &f[1]);
+    render_close(deg1, mesh1, 1, &s[2], &f[2]);
 }
 
 /* Texture on a face: over neighbouring pixel pairs (along rows and
@@ -91,11 +103,11 @@ static double rock_mean(const struct nc_frame *flat, const struct nc_frame *f)
 
 static void check_render(void)
 {
-    struct nc_scene flat, rough, rough1;
-    struct nc_frame a, b, c;
-    render_close(0, 2, &flat, &a);
-    render_close(25, 2, &rough, &b);
-    render_close(25, 1, &rough1, &c);
+    struct nc_scene sc[3];
+    struct nc_frame fr[3];
+    render_trio(0, 0, 25, 0, sc, fr); /* flat faces; the relief in the shading */
+    struct nc_scene *rough = &sc[1];
+    struct nc_frame a = fr[0], b = fr[1], c = fr[2];
     size_t n = (size_t)a.width_px * a.height_px, rock = 0, ground = 0, rock_changed = 0, ground_changed = 0,
            id_changed = 0;
     for (size_t i = 0; i < n; i++) {
@@ -123,22 +135,22 @@ static void check_render(void)
     CHECK(pairs > 1000 && tex_b > 0.02, "face texture %g over %zu pairs", tex_b, pairs);
     CHECK(fabs(mean) < 0.1, "the relief changes the rocks' mean by %+.2f %%", 100 * mean);
     nc_frame_free(&a), nc_frame_free(&b), nc_frame_free(&c);
-    nc_scene_free(&flat), nc_scene_free(&rough1);
+    nc_scene_free(&sc[0]), nc_scene_free(&sc[2]);
 
     /* One point of the largest rock seen from straight above and from 60 m
      * aside: the same shading normal (a function of the rock and the point,
      * not of the camera). */
     const size_t big = 0; /* the list starts with the largest rock */
-    const struct nc_boulder *r = &rough.body[0].boulders.rock[big];
+    const struct nc_boulder *r = &rough->body[0].boulders.rock[big];
     struct nc_vec3 c0 = nc_v3(r->centre_m[0], r->centre_m[1], r->centre_m[2]), up = nc_v3_unit(c0);
     struct nc_vec3 side = nc_v3_unit(nc_v3_cross(up, nc_v3(0, 0, 1)));
     struct nc_vec3 cam[2] = {nc_v3_add(c0, nc_v3_scale(up, 50)), c0}, hitp = c0;
     struct nc_vec3 nrm[2];
     int32_t id[2];
     for (int v = 0; v < 2; v++) {
-        rough.camera.position_m = cam[v];
+        rough->camera.position_m = cam[v];
         struct nc_rt *rt;
-        CHECK(nc_rt_create(&rough, 1, &rt) == 0, "%s", nc_errmsg());
+        CHECK(nc_rt_create(rough, 1, &rt) == 0, "%s", nc_errmsg());
         struct nc_vec3 d = v == 0 ? nc_v3_scale(up, -1) : nc_v3_unit(nc_v3_sub(hitp, cam[v]));
         struct nc_ray16 ray = {0};
         ray.dx[0] = (float)d.x, ray.dy[0] = (float)d.y, ray.dz[0] = (float)d.z;
@@ -158,7 +170,100 @@ static void check_render(void)
     printf("rock %zu: the normal at one point differs by %.2g rad between two cameras\n", big, ang);
     CHECK(id[0] == (int32_t)big && id[1] == (int32_t)big, "the rays hit rocks %d and %d, not %zu", id[0], id[1], big);
     CHECK(ang < 2e-3, "the shading normal moved by %g rad with the camera", ang);
-    nc_scene_free(&rough);
+    nc_scene_free(rough);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Each shape's detailed surface: closed (every edge in two triangles,
+ * once each way), within its planes, rough. */
+static void check_meshes(const struct nc_boulder_field *f)
+{
+    double worst = 0, slope2 = 0, area = 0;
+    for (int s = 0; s < f->nshapes; s++) {
+        struct nc_mesh m;
+        CHECK(nc_rock_shape_mesh(f, s, NC_ROCK_MESH_SUBDIVISIONS, &m) == 0, "%s", nc_errmsg());
+        const struct nc_rock_shape *sh = &f->shape[s];
+        for (size_t i = 0; i < m.nv; i++)
+            for (int g = 0; g < sh->nplanes; g++) {
+                const double *v = m.v + 3 * i;
+                worst = fmax(worst, sh->nx[g] * v[0] + sh->ny[g] * v[1] + sh->nz[g] * v[2] - sh->d[g]);
+            }
+        /* closed: the directed edges, each with its reverse exactly once */
+        size_t ne = 3 * m.nt, unmatched = 0;
+        uint64_t *e = malloc(2 * ne * sizeof *e);
+        CHECK(e != NULL, "out of memory");
+        for (size_t t = 0; t < m.nt; t++)
+            for (int k = 0; k < 3; k++) {
+                uint64_t a = m.tri[3 * t + k], b = m.tri[3 * t + (k + 1) % 3];
+                e[3 * t + k] = a << 32 | b;
+                e[ne + 3 * t + k] = b << 32 | a;
+            }
+        qsort(e, ne, sizeof *e, cmp_u64);
+        qsort(e + ne, ne, sizeof *e, cmp_u64);
+        for (size_t i = 0; i < ne; i++)
+            unmatched += e[i] != e[ne + i] || (i && e[i] == e[i - 1]);
+        free(e);
+        CHECK(unmatched == 0, "shape %d's surface: %zu edges not in two triangles", s, unmatched);
+        /* the facets' slope against the nearest plane of the shape */
+        for (size_t t = 0; t < m.nt; t++) {
+            struct nc_vec3 n;
+            double a = nc_mesh_face(&m, t, &n), best = -2;
+            for (int g = 0; g < sh->nplanes; g++)
+                best = fmax(best, n.x * sh->nx[g] + n.y * sh->ny[g] + n.z * sh->nz[g]);
+            double c = fmin(best, 1);
+            slope2 += a * (1 - c * c) / (c * c), area += a;
+        }
+        if (s == 0)
+            printf("meshes: %zu triangles a shape\n", m.nt);
+        nc_mesh_free(&m);
+    }
+    printf("meshes: vertices at most %.2g outside the planes; RMS facet slope against the nearest plane "
+           "%.1f deg (roughness_deg %g)\n", worst, atan(sqrt(slope2 / area)) * 180 / M_PI, f->params.roughness_deg);
+    CHECK(worst <= 1e-9, "a vertex %g outside its shape's planes", worst);
+    CHECK(atan(sqrt(slope2 / area)) * 180 / M_PI > 0.5 * f->params.roughness_deg, "the surfaces are not rough");
+}
+
+/* Rocks resolved by 16 pixels or more as detailed surfaces, against the
+ * same frame with every rock flat-faced (relief in the shading): the same
+ * rocks in view, the frame's total and the rocks' mean radiance within the
+ * stated tolerances, shadows of their own, 1 and 2 threads alike. */
+static void check_mesh_render(void)
+{
+    struct nc_scene sc[3];
+    struct nc_frame fr[3];
+    render_trio(25, 0, 25, 16, sc, fr);
+    struct nc_frame a = fr[0], b = fr[1], c = fr[2];
+    const size_t n = (size_t)a.width_px * a.height_px;
+    size_t rock = 0, id_changed = 0, changed = 0;
+    double sa = 0, sb = 0, ra = 0, rb = 0;
+    int finite = 1;
+    for (size_t i = 0; i < n; i++) {
+        sa += a.radiance[i], sb += b.radiance[i];
+        changed += a.radiance[i] != b.radiance[i];
+        finite &= isfinite(b.radiance[i]) && b.radiance[i] >= 0;
+        if (a.rock_id[i] >= 0 || b.rock_id[i] >= 0) {
+            rock++, id_changed += a.rock_id[i] != b.rock_id[i];
+            ra += a.radiance[i], rb += b.radiance[i];
+        }
+    }
+    printf("detailed surfaces (16 px): %zu of %zu pixels changed; %zu of %zu rock pixels show another rock or "
+           "ground; frame total %+.3f %%, the rocks' pixels %+.2f %%\n", changed, n, id_changed, rock,
+           100 * (sb / sa - 1), 100 * (rb / ra - 1));
+    CHECK(finite, "a non-finite or negative pixel");
+    CHECK(changed > n / 50, "the detailed surfaces changed only %zu pixels", changed);
+    CHECK(id_changed < rock / 10, "%zu of %zu rock pixels changed rock", id_changed, rock);
+    CHECK(fabs(sb / sa - 1) < 0.01 && fabs(rb / ra - 1) < 0.03, "total %+.3f %%, rocks %+.2f %%",
+          100 * (sb / sa - 1), 100 * (rb / ra - 1));
+    CHECK(!memcmp(b.radiance, c.radiance, n * sizeof *b.radiance) && !memcmp(b.rock_id, c.rock_id, n * 4),
+          "1 and 2 threads differ with detailed surfaces");
+    nc_frame_free(&a), nc_frame_free(&b), nc_frame_free(&c);
+    for (int i = 0; i < 3; i++)
+        nc_scene_free(&sc[i]);
 }
 
 int main(void)
@@ -198,7 +303,12 @@ int main(void)
     bp.roughness_deg = 46;
     CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) < 0 && nc_test_contains(nc_errmsg(), "roughness"),
           "a roughness of 46 deg: %s", nc_errmsg());
+    bp.roughness_deg = 25;
+    CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) == 0, "%s", nc_errmsg());
+    check_meshes(&f);
+    nc_boulders_free(&f);
     nc_mesh_free(&m);
     check_render();
+    check_mesh_render();
     return nc_test_end();
 }
