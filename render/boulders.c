@@ -208,19 +208,19 @@ static void relief_scales(double deg, double *a)
         a[o] = tan(deg * M_PI / 180) / (M_SQRT2 * NC_NOISE_GRAD_RMS * sqrt(s2)) * relief_weight(o) * relief_freq(o);
 }
 
-void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double p[3], double footprint,
+void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double p[3], double footprint, int first,
                        double g[3])
 {
     g[0] = g[1] = g[2] = 0;
     if (!(f->relief[0] > 0))
         return;
     uint64_t seed = 0;
-    for (int o = 0; o < NC_ROCK_RELIEF_OCTAVES; o++) {
+    for (int o = first; o < NC_ROCK_RELIEF_OCTAVES; o++) {
         const double fr = relief_freq(o), span = footprint > 0 ? 1 / (fr * footprint) : INFINITY; /* a wavelength */
         const double fade = span >= 4 ? 1 : 0.5 * (span - 2);
         if (!(fade > 0))
             break; /* the finer octaves fade sooner */
-        if (o == 0)
+        if (o == first)
             seed = nc_rng_seed(f->params.seed, TAG_RELIEF, (uint64_t)k);
         const double a = fade * f->relief[o];
         double go[3];
@@ -249,7 +249,7 @@ int nc_rock_shape_mesh(const struct nc_boulder_field *f, int s, int subdivisions
                 t = fmin(t, sh->d[g] / c);
         }
         double p[3] = {t * u[0], t * u[1], t * u[2]}, h = 0;
-        for (int o = 0; o < NC_ROCK_RELIEF_OCTAVES; o++) {
+        for (int o = 0; o < NC_ROCK_MESH_OCTAVES; o++) {
             const double fr = relief_freq(o); /* height (a / fr) noise: gradient a grad(noise), as the shading's */
             h += f->relief[o] / fr * nc_noise3(seed + (uint64_t)o, fr * p[0], fr * p[1], fr * p[2]);
         }

@@ -101,22 +101,26 @@ int nc_boulders_generate(const struct nc_mesh *m, const struct nc_boulder_params
  * units (0: none): an octave is whole where its wavelength spans 4
  * footprints or more, fades linearly to nothing at 2 (a pixel cannot show
  * it; the material's theta_bar stands for what is finer). A function of the
- * rock, the point and the footprint alone. Zero where roughness_deg is 0. */
+ * rock, the point and the footprint alone. Zero where roughness_deg is 0.
+ * Octaves from first on (0: all; a detailed surface's shading takes those
+ * its geometry does not carry, NC_ROCK_MESH_OCTAVES). */
 #define NC_ROCK_RELIEF_HURST 0.8
-void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double p[3], double footprint,
+void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double p[3], double footprint, int first,
                        double g[3]);
 /* The detailed surface of shape s, for rocks resolved by many pixels
  * (rt_rocks.h): an icosphere of 20 x 4^subdivisions triangles whose
  * vertices are put on the shape's planes along their directions from its
  * centre (its convex outline, edges and corners rounded at the scale of a
  * triangle), then moved inward along those directions where a height is
- * negative: the fBm of nc_boulder_relief (the same octaves and amplitudes,
- * seeded per shape, no footprint). The faces keep their planes where the
- * height is positive and are pitted where it is negative, so the surface
- * lies within the shape's planes: the flat-faced rock's box, sphere and
- * planes bound it. Rock units, outward winding. Needs roughness_deg > 0
- * (flat faces need no mesh). */
+ * negative: the first NC_ROCK_MESH_OCTAVES octaves of nc_boulder_relief
+ * (those the triangles resolve: the same amplitudes, seeded per shape, no
+ * footprint; the finer ones stay in the shading). The faces keep their
+ * planes where the height is positive and are pitted where it is negative,
+ * so the surface lies within the shape's planes: the flat-faced rock's
+ * box, sphere and planes bound it. Rock units, outward winding. Needs
+ * roughness_deg > 0 (flat faces need no mesh). */
 #define NC_ROCK_MESH_SUBDIVISIONS 3 /* 1280 triangles a shape */
+#define NC_ROCK_MESH_OCTAVES 1      /* wavelength D/4: about 7 vertex spacings */
 int nc_rock_shape_mesh(const struct nc_boulder_field *f, int s, int subdivisions, struct nc_mesh *out);
 /* How many rocks have a diameter of at least d_m (a prefix of the list). */
 size_t nc_boulders_at_least(const struct nc_boulder_field *f, double d_m);

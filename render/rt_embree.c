@@ -582,10 +582,10 @@ static void load_ray(struct RTCRay16 *r, const struct nc_ray16 *in)
 
 /* The shading normal of rock k of tile tl, hit at t along lane i of ray:
  * its face's normal n (x, y, z: unnormalised, body frame) tilted by the
- * relief's gradient along the face (nc_boulder_relief), kept only where it
- * faces the ray as n does (a shading normal never shows a face the
- * geometry hides). */
-static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *tl, size_t k, float t,
+ * relief's gradient along the face (nc_boulder_relief's octaves from
+ * first on), kept only where it faces the ray as n does (a shading normal
+ * never shows a face the geometry hides). */
+static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *tl, size_t k, int first, float t,
                         const struct nc_ray16 *ray, int i, float *x, float *y, float *z)
 {
     const float *R = b->rot, *M = tl->rocks->rock[k].M, *c = tl->rocks->rock[k].c;
@@ -606,7 +606,7 @@ static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *
     const double half = 1 / sqrt((double)M[0] * M[0] + (double)M[1] * M[1] + (double)M[2] * M[2]);
     const double dist = t * sqrt((double)ray->dx[i] * ray->dx[i] + (double)ray->dy[i] * ray->dy[i] +
                                  (double)ray->dz[i] * ray->dz[i]);
-    nc_boulder_relief(&b->src->boulders, k, p, dist * tl->rocks->px_rad / half, g);
+    nc_boulder_relief(&b->src->boulders, k, p, dist * tl->rocks->px_rad / half, first, g);
     const double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     double gn = 0, nd = 0;
     for (int j = 0; j < 3; j++) {
@@ -661,8 +661,8 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
         size_t k = tl->index[prim];
         alb = nc_albedo_var_rock(&b->src->albedo_var, k);
         rock = (int32_t)k;
-        if (b->src->boulders.relief[0] > 0 && u == 0) /* u 1: the detailed surface's, relief and all */
-            rock_relief(b, tl, k, t, ray, i, &x, &y, &z);
+        if (b->src->boulders.relief[0] > 0) /* u 1: a detailed surface's hit, the coarse relief in geometry */
+            rock_relief(b, tl, k, u != 0 ? NC_ROCK_MESH_OCTAVES : 0, t, ray, i, &x, &y, &z);
     }
     hit->albedo[i] = alb;
     hit->rock[i] = rock;

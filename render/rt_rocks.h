@@ -27,6 +27,14 @@
 
 struct nc__rt_rocks;
 
+/* A shape's detailed surface: its Embree scene, and for its shading normals
+ * (interpolated over each triangle) the normals at its triangles' corners,
+ * smooth within the polyhedron's faces and sharp across its edges. */
+struct nc__rt_rock_surface {
+    RTCScene scene;
+    int16_t *cn; /* 9 a triangle: its corners' unit normals, rock frame, times 32767 */
+};
+
 struct nc__rt_rock_tile {
     struct nc__rt_rocks *rocks;
     double origin_m[3];    /* body frame: its rocks' records are relative to it */
@@ -63,10 +71,10 @@ struct nc__rt_rocks {
     double px_rad;    /* the camera's pixel, rad (the finest axis): the relief's footprint */
     /* Rocks resolved by render.boulder_mesh_px pixels or more at their
      * centre's distance from the camera are traced as their shape's
-     * detailed surface (nc_rock_shape_mesh: the relief in geometry, within
-     * the planes), the others as flat-faced polyhedra. mesh[] is NULL for
-     * flat-faced rocks (roughness_deg 0). */
-    RTCScene *mesh;
+     * detailed surface (nc_rock_shape_mesh: the coarse relief in geometry,
+     * within the planes), the others as flat-faced polyhedra. surf[] is
+     * NULL for flat-faced rocks (roughness_deg 0). */
+    struct nc__rt_rock_surface *surf;
     size_t mesh_triangles; /* each shape's surface */
     float mesh_k2;         /* (boulder_mesh_px * px_rad)^2, 0: no rock is */
 };
@@ -101,7 +109,7 @@ int nc__rt_rocks_attach(struct nc__rt_rocks *r, RTCDevice dev, RTCScene top, RTC
 static inline void nc__rt_rocks_mesh_px(struct nc__rt_rocks *r, double mesh_px, double px_rad)
 {
     r->px_rad = px_rad;
-    r->mesh_k2 = r->mesh ? (float)(mesh_px * px_rad * mesh_px * px_rad) : 0.0f;
+    r->mesh_k2 = r->surf ? (float)(mesh_px * px_rad * mesh_px * px_rad) : 0.0f;
 }
 /* Trace only rocks of diameter min_d_m or more (0: all). */
 void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m);
@@ -110,7 +118,7 @@ void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m);
 void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct nc_vec3 origin_rel);
 void nc__rt_rocks_free(struct nc__rt_rocks *r);
 
-/* rt_rock_mesh.c: each shape's detailed surface (r->mesh), built when the
+/* rt_rock_mesh.c: each shape's detailed surface (r->surf), built when the
  * rocks' faces are rough; and their release. */
 int nc__rt_rock_meshes(RTCDevice dev, struct nc__rt_rocks *r);
 void nc__rt_rock_meshes_free(struct nc__rt_rocks *r);
@@ -118,8 +126,10 @@ void nc__rt_rock_meshes_free(struct nc__rt_rocks *r);
  * [t0, t1], its interval in the rock's planes, widened by 1e-3 of the
  * rock's half size (where the surface lies on a plane, the float rays
  * through the two may part by a few ulps) and kept within (tnear, tfar):
- * whether it meets it, and where (*t) with which geometric normal n (rock
- * frame, unnormalised); occlusion only if n is NULL. */
+ * whether it meets it, and where (*t) with which shading normal n (rock
+ * frame, unnormalised: its corners' normals interpolated, or the
+ * triangle's where they would face the ray otherwise); occlusion only if n
+ * is NULL. */
 int nc__rt_rock_mesh_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, const float o[3],
                          const float d[3], float tnear, float tfar, float t0, float t1, float *t, float *n);
 

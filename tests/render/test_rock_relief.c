@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/noise.h"
 #include "core/rng.h"
 #include "render/boulders.h"
 #include "render/render.h"
@@ -26,8 +27,8 @@ static void check_slope(const struct nc_boulder_field *f, double deg)
         size_t k = (size_t)(nc_rng_uniform(&s) * (double)f->n);
         struct nc_vec3 u = nc_rng_dir(&s), nrm = nc_rng_dir(&s);
         double r = nc_rng_uniform(&s), p[3] = {r * u.x, r * u.y, r * u.z}, g[3], g2[3];
-        nc_boulder_relief(f, k, p, 0, g);
-        nc_boulder_relief(f, (k + 1) % f->n, p, 0, g2); /* another rock at the same point */
+        nc_boulder_relief(f, k, p, 0, 0, g);
+        nc_boulder_relief(f, (k + 1) % f->n, p, 0, 0, g2); /* another rock at the same point */
         double gn = g[0] * nrm.x + g[1] * nrm.y + g[2] * nrm.z;
         sum2 += g[0] * g[0] + g[1] * g[1] + g[2] * g[2] - gn * gn;
         diff += g[0] != g2[0];
@@ -222,10 +223,18 @@ static void check_meshes(const struct nc_boulder_field *f)
             printf("meshes: %zu triangles a shape\n", m.nt);
         nc_mesh_free(&m);
     }
-    printf("meshes: vertices at most %.2g outside the planes; RMS facet slope against the nearest plane "
-           "%.1f deg (roughness_deg %g)\n", worst, atan(sqrt(slope2 / area)) * 180 / M_PI, f->params.roughness_deg);
+    /* the RMS slope the octaves in geometry give a face (the shading's own
+     * scale: tan S = sqrt(2) NC_NOISE_GRAD_RMS |a|) */
+    double a2 = 0;
+    for (int o = 0; o < NC_ROCK_MESH_OCTAVES; o++)
+        a2 += f->relief[o] * f->relief[o];
+    const double geo = atan(M_SQRT2 * NC_NOISE_GRAD_RMS * sqrt(a2)) * 180 / M_PI;
+    const double got = atan(sqrt(slope2 / area)) * 180 / M_PI;
+    printf("meshes: vertices at most %.2g outside the planes; RMS facet slope against the nearest plane %.1f deg "
+           "(roughness_deg %g, of which the octaves in geometry %.1f deg; pitted only: half the faces flat)\n",
+           worst, got, f->params.roughness_deg, geo);
     CHECK(worst <= 1e-9, "a vertex %g outside its shape's planes", worst);
-    CHECK(atan(sqrt(slope2 / area)) * 180 / M_PI > 0.5 * f->params.roughness_deg, "the surfaces are not rough");
+    CHECK(got > 0.5 * geo && got < 1.5 * geo, "the surfaces' slope %.1f deg for %.1f deg in geometry", got, geo);
 }
 
 /* Rocks resolved by 16 pixels or more as detailed surfaces, against the
@@ -284,7 +293,7 @@ int main(void)
     struct nc_boulder_field f;
     CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) == 0, "%s", nc_errmsg());
     double g[3] = {1, 1, 1}, q[3] = {0.3, -0.2, 0.5};
-    nc_boulder_relief(&f, 0, q, 0, g);
+    nc_boulder_relief(&f, 0, q, 0, 0, g);
     CHECK(g[0] == 0 && g[1] == 0 && g[2] == 0, "flat faces have a gradient");
     nc_boulders_free(&f);
     /* The pixel's footprint: every octave whole where the finest spans 4
@@ -292,10 +301,10 @@ int main(void)
     bp.roughness_deg = 25;
     CHECK(nc_boulders_generate(&m, &bp, 1000000, &f) == 0, "%s", nc_errmsg());
     double g0[3], g1[3], g2[3], g3[3];
-    nc_boulder_relief(&f, 7, q, 0, g0);
-    nc_boulder_relief(&f, 7, q, 0.125 / 4, g1);
-    nc_boulder_relief(&f, 7, q, 0.125 / 3, g2);
-    nc_boulder_relief(&f, 7, q, 0.5 / 2, g3);
+    nc_boulder_relief(&f, 7, q, 0, 0, g0);
+    nc_boulder_relief(&f, 7, q, 0.125 / 4, 0, g1);
+    nc_boulder_relief(&f, 7, q, 0.125 / 3, 0, g2);
+    nc_boulder_relief(&f, 7, q, 0.5 / 2, 0, g3);
     CHECK(!memcmp(g0, g1, sizeof g0) && memcmp(g0, g2, sizeof g0) && g3[0] == 0 && g3[1] == 0 && g3[2] == 0,
           "the footprint's fade: (%g %g %g) whole, (%g %g %g) at 4 footprints, (%g %g %g) at 3, (%g %g %g) at none",
           g0[0], g0[1], g0[2], g1[0], g1[1], g1[2], g2[0], g2[1], g2[2], g3[0], g3[1], g3[2]);
