@@ -3,8 +3,9 @@
  * The default scene (its asteroid, Hapke, shadows, 4 samples per pixel,
  * 1024x1024) bare and covered with the Bennu boulder preset down to 0.45 m
  * (over a million rocks, faces 20 deg rough; those of 64 pixels or more at
- * their distance traced as detailed surfaces of 5120 triangles: the
- * effective triangles are the rocks times that), seen along -y from far (6 km: the whole body),
+ * their distance traced as detailed surfaces of 1280 triangles: the
+ * effective triangles are the rocks times that), seen along -y from far
+ * (6 km: the whole body),
  * medium (1.5 km: the body fills the frame) and close (300 m above the
  * surface, 7 cm pixels). Per range: the frame time of each (median of N
  * frames; bare, every rock and cut interleaved frame by frame after one

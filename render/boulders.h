@@ -120,7 +120,7 @@ void nc_boulder_relief(const struct nc_boulder_field *f, size_t k, const double 
  * box, sphere and planes bound it. Rock units, outward winding. Needs
  * roughness_deg > 0 (flat faces need no mesh). */
 #define NC_ROCK_MESH_SUBDIVISIONS 3 /* 1280 triangles a shape */
-#define NC_ROCK_MESH_OCTAVES 1      /* wavelength D/4: about 7 vertex spacings */
+#define NC_ROCK_MESH_OCTAVES 1      /* wavelength D/4: four to seven vertex spacings */
 int nc_rock_shape_mesh(const struct nc_boulder_field *f, int s, int subdivisions, struct nc_mesh *out);
 /* How many rocks have a diameter of at least d_m (a prefix of the list). */
 size_t nc_boulders_at_least(const struct nc_boulder_field *f, double d_m);

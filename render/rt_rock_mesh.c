@@ -1,9 +1,9 @@
 /* rt_rock_mesh.c - the rocks' detailed surfaces (rt_rocks.h): each shape's
  * surface (nc_rock_shape_mesh) is an Embree scene of one triangle mesh,
- * built once and shared by every rock of that shape, with its vertex
- * normals for shading; a rock resolved by enough pixels is traced through
- * it with the ray in the rock's own frame, from inside its intersection
- * test (rt_rocks.c). */
+ * built once and shared by every rock of that shape, with normals at its
+ * triangles' corners for shading; a rock resolved by enough pixels is
+ * traced through it with the ray in the rock's own frame, from inside its
+ * intersection test (rt_rocks.c). */
 #include "render/rt_rocks.h"
 
 #include <errno.h>
@@ -15,10 +15,11 @@
 #include "core/error.h"
 
 /* Shading normals at each triangle's corners (9 a triangle, rock frame,
- * unit, times 32767: half the memory of floats, 1e-4 rad): the area-weighted mean of the normals of the triangles
- * around that corner's vertex that turn less than CREASE_DEG from the
- * triangle's own, so that the polyhedron's edges stay sharp while the
- * triangles within a face shade smoothly. */
+ * unit, times 32767: half the memory of floats, within 1e-4 rad): the
+ * area-weighted mean of the normals of the triangles around that corner's
+ * vertex that turn less than CREASE_DEG from the triangle's own, so that
+ * the polyhedron's edges stay sharp while the triangles within a face
+ * shade smoothly. */
 #define CREASE_DEG 30.0
 static int corner_normals(const struct nc_mesh *m, int16_t *cn)
 {

@@ -120,7 +120,8 @@ rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, co
  * without it, ends the lane (occlusion: tfar = -inf). A rock resolved by
  * enough pixels at its distance from the camera (the same for every ray of
  * a frame: camera, shadow) is traced as its detailed surface, its hits
- * marked by u = 1 (no shading relief: the relief is in the geometry). */
+ * marked by u = 1 (their shading takes only the relief's octaves the
+ * geometry does not carry). */
 static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const int *valid, float *ray, unsigned N,
                         const struct RTCIntersectFunctionNArguments *hit)
 {

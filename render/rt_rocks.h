@@ -15,8 +15,10 @@
  * are refused in the intersection test by their rank in the list (the list
  * is sorted by size). An Embree instance per rock would cost about 390
  * bytes (measured with Embree 3.13: a million instances take 368 MiB); per
- * tile, it is a few per thousand rocks. Internal to the Embree back-end
- * (rt_embree.c). */
+ * tile, it is a few per thousand rocks. Rough-faced rocks resolved by
+ * render.boulder_mesh_px pixels are traced through their shape's detailed
+ * surface (rt_rock_mesh.c), which lies within their planes. Internal to
+ * the Embree back-end (rt_embree.c). */
 #ifndef NC_RT_ROCKS_H
 #define NC_RT_ROCKS_H
 
