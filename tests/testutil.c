@@ -99,6 +99,12 @@ void nc_test_asteroid_mesh(int subdivisions, int craters, struct nc_mesh *m)
 
 int nc_test_contains(const char *haystack, const char *needle) { return strstr(haystack, needle) != NULL; }
 
+int nc_test_cmp_u64(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
 double nc_test_fit_slope(const double *d, size_t n, double lo, double hi)
 {
     /* Maximum likelihood: the mean of ln(D/lo) equals its expectation

@@ -4,6 +4,7 @@
 #define NC_TESTUTIL_H
 
 #include <stdio.h>
+#include <stdint.h>
 
 #include "render/render.h"
 #include "render/scene.h"
@@ -41,6 +42,8 @@ void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f);
  * many subdivisions and craters; a failure ends the test. */
 void nc_test_asteroid_mesh(int subdivisions, int craters, struct nc_mesh *m);
 int nc_test_contains(const char *haystack, const char *needle);
+/* qsort's comparison of uint64_t values, ascending. */
+int nc_test_cmp_u64(const void *a, const void *b);
 /* The slope b of a cumulative power law N(>D) ~ D^-b truncated to [lo, hi],
  * fitted by maximum likelihood to n diameters. */
 double nc_test_fit_slope(const double *d, size_t n, double lo, double hi);

@@ -212,12 +212,6 @@ static void test_next_exposure(void)
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
 }
 
-static int cmp_u64(const void *a, const void *b)
-{
-    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* Frames for up to `seconds` after `settle` s: the frame period from the
  * GVSP timestamps (exposure starts) as the median interval between
  * consecutive frames received, so that neither a frame the device replaced
@@ -248,7 +242,7 @@ static double measure_rate(struct stream *st, uint8_t *img, double settle, doubl
     for (int i = 1; i < *n; i++)
         dt[i - 1] = at[i] - at[i - 1];
     memcpy(sorted, dt, (size_t)(*n - 1) * sizeof *dt);
-    qsort(sorted, (size_t)(*n - 1), sizeof *sorted, cmp_u64);
+    qsort(sorted, (size_t)(*n - 1), sizeof *sorted, nc_test_cmp_u64);
     const double period = (double)sorted[(*n - 1) / 2];
     for (int i = 0; i < *n - 1; i++) {
         const double k = round((double)dt[i] / period);

@@ -3,7 +3,11 @@
  * rendered, it changes the rocks' pixels and nothing else (shadows and
  * ground are the flat-faced rocks' bit for bit), gives them texture, and is
  * the same on 1 and 2 threads; a point of a rock is shaded with the same
- * normal seen from two camera positions. */
+ * normal seen from two camera positions. Rocks resolved by enough pixels
+ * as detailed surfaces (render.boulder_mesh_px, nc_rock_shape_mesh): each
+ * surface closed, within its planes and rough; rendered, they change the
+ * frame and the rocks' brightness within stated tolerances, on 1 and 2
+ * threads alike. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -174,12 +178,6 @@ static void check_render(void)
     nc_scene_free(rough);
 }
 
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* Each shape's detailed surface: closed (every edge in two triangles,
  * once each way), within its planes, rough. */
 static void check_meshes(const struct nc_boulder_field *f)
@@ -204,8 +202,8 @@ static void check_meshes(const struct nc_boulder_field *f)
                 e[3 * t + k] = a << 32 | b;
                 e[ne + 3 * t + k] = b << 32 | a;
             }
-        qsort(e, ne, sizeof *e, cmp_u64);
-        qsort(e + ne, ne, sizeof *e, cmp_u64);
+        qsort(e, ne, sizeof *e, nc_test_cmp_u64);
+        qsort(e + ne, ne, sizeof *e, nc_test_cmp_u64);
         for (size_t i = 0; i < ne; i++)
             unmatched += e[i] != e[ne + i] || (i && e[i] == e[i - 1]);
         free(e);
@@ -238,9 +236,10 @@ static void check_meshes(const struct nc_boulder_field *f)
 }
 
 /* Rocks resolved by 16 pixels or more as detailed surfaces, against the
- * same frame with every rock flat-faced (relief in the shading): the same
- * rocks in view, the frame's total and the rocks' mean radiance within the
- * stated tolerances, shadows of their own, 1 and 2 threads alike. */
+ * same frame with every rock flat-faced (relief in the shading): pixels
+ * change (outlines, pits, shadows), the same rocks in view, the frame's
+ * total and the rocks' mean radiance within the stated tolerances, 1 and
+ * 2 threads alike. */
 static void check_mesh_render(void)
 {
     struct nc_scene sc[3];
@@ -268,7 +267,7 @@ static void check_mesh_render(void)
     CHECK(id_changed < rock / 10, "%zu of %zu rock pixels changed rock", id_changed, rock);
     CHECK(fabs(sb / sa - 1) < 0.01 && fabs(rb / ra - 1) < 0.03, "total %+.3f %%, rocks %+.2f %%",
           100 * (sb / sa - 1), 100 * (rb / ra - 1));
-    CHECK(!memcmp(b.radiance, c.radiance, n * sizeof *b.radiance) && !memcmp(b.rock_id, c.rock_id, n * 4),
+    CHECK(!memcmp(b.radiance, c.radiance, n * sizeof *b.radiance) && !memcmp(b.rock_id, c.rock_id, n * sizeof *b.rock_id),
           "1 and 2 threads differ with detailed surfaces");
     nc_frame_free(&a), nc_frame_free(&b), nc_frame_free(&c);
     for (int i = 0; i < 3; i++)
