@@ -257,10 +257,11 @@ static void rows(void (*f)(double *, size_t), double *x, int nrows, size_t n)
 
 /* Each stage's loop is branch-free over the lanes (the rare cases, psi near
  * 0 or 180 deg, are redone after it), so that the compiler vectorises it;
- * the AVX2 clone has no FMA, so nothing is contracted and every lane's
- * result is the same, bit for bit, as the plain one's (and as the scalar
- * loops' before: 1.4 million evaluations over edge geometries compared). */
-__attribute__((target_clones("avx2", "default"))) static void hapke_chunk(const double *p, const double *c, size_t n,
+ * nothing is contracted (the AVX2 clone has no FMA, and this file is built
+ * without contraction for the AVX-512 one), so every lane's result is the
+ * same, bit for bit, as the plain one's (and as the scalar loops' before:
+ * 1.4 million evaluations over edge geometries compared). */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void hapke_chunk(const double *p, const double *c, size_t n,
                                                                             const struct nc_photometry *geo, double *r)
 {
     const double K = c[CK], chi = c[CCHI], tanb = c[CTAN], cotb = c[CCOT];

@@ -74,7 +74,8 @@ struct nc_pool;
 
 struct nc__bins {
     int bw, bh, nparts;
-    int avx512; /* the test in AVX-512 registers (the same bits as without) */
+    int avx512; /* the build's triangle setup and the test in AVX-512 registers (the same bits as without) */
+    int plain;  /* set by the caller: never AVX-512 (tests compare the two) */
     size_t nblocks;
     /* The build's input. */
     struct nc__bins_body body[NC_MAX_BODIES];
@@ -99,6 +100,15 @@ struct nc__bins {
     int phase;
     _Atomic int next, straddle;
 };
+
+/* The body holding global index i of a table of offsets. */
+static inline int nc__bins_body_of(const size_t *off, int nbodies, size_t i)
+{
+    int k = 0;
+    while (k + 1 < nbodies && i >= off[k + 1])
+        k++;
+    return k;
+}
 
 /* The lists for this view, built on the threads of pool (NULL: the caller
  * alone) in nparts parts (the lists do not depend on it). Returns 1, 0 when

@@ -3,6 +3,8 @@
 
 #include "render/vmath.h"
 
+int nc__vmath_no_avx512; /* nothing to keep out here */
+
 void nc_vexp(double *x, size_t n)
 {
     for (size_t i = 0; i < n; i++)

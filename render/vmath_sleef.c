@@ -1,23 +1,32 @@
 /* vmath_sleef.c - vmath.h with SLEEF's 4-wide AVX2 double functions (u10:
- * max error 1 ulp), chosen once at run time when the CPU has AVX2 and FMA;
- * otherwise the C library. Only the code between the target pragmas is
- * compiled for AVX2 and FMA (sleef.h declares its AVX2 functions only
- * there); the check and the libm loops run on any x86-64. */
+ * max error 1 ulp), chosen once at run time when the CPU has AVX2 and FMA,
+ * and their 8-wide AVX-512 twins for exp, log and acos where it has
+ * AVX-512 (the same results bit for bit: SLEEF computes every lane alike,
+ * and test_vmath compares them); otherwise the C library. Only the
+ * functions marked AVX2 or AVX512 are compiled for those extensions; the
+ * check and the libm loops run on any x86-64. */
 #include <math.h>
 #include <stddef.h>
 
 #include "render/vmath.h"
 
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
+/* The intrinsics first, each with its own target; sleef.h declares each
+ * extension's functions only where the compiler may use it: all of them
+ * here. Each function below states its own target. */
 #include <immintrin.h>
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx2,fma")
 #include <sleef.h>
+#pragma GCC pop_options
+
+#define AVX2 __attribute__((target("avx2,fma")))
+#define AVX512 __attribute__((target("avx512f,avx2,fma")))
 
 /* Full groups of lanes through SLEEF; the tail through a padded group, so a
  * value's result never depends on its position in the array. T is the
  * element type, LANES the vector width, LD/ST its load and store. */
-#define NC_VMATH_AVX2(name, T, LANES, LD, ST, sleef_fn, pad)                                                  \
-    static void name##_avx2(T *x, size_t n)                                                                    \
+#define NC_VMATH_BATCH(attr, name, T, LANES, LD, ST, sleef_fn, pad)                                         \
+    attr static void name(T *x, size_t n)                                                                      \
     {                                                                                                          \
         size_t i = 0;                                                                                          \
         for (; i + LANES <= n; i += LANES)                                                                     \
@@ -31,13 +40,13 @@
                 x[i + k] = t[k];                                                                               \
         }                                                                                                      \
     }
-NC_VMATH_AVX2(nc_vexp, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_expd4_u10avx2, 0.0)
-NC_VMATH_AVX2(nc_vlog, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_logd4_u10avx2, 1.0)
-NC_VMATH_AVX2(nc_vacos, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_acosd4_u10avx2, 0.0)
-NC_VMATH_AVX2(nc_vlogf, float, 8, _mm256_loadu_ps, _mm256_storeu_ps, Sleef_logf8_u35avx2, 1.0f)
-NC_VMATH_AVX2(nc_vexpf, float, 8, _mm256_loadu_ps, _mm256_storeu_ps, Sleef_expf8_u10avx2, 0.0f)
+NC_VMATH_BATCH(AVX2, nc_vexp_avx2, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_expd4_u10avx2, 0.0)
+NC_VMATH_BATCH(AVX2, nc_vlog_avx2, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_logd4_u10avx2, 1.0)
+NC_VMATH_BATCH(AVX2, nc_vacos_avx2, double, 4, _mm256_loadu_pd, _mm256_storeu_pd, Sleef_acosd4_u10avx2, 0.0)
+NC_VMATH_BATCH(AVX2, nc_vlogf_avx2, float, 8, _mm256_loadu_ps, _mm256_storeu_ps, Sleef_logf8_u35avx2, 1.0f)
+NC_VMATH_BATCH(AVX2, nc_vexpf_avx2, float, 8, _mm256_loadu_ps, _mm256_storeu_ps, Sleef_expf8_u10avx2, 0.0f)
 
-static void sincospi_avx2(const double *x, double *s, double *c, size_t n)
+AVX2 static void sincospi_avx2(const double *x, double *s, double *c, size_t n)
 {
     size_t i = 0;
     for (; i + 4 <= n; i += 4) {
@@ -59,7 +68,7 @@ static void sincospi_avx2(const double *x, double *s, double *c, size_t n)
     }
 }
 
-static void sincospif_avx2(const float *x, float *s, float *c, size_t n)
+AVX2 static void sincospif_avx2(const float *x, float *s, float *c, size_t n)
 {
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
@@ -80,22 +89,32 @@ static void sincospif_avx2(const float *x, float *s, float *c, size_t n)
         }
     }
 }
-#pragma GCC pop_options
 
-static int use_avx2 = -1;
+NC_VMATH_BATCH(AVX512, nc_vexp_avx512, double, 8, _mm512_loadu_pd, _mm512_storeu_pd, Sleef_expd8_u10avx512f, 0.0)
+NC_VMATH_BATCH(AVX512, nc_vlog_avx512, double, 8, _mm512_loadu_pd, _mm512_storeu_pd, Sleef_logd8_u10avx512f, 1.0)
+NC_VMATH_BATCH(AVX512, nc_vacos_avx512, double, 8, _mm512_loadu_pd, _mm512_storeu_pd, Sleef_acosd8_u10avx512f, 0.0)
+
+static int use_avx2 = -1, use_avx512 = -1;
 
 static int avx2(void)
 {
     if (use_avx2 < 0) {
         __builtin_cpu_init();
         use_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+        use_avx512 = use_avx2 && __builtin_cpu_supports("avx512f");
     }
     return use_avx2;
 }
 
-#define NC_VMATH_DEFINE(name, T, libm_fn)                                                                     \
+/* wide: the function's AVX-512 twin, or NULL */
+#define NC_VMATH_DEFINE(name, T, libm_fn, wide)                                                               \
     void name(T *x, size_t n)                                                                                  \
     {                                                                                                          \
+        void (*const z)(T *, size_t) = wide;                                                                   \
+        if (avx2() && z && use_avx512 && !nc__vmath_no_avx512) {                                               \
+            z(x, n);                                                                                           \
+            return;                                                                                            \
+        }                                                                                                      \
         if (avx2()) {                                                                                          \
             name##_avx2(x, n);                                                                                 \
             return;                                                                                            \
@@ -103,11 +122,12 @@ static int avx2(void)
         for (size_t i = 0; i < n; i++)                                                                         \
             x[i] = libm_fn(x[i]);                                                                              \
     }
-NC_VMATH_DEFINE(nc_vexp, double, exp)
-NC_VMATH_DEFINE(nc_vlog, double, log)
-NC_VMATH_DEFINE(nc_vacos, double, acos)
-NC_VMATH_DEFINE(nc_vlogf, float, logf)
-NC_VMATH_DEFINE(nc_vexpf, float, expf)
+int nc__vmath_no_avx512;
+NC_VMATH_DEFINE(nc_vexp, double, exp, nc_vexp_avx512)
+NC_VMATH_DEFINE(nc_vlog, double, log, nc_vlog_avx512)
+NC_VMATH_DEFINE(nc_vacos, double, acos, nc_vacos_avx512)
+NC_VMATH_DEFINE(nc_vlogf, float, logf, NULL)
+NC_VMATH_DEFINE(nc_vexpf, float, expf, NULL)
 
 void nc_vsincospi(const double *x, double *s, double *c, size_t n)
 {
@@ -133,4 +153,7 @@ void nc_vsincospif(const float *x, float *s, float *c, size_t n)
     }
 }
 
-const char *nc_vmath_impl(void) { return avx2() ? "SLEEF AVX2 (u10)" : "libm"; }
+const char *nc_vmath_impl(void)
+{
+    return !avx2() ? "libm" : use_avx512 && !nc__vmath_no_avx512 ? "SLEEF AVX-512 and AVX2 (u10)" : "SLEEF AVX2 (u10)";
+}

@@ -2,7 +2,7 @@
  * against Embree: the same first hits, ranges and normals ray by ray on
  * procedural asteroids (flat, smooth with albedo variation, two bodies), a
  * grid whose lines run through the pixel centres (no ray slips between
- * triangles), the AVX-512 and plain tests bit for bit, clusters of
+ * triangles), the AVX-512 and plain tests and list builds bit for bit, clusters of
  * triangles skipped whole without changing the lists, the cases the bins
  * refuse, and whole frames. */
 #include <math.h>
@@ -113,6 +113,19 @@ static struct agree compare_rays(const struct nc_scene *s, int centre, const cha
     return a;
 }
 
+/* Whether two builds made the same lists, entry for entry. */
+static int same_lists(const struct nc__bins *a, const struct nc__bins *b)
+{
+    const size_t n = a->start[a->nblocks];
+    if (a->nblocks != b->nblocks || memcmp(a->start, b->start, (a->nblocks + 1) * sizeof *a->start) != 0)
+        return 0;
+    for (size_t i = 0; i < n; i++)
+        if (a->tri[a->list[i]] != b->tri[b->list[i]] ||
+            memcmp(&a->cand[a->list[i]], &b->cand[b->list[i]], sizeof *a->cand) != 0)
+            return 0;
+    return 1;
+}
+
 /* A plane grid of n x n squares (2 triangles each) at z = 100 m seen from
  * the origin along +z, its lines through pixel centres: every ray through a
  * centre lies on an edge or a vertex, and each must still hit. The test in
@@ -179,6 +192,12 @@ static void check_grid(void)
     CHECK(inside > 30000 && hit == inside, "grid: %ld of %ld rays slipped through", inside - hit, inside);
     CHECK(bad_t == 0, "grid: %ld ranges off", bad_t);
     CHECK(differ == 0, "grid: AVX-512 and plain tests differ in %ld blocks", differ);
+    struct nc__bins bp; /* both sides listed: the plain setup's lists */
+    memset(&bp, 0, sizeof bp);
+    bp.plain = 1;
+    CHECK(nc__bins_build(&bp, &view, &body, 1, NULL, 3) == 1 && same_lists(&b, &bp),
+          "grid: the AVX-512 and plain setups make different lists");
+    nc__bins_free(&bp);
     /* A triangle across the plane of the origin parallel to the image: refused. */
     body.origin = nc_v3(0, 0, -z);
     CHECK(nc__bins_build(&b, &view, &body, 1, NULL, 1) == 1, "grid in the plane of the origin: wholly behind it");
@@ -198,7 +217,8 @@ static void check_grid(void)
 /* Clusters skipped whole (outside the image, or facing away) lose no
  * listed triangle: the lists with and without them are the same entry for
  * entry, from views where they skip most of the mesh (min_skip: the share
- * of clusters at least skipped). */
+ * of clusters at least skipped). The triangle setup in AVX-512 registers
+ * (where the CPU has them) and in plain C make the same lists too. */
 static void check_clusters(const struct nc_scene *s, double min_skip, const char *what)
 {
     const struct nc_mesh *m = &s->body[0].mesh;
@@ -211,26 +231,28 @@ static void check_clusters(const struct nc_scene *s, double min_skip, const char
     struct nc__bins_body body = {.v = m->v, .tri = m->tri, .ng = ng, .nv = m->nv, .nt = m->nt,
                                  .R = nc_quat_to_mat(s->body[0].attitude_q),
                                  .origin = nc_v3_sub(s->body[0].position_m, s->camera.position_m), .front_only = 1};
-    struct nc__bins all, some;
+    struct nc__bins all, some, plain;
     memset(&all, 0, sizeof all);
     memset(&some, 0, sizeof some);
+    memset(&plain, 0, sizeof plain);
+    plain.plain = 1;
     CHECK(nc__bins_build(&all, &view, &body, 1, NULL, 2) == 1, "%s: bins without clusters", what);
     body.cl = cl;
     CHECK(nc__bins_build(&some, &view, &body, 1, NULL, 3) == 1, "%s: bins with clusters", what);
-    size_t live = 0, differ = 0;
+    CHECK(nc__bins_build(&plain, &view, &body, 1, NULL, 3) == 1, "%s: bins in plain C", what);
+    size_t live = 0;
     for (size_t k = 0; k < ncl; k++)
         live += some.cl_live[k];
-    const size_t n = all.start[all.nblocks];
-    differ += memcmp(all.start, some.start, (all.nblocks + 1) * sizeof *all.start) != 0;
-    for (size_t i = 0; i < n && !differ; i++)
-        differ += all.tri[all.list[i]] != some.tri[some.list[i]] ||
-                  memcmp(&all.cand[all.list[i]], &some.cand[some.list[i]], sizeof *all.cand) != 0;
-    printf("%s: %zu of %zu clusters skipped, %zu list entries, %s\n", what, ncl - live, ncl, n,
-           differ ? "lists differ" : "the same lists");
-    CHECK(!differ, "%s: the clusters change the lists", what);
+    const int same = same_lists(&all, &some), simd = same_lists(&some, &plain);
+    printf("%s: %zu of %zu clusters skipped, %u list entries, %s; AVX-512 setup %s\n", what, ncl - live, ncl,
+           some.start[some.nblocks], same ? "the same lists" : "lists differ",
+           !some.avx512 ? "absent" : simd ? "and plain C: the same lists" : "and plain C: lists differ");
+    CHECK(same, "%s: the clusters change the lists", what);
+    CHECK(simd, "%s: the AVX-512 and plain setups make different lists", what);
     CHECK(ncl - live >= min_skip * ncl, "%s: only %zu of %zu clusters skipped", what, ncl - live, ncl);
     nc__bins_free(&all);
     nc__bins_free(&some);
+    nc__bins_free(&plain);
     free(cl);
     free(ng);
 }
