@@ -732,7 +732,10 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
     if (triangles > samples)
         return 0; /* Embree's tree is cheaper than listing them */
     const struct nc__bins_view v = {cam->d00, cam->ex, cam->ey, cam->width_px, cam->height_px};
-    return nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, threads);
+    /* Four parts a thread: a thread that loses its core for a while (in
+     * serve, the camera model of the frame before runs beside the render)
+     * leaves its share of the build to the others. */
+    return nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, 4 * threads);
 }
 
 /* The rocks in front of a packet of camera rays whose meshes the bins
