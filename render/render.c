@@ -233,6 +233,15 @@ static int block_can_hit(const struct job *j, int px0, int py0)
     return 0;
 }
 
+/* Whether to trace the 4x4 block at (px0, py0): where the bins serve the
+ * pass, their lists tell (an empty list and no rocks: every ray misses),
+ * else the bounding spheres; the frame is the same either way. */
+static int block_live(const struct job *j, int px0, int py0)
+{
+    const int listed = j->bins ? nc_rt_block_listed(j->rt, px0, py0) : -1;
+    return !j->cull || (listed >= 0 ? listed : block_can_hit(j, px0, py0));
+}
+
 /* The surface points a packet's rays reached: per lane, where and how. */
 struct surf {
     int body[NC_PACKET];      /* -1: none (a miss, or a float hit the exact shape refutes) */
@@ -717,7 +726,7 @@ static void shade_tile(struct job *j, int tile)
     for (int by = 0; by < TILE; by += 4)
         for (int bx = 0; bx < TILE; bx += 4) {
             mine[by / 4][bx / 4] = y0 + by < H && x0 + bx < W && (!j->blocks || (bx + by) / 4 % 2 == j->blocks - 1);
-            live[by / 4][bx / 4] = mine[by / 4][bx / 4] && (!j->cull || block_can_hit(j, x0 + bx, y0 + by));
+            live[by / 4][bx / 4] = mine[by / 4][bx / 4] && block_live(j, x0 + bx, y0 + by);
         }
     float *one = j->f->one;
     int one_g[TILE * TILE]; /* the sample plane `one` keeps: (0 <= g < N) */

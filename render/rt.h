@@ -83,6 +83,11 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
  * block at (px0, py0) (multiples of 4). */
 void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
                            int n);
+/* What the lists say of the 4x4 pixel block at (px0, py0), in a pass that
+ * nc_rt_bin_camera serves: 1 if they hold a triangle for it, 0 if no
+ * camera ray of it can hit anything (no triangle listed, no rock traced),
+ * -1 if they cannot tell (rocks are traced). */
+int nc_rt_block_listed(const struct nc_rt *rt, int px0, int py0);
 /* For a hit on an analytic body, recompute range t and unit normal n (scene
  * frame) in double precision for the exact camera-relative ray origin + t d (d unit):
  * the packet trace is float. Returns 1 if refined, 0 for meshes (the float

@@ -738,6 +738,15 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
     return nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, 4 * threads);
 }
 
+int nc_rt_block_listed(const struct nc_rt *rt, int px0, int py0)
+{
+    const struct nc__bins *b = &rt->bins;
+    if (rt->rocks_on)
+        return -1;
+    const size_t k = (size_t)(py0 / NC_BINS_BLOCK) * (size_t)b->bw + (size_t)(px0 / NC_BINS_BLOCK);
+    return b->start[k + 1] > b->start[k];
+}
+
 /* The rocks in front of a packet of camera rays whose meshes the bins
  * traced: each lane through the rocks alone, up to its mesh hit. */
 static void rocks_over(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit)
