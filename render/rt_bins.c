@@ -151,18 +151,6 @@ void nc__bins_uv(const struct nc__bins_tri *c, const float *d, float *u, float *
     *v = s != 0 ? w[2] / s : 0.0f;
 }
 
-int nc__bins_which(const struct nc__bins *b, int32_t slot, uint32_t *prim)
-{
-    const size_t g = b->tri[slot];
-    if (b->nbodies == 1) {
-        *prim = (uint32_t)g;
-        return 0;
-    }
-    const int k = nc__bins_body_of(b->t_off, b->nbodies, g);
-    *prim = (uint32_t)(g - b->t_off[k]);
-    return k;
-}
-
 void nc__bins_free(struct nc__bins *b)
 {
     free(b->cand);

@@ -128,8 +128,18 @@ void nc__bins_intersect(const struct nc__bins *b, int px0, int py0, const struct
 /* Barycentric weights (u of v1, v of v2) of ray direction d on candidate c. */
 void nc__bins_uv(const struct nc__bins_tri *c, const float *d, float *u, float *v);
 
-/* Body and triangle index of a slot. */
-int nc__bins_which(const struct nc__bins *b, int32_t slot, uint32_t *prim);
+/* The body of the triangle in slot and, with prim, its index in that
+ * body's triangles (one body and no prim: no memory read). */
+static inline int nc__bins_which(const struct nc__bins *b, int32_t slot, uint32_t *prim)
+{
+    if (b->nbodies == 1 && !prim)
+        return 0;
+    const size_t g = b->tri[slot];
+    const int k = nc__bins_body_of(b->t_off, b->nbodies, g);
+    if (prim)
+        *prim = (uint32_t)(g - b->t_off[k]);
+    return k;
+}
 
 void nc__bins_free(struct nc__bins *b);
 

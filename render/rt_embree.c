@@ -787,12 +787,13 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
                     continue;
                 }
                 const struct nc__bins_tri *ct = &rt->bins.cand[slot[q][i]];
-                uint32_t prim;
-                const struct rt_body *b = &rt->body[nc__bins_which(&rt->bins, slot[q][i], &prim)];
+                uint32_t prim = 0; /* put_hit reads it for vertex normals and albedos only */
+                const struct rt_body *b = &rt->body[nc__bins_which(&rt->bins, slot[q][i], NULL)];
                 float u = 0, v = 0;
                 if (b->vnormal || b->src->albedo_vertex) {
                     const float d[3] = {ray[q0 + q].dx[i], ray[q0 + q].dy[i], ray[q0 + q].dz[i]};
                     nc__bins_uv(ct, d, &u, &v);
+                    nc__bins_which(&rt->bins, slot[q][i], &prim);
                 }
                 put_hit(rt, b->inst_id, prim, t[q][i], u, v, ct->ng[0], ct->ng[1], ct->ng[2], &ray[q0 + q], h, i);
             }
