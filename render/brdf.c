@@ -261,8 +261,8 @@ static void rows(void (*f)(double *, size_t), double *x, int nrows, size_t n)
  * without contraction for the AVX-512 one), so every lane's result is the
  * same, bit for bit, as the plain one's (and as the scalar loops' before:
  * 1.4 million evaluations over edge geometries compared). */
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void hapke_chunk(const double *p, const double *c, size_t n,
-                                                                            const struct nc_photometry *geo, double *r)
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void
+hapke_chunk(const double *p, const double *c, size_t n, const struct nc_photometry *geo, double *r)
 {
     const double K = c[CK], chi = c[CCHI], tanb = c[CTAN], cotb = c[CCOT];
     const int rough = p[HTHETA] > 0;

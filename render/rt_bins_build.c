@@ -227,7 +227,8 @@ __attribute__((target("avx512f,avx512vl"))) static unsigned setup8_avx512(const 
             ac[3] = {SUB(c[0], a[0]), SUB(c[1], a[1]), SUB(c[2], a[2])};
     V n[3];
     CROSS(ab, ac, n);
-    const V zero = _mm512_setzero_pd(), nv0 = _mm512_add_pd(_mm512_add_pd(MUL(n[0], a[0]), MUL(n[1], a[1])), MUL(n[2], a[2]));
+    const V zero = _mm512_setzero_pd(),
+            nv0 = _mm512_add_pd(_mm512_add_pd(MUL(n[0], a[0]), MUL(n[1], a[1])), MUL(n[2], a[2]));
     __mmask8 keep = _mm512_cmp_pd_mask(nv0, zero, _CMP_NEQ_UQ);
     if (front_only)
         keep &= (__mmask8)~_mm512_cmp_pd_mask(nv0, zero, _CMP_GT_OQ);
