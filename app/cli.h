@@ -5,9 +5,16 @@
 #ifndef NC_APP_CLI_H
 #define NC_APP_CLI_H
 
+#include <stdio.h>
+
 /* "navcam render" etc.: the log prefix and the error prefix. */
 void nc_cli_init(const char *command);
 /* Prints "navcam CMD: <last error>" and returns 1 (the exit status). */
 int nc_cli_fail(void);
+
+/* JSON members: "key": v then sep (null when v is not finite), and
+ * "key": "v", (the string escaped). */
+void nc_cli_json_num(FILE *f, const char *key, double v, const char *sep);
+void nc_cli_json_str(FILE *f, const char *key, const char *v);
 
 #endif

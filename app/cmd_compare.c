@@ -92,22 +92,6 @@ static int plots(const char *dir, const float *rel, int w, int h, const struct n
     return nc_image_write(path, rel, w, h, NULL, 0, NULL);
 }
 
-static void json_num(FILE *f, const char *key, double v, const char *sep)
-{
-    if (isfinite(v))
-        fprintf(f, "\"%s\": %.9g%s", key, v, sep);
-    else
-        fprintf(f, "\"%s\": null%s", key, sep);
-}
-
-static void json_str(FILE *f, const char *key, const char *v)
-{
-    fprintf(f, "\"%s\": \"", key);
-    for (; *v; v++)
-        fprintf(f, *v == '"' || *v == '\\' ? "\\%c" : (unsigned char)*v < 32 ? "?" : "%c", *v);
-    fprintf(f, "\", ");
-}
-
 int main(int argc, char **argv)
 {
     nc_cli_init("compare");
@@ -187,26 +171,26 @@ int main(int argc, char **argv)
         goto done;
     }
     fprintf(out, "{");
-    json_str(out, "real", real_path);
-    json_str(out, "render", render_path);
+    nc_cli_json_str(out, "real", real_path);
+    nc_cli_json_str(out, "render", render_path);
     fprintf(out, "\"width\": %d, \"height\": %d, ", w, h);
-    json_str(out, "fit", fits[fit]);
-    json_num(out, "scale", res.scale, ", ");
+    nc_cli_json_str(out, "fit", fits[fit]);
+    nc_cli_json_num(out, "scale", res.scale, ", ");
     fprintf(out, "\"shift_px\": [%.6f, %.6f], ", dx, dy);
-    json_num(out, "threshold_real", res.threshold_real, ", ");
-    json_num(out, "threshold_render", res.threshold_render, ", ");
+    nc_cli_json_num(out, "threshold_real", res.threshold_real, ", ");
+    nc_cli_json_num(out, "threshold_render", res.threshold_render, ", ");
     fprintf(out, "\"foreground_px\": %zu, \"relative_error\": {", res.foreground_px);
-    json_num(out, "mean", res.rel_mean, ", ");
-    json_num(out, "median", res.rel_median, ", ");
-    json_num(out, "rms", res.rel_rms, ", ");
-    json_num(out, "p95", res.rel_p95, ", ");
-    json_num(out, "bias", res.rel_bias, "}, \"ncc\": {");
+    nc_cli_json_num(out, "mean", res.rel_mean, ", ");
+    nc_cli_json_num(out, "median", res.rel_median, ", ");
+    nc_cli_json_num(out, "rms", res.rel_rms, ", ");
+    nc_cli_json_num(out, "p95", res.rel_p95, ", ");
+    nc_cli_json_num(out, "bias", res.rel_bias, "}, \"ncc\": {");
     for (int k = 0; k < 5; k++) {
         char key[8];
         snprintf(key, sizeof key, "%d", nc_imgcmp_blocks[k]);
-        json_num(out, key, res.ncc[k], k < 4 ? ", " : "}, ");
+        nc_cli_json_num(out, key, res.ncc[k], k < 4 ? ", " : "}, ");
     }
-    json_num(out, "limb_iou", res.limb_iou, "}\n");
+    nc_cli_json_num(out, "limb_iou", res.limb_iou, "}\n");
     if (json)
         fclose(out);
 done:

@@ -29,6 +29,7 @@ static const char main_help[] =
     "  bench accuracy [-o DIR]      error against time of the render methods (CSV, chart)\n"
     "  stars index STARS.DAT -o IX  NavCam's star index from a catalogue (stars in frames)\n"
     "  compare REAL RENDER          a real image against a render: errors, NCC, limb IoU, shift\n"
+    "  texture IMAGE...             texture statistics: FAST corners, spectrum slope, gradients\n"
     "  batch TRAJ.csv -o DIR        render a trajectory to a dataset (resumable, shardable)\n"
     "\n"
     "Options:\n"
@@ -42,7 +43,7 @@ static const char main_help[] =
     "\n"
     "Configuration keys and units: docs/config.md.\n";
 
-static const char *const commands[] = {"render", "expose", "serve", "replay", "pose", "scene", "brdf", "bench", "stars", "compare", "batch", NULL};
+static const char *const commands[] = {"render", "expose", "serve", "replay", "pose", "scene", "brdf", "bench", "stars", "compare", "texture", "batch", NULL};
 
 /* The command's executable: DIR/libexec/navcam (a build tree) or
  * DIR/../libexec/navcam (an installed tree), DIR being this program's. */

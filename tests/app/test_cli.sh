@@ -222,6 +222,21 @@ expect 1 "is 96x96 but $tmp/other.fits is 64x96: the images must have the same s
 expect 2 "--fit expects scale, histogram or none" -- "$navcam" compare a b --fit gamma
 expect 1 "no.SUM: No such file or directory" -- "$navcam" render -o "$tmp/s.fits" --sumfile "$tmp/no.SUM" \
   --set sun.distance_au=1
+# navcam texture: two renders at once (JSON fields, the region, --gsd), and
+# its argument and file errors.
+expect 0 "FastFeatureDetector" -- "$navcam" texture --help
+"$navcam" texture "$tmp/real.fits" "$tmp/other.fits" --region otsu --gsd 2 > "$tmp/tex.json" 2> "$tmp/tex.err" &&
+  python3 -c "
+import json, sys; d = json.load(open(sys.argv[1]))
+assert len(d) == 2 and d[0]['width'] == 96 and d[1]['width'] == 64 and d[0]['region'] == 'otsu', d
+a = d[0]
+assert 0 < a['region_px'] < 96 * 96 and a['corners'] > 0 and a['psd_beta'] is not None and a['grad_mean'] > 0, a
+assert abs(a['corners_per_m2'] - a['corners'] / (a['region_px'] * 4.0)) < 1e-9 * a['corners_per_m2'], a" \
+  "$tmp/tex.json" && [ ! -s "$tmp/tex.err" ] && ok || bad "navcam texture: $(cat "$tmp/tex.json" "$tmp/tex.err")"
+expect 2 "--band expects FLO,FHI cycles per pixel" -- "$navcam" texture a.fits --band 0.3,0.2
+expect 2 "--threshold expects an integer 0..254" -- "$navcam" texture a.fits -t 300
+expect 2 "give at least one image" -- "$navcam" texture
+expect 1 "navcam texture: $tmp/none.fits" -- "$navcam" texture "$tmp/none.fits"
 expect 0 "--shard K/N" -- "$navcam" batch --help
 
 # The reference USB trigger adapter: its help, its argument errors, and the
