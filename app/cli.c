@@ -1,4 +1,4 @@
-/* cli.c - the commands' shared start-up and error reporting (cli.h). */
+/* cli.c - the commands' shared start-up, error reporting and JSON members (cli.h). */
 #include "app/cli.h"
 
 #include <math.h>

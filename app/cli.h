@@ -1,7 +1,7 @@
 /* cli.h - what the `navcam` commands share: naming the program in log lines
- * and error messages, and reporting the library's last error. Each command
- * is its own small executable (app/cmd_*.c) that links only the layers it
- * uses; app/navcam.c dispatches to them. */
+ * and error messages, reporting the library's last error, and writing JSON
+ * members. Each command is its own small executable (app/cmd_*.c) that
+ * links only the layers it uses; app/navcam.c dispatches to them. */
 #ifndef NC_APP_CLI_H
 #define NC_APP_CLI_H
 

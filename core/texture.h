@@ -14,7 +14,8 @@
  *     components (3 for Gaussian gradients, larger for sparse edges).
  * Images are float arrays, row-major, width x height, any units; NaN and
  * Inf pixels are left out of the region. Pure computation: no files, no
- * logging.
+ * logging; the spectrum plans an FFTW transform, so calls must not run
+ * beside other FFTW planning (FFTW's planner is not thread-safe).
  */
 #ifndef NC_TEXTURE_H
 #define NC_TEXTURE_H
