@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/texture.h"
 
 static char name[64] = "navcam";
 
@@ -35,4 +36,15 @@ void nc_cli_json_str(FILE *f, const char *key, const char *v)
     for (; *v; v++)
         fprintf(f, *v == '"' || *v == '\\' ? "\\%c" : (unsigned char)*v < 32 ? "?" : "%c", *v);
     fprintf(f, "\", ");
+}
+
+void nc_cli_json_texture(FILE *f, const struct nc_texture *t)
+{
+    fprintf(f, "\"region_px\": %zu, \"scale\": [%.9g, %.9g], \"corners\": %zu, ", t->region_px, t->lo, t->hi, t->corners);
+    nc_cli_json_num(f, "corners_per_mpx", t->corners_per_mpx, ", ");
+    nc_cli_json_num(f, "psd_beta", t->psd_beta, ", ");
+    nc_cli_json_num(f, "psd_r2", t->psd_r2, ", ");
+    nc_cli_json_num(f, "grad_mean", t->grad_mean, ", ");
+    nc_cli_json_num(f, "grad_rms", t->grad_rms, ", ");
+    nc_cli_json_num(f, "grad_kurtosis", t->grad_kurtosis, "");
 }

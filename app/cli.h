@@ -17,4 +17,10 @@ int nc_cli_fail(void);
 void nc_cli_json_num(FILE *f, const char *key, double v, const char *sep);
 void nc_cli_json_str(FILE *f, const char *key, const char *v);
 
+/* The members of a texture measurement (core/texture.h): region_px,
+ * scale [lo, hi], corners, corners_per_mpx, psd_beta, psd_r2, grad_mean,
+ * grad_rms, grad_kurtosis (no separator after the last). */
+struct nc_texture;
+void nc_cli_json_texture(FILE *f, const struct nc_texture *t);
+
 #endif

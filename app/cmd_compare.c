@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,7 @@
 #include "app/cli.h"
 #include "core/error.h"
 #include "core/imgcmp.h"
+#include "core/texture.h"
 #include "render/image_io.h"
 
 static const char compare_help[] =
@@ -32,6 +34,9 @@ static const char compare_help[] =
     "     the correlation (NCC) at full resolution and of 2, 4, 8 and 16 px block\n"
     "     means; the limb IoU: overlap of the two silhouettes, each by its own\n"
     "     Otsu threshold, |A and B| / |A or B|.\n"
+    "  5. The texture of REAL and of RENDER (as moved) over the foreground, as\n"
+    "     `navcam texture` measures it with its defaults: FAST corners, the\n"
+    "     power spectrum's slope, gradient statistics.\n"
     "\n"
     "  -o, --output DIR     also write DIR/relative_error.fits (the signed map,\n"
     "                       float32, 0 off the foreground), DIR/relative_error.png\n"
@@ -44,7 +49,9 @@ static const char compare_help[] =
     "The JSON: real, render, width, height, fit, scale, shift_px [dx, dy]\n"
     "(RENDER moved right and down), threshold_real, threshold_render,\n"
     "foreground_px, relative_error {mean, median, rms, p95, bias}, ncc {1, 2, 4,\n"
-    "8, 16: NCC of block means, null when undefined}, limb_iou.\n";
+    "8, 16: NCC of block means, null when undefined}, limb_iou, texture {real,\n"
+    "render: {region_px, scale, corners, corners_per_mpx, psd_beta, psd_r2,\n"
+    "grad_mean, grad_rms, grad_kurtosis}}.\n";
 
 static int plots(const char *dir, const float *rel, int w, int h, const struct nc_imgcmp_result *res)
 {
@@ -136,6 +143,8 @@ int main(int argc, char **argv)
     }
     const char *real_path = argv[optind], *render_path = argv[optind + 1];
     float *real = NULL, *render = NULL, *moved = NULL, *rel = NULL;
+    uint8_t *fg = NULL;
+    struct nc_texture tex[2];
     int w, h, w2, h2, rc;
     double dx = 0, dy = 0;
     struct nc_imgcmp_result res;
@@ -162,6 +171,18 @@ int main(int argc, char **argv)
         nc_imgcmp_shift(render, w, h, dx, dy, moved);
     }
     if ((rc = nc_imgcmp(real, moved, w, h, (enum nc_imgcmp_fit)fit, &res, rel)) < 0)
+        goto done;
+    /* the texture of both over the foreground compared */
+    if (!(fg = malloc(n))) {
+        rc = nc_error(-ENOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < n; i++)
+        fg[i] = isfinite(real[i]) && real[i] > res.threshold_real && real[i] > 0 && isfinite(moved[i]);
+    struct nc_texture_opts to;
+    nc_texture_defaults(&to);
+    to.mask = fg;
+    if ((rc = nc_texture_measure(real, w, h, &to, &tex[0])) < 0 || (rc = nc_texture_measure(moved, w, h, &to, &tex[1])) < 0)
         goto done;
     if (dir && (rc = plots(dir, rel, w, h, &res)) < 0)
         goto done;
@@ -190,7 +211,11 @@ int main(int argc, char **argv)
         snprintf(key, sizeof key, "%d", nc_imgcmp_blocks[k]);
         nc_cli_json_num(out, key, res.ncc[k], k < 4 ? ", " : "}, ");
     }
-    nc_cli_json_num(out, "limb_iou", res.limb_iou, "}\n");
+    nc_cli_json_num(out, "limb_iou", res.limb_iou, ", \"texture\": {\"real\": {");
+    nc_cli_json_texture(out, &tex[0]);
+    fprintf(out, "}, \"render\": {");
+    nc_cli_json_texture(out, &tex[1]);
+    fprintf(out, "}}}\n");
     if (json)
         fclose(out);
 done:
@@ -198,5 +223,6 @@ done:
     free(render);
     free(moved);
     free(rel);
+    free(fg);
     return rc < 0 ? nc_cli_fail() : 0;
 }

@@ -160,17 +160,11 @@ int main(int argc, char **argv)
         nc_cli_json_str(out, "image", argv[optind + k]);
         fprintf(out, "\"width\": %d, \"height\": %d, ", wh[2 * k], wh[2 * k + 1]);
         nc_cli_json_str(out, "region", o.otsu ? "otsu" : "all");
-        fprintf(out, "\"region_px\": %zu, \"scale\": [%.9g, %.9g], \"threshold\": %d, \"corners\": %zu, ", t->region_px,
-                t->lo, t->hi, o.threshold, t->corners);
-        nc_cli_json_num(out, "corners_per_mpx", t->corners_per_mpx, ", ");
+        fprintf(out, "\"threshold\": %d, \"band_cpp\": [%.9g, %.9g], ", o.threshold, o.f_lo, o.f_hi);
         nc_cli_json_num(out, "corners_per_m2", gsd > 0 ? (double)t->corners / ((double)t->region_px * gsd * gsd) : NAN,
                         ", ");
-        fprintf(out, "\"band_cpp\": [%.9g, %.9g], ", o.f_lo, o.f_hi);
-        nc_cli_json_num(out, "psd_beta", t->psd_beta, ", ");
-        nc_cli_json_num(out, "psd_r2", t->psd_r2, ", ");
-        nc_cli_json_num(out, "grad_mean", t->grad_mean, ", ");
-        nc_cli_json_num(out, "grad_rms", t->grad_rms, ", ");
-        nc_cli_json_num(out, "grad_kurtosis", t->grad_kurtosis, "}");
+        nc_cli_json_texture(out, t);
+        fprintf(out, "}");
     }
     fprintf(out, "]\n");
     if (json && fclose(out) != 0)

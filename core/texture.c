@@ -14,7 +14,8 @@
 
 void nc_texture_defaults(struct nc_texture_opts *o)
 {
-    *o = (struct nc_texture_opts){.threshold = 10, .lo = 0, .hi = 0, .otsu = 0, .f_lo = 1.0 / 64, .f_hi = 0.25};
+    *o = (struct nc_texture_opts){
+        .threshold = 10, .lo = 0, .hi = 0, .otsu = 0, .mask = NULL, .f_lo = 1.0 / 64, .f_hi = 0.25};
 }
 
 /* The circle of radius 3 (Bresenham), clockwise from the top. */
@@ -172,18 +173,19 @@ int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_o
         rc = nc_error(-ENOMEM, "texture: out of memory for a %dx%d image", w, h);
         goto done;
     }
-    const double thr = o->otsu ? nc_otsu_threshold(img, n) : -INFINITY;
+    const double thr = o->otsu && !o->mask ? nc_otsu_threshold(img, n) : -INFINITY;
     size_t m = 0;
     double mean = 0;
     for (size_t i = 0; i < n; i++) {
-        region[i] = isfinite(img[i]) && img[i] > thr;
+        region[i] = isfinite(img[i]) && (o->mask ? o->mask[i] != 0 : img[i] > thr);
         if (region[i]) {
             sorted[m++] = img[i];
             mean += img[i];
         }
     }
     if (m == 0) {
-        rc = nc_error(NC_ERANGE, "texture: no pixel in the region (%s)", o->otsu ? "above Otsu's threshold" : "finite");
+        rc = nc_error(NC_ERANGE, "texture: no pixel in the region (%s)",
+                      o->mask ? "the mask given" : o->otsu ? "above Otsu's threshold" : "finite");
         goto done;
     }
     mean /= (double)m;

@@ -30,10 +30,11 @@ struct nc_texture_opts {
                           and 99.5th percentiles */
     int otsu;          /* the region: 0 every finite pixel, 1 those above Otsu's threshold (a body
                           against the sky) */
+    const uint8_t *mask; /* NULL, or the region given: its non-zero pixels (finite ones) */
     double f_lo, f_hi; /* the spectrum's band, cycles per pixel (0 < f_lo < f_hi <= 0.5) */
 };
 
-/* threshold 10, percentiles, every finite pixel, band 1/64 .. 1/4 cycle per pixel */
+/* threshold 10, percentiles, every finite pixel (no mask), band 1/64 .. 1/4 cycle per pixel */
 void nc_texture_defaults(struct nc_texture_opts *o);
 
 struct nc_texture {

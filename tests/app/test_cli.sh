@@ -211,7 +211,10 @@ whole=("${small[@]}" --set camera.pixel_pitch_m=5.5e-5)  # the whole body in the
   python3 -c "
 import json, sys; d = json.load(open(sys.argv[1]))
 dx, dy = d['shift_px']
-assert abs(dx + 2) < 0.15 and abs(dy) < 0.15 and d['limb_iou'] > 0.95 and d['relative_error']['p95'] < 0.1, d" \
+assert abs(dx + 2) < 0.15 and abs(dy) < 0.15 and d['limb_iou'] > 0.95 and d['relative_error']['p95'] < 0.1, d
+a, b = d['texture']['real'], d['texture']['render']  # the same scene: the same texture over the same pixels
+assert a['region_px'] == b['region_px'] == d['foreground_px'] and a['corners'] > 0, d
+assert abs(b['grad_mean'] / a['grad_mean'] - 1) < 0.1 and abs(b['psd_beta'] - a['psd_beta']) < 0.2, d" \
   "$tmp/cmp.json" && [ ! -s "$tmp/cmp.err" ] && ok || bad "navcam compare of a 2 px shift: $(cat "$tmp/cmp.json" "$tmp/cmp.err")"
 for f in relative_error.png error_histogram.png error_histogram.csv relative_error.fits; do
   [ -s "$tmp/cmp/$f" ] && ok || bad "navcam compare -o: no $f"
