@@ -152,6 +152,13 @@ static void check_gradients(void)
     o.otsu = 1;
     CHECK(nc_texture_measure(img, W, H, &o, &t) == 0 && t.region_px > W * H / 3 && t.region_px < 2 * W * H / 3,
           "Otsu's region: %zu of %d px", t.region_px, W * H);
+    static uint8_t mask[W * H]; /* a given region overrides Otsu's: the first 10 rows, less the NaN */
+    for (int i = 0; i < 10 * W; i++)
+        mask[i] = 1;
+    o.mask = mask;
+    CHECK(nc_texture_measure(img, W, H, &o, &t) == 0 && t.region_px == 10 * W - 1, "the mask's region: %zu px",
+          t.region_px);
+    o.mask = NULL;
     for (int i = 0; i < W * H; i++)
         img[i] = NAN;
     CHECK(nc_texture_measure(img, W, H, &o, &t) < 0, "no finite pixel: an error");
