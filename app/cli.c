@@ -40,7 +40,8 @@ void nc_cli_json_str(FILE *f, const char *key, const char *v)
 
 void nc_cli_json_texture(FILE *f, const struct nc_texture *t)
 {
-    fprintf(f, "\"region_px\": %zu, \"scale\": [%.9g, %.9g], \"corners\": %zu, ", t->region_px, t->lo, t->hi, t->corners);
+    fprintf(f, "\"region_px\": %zu, \"scale\": [%.9g, %.9g], \"corners\": %zu, ", t->region_px, t->lo, t->hi,
+            t->corners);
     nc_cli_json_num(f, "corners_per_mpx", t->corners_per_mpx, ", ");
     nc_cli_json_num(f, "psd_beta", t->psd_beta, ", ");
     nc_cli_json_num(f, "psd_r2", t->psd_r2, ", ");

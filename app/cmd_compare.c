@@ -182,7 +182,8 @@ int main(int argc, char **argv)
     struct nc_texture_opts to;
     nc_texture_defaults(&to);
     to.mask = fg;
-    if ((rc = nc_texture_measure(real, w, h, &to, &tex[0])) < 0 || (rc = nc_texture_measure(moved, w, h, &to, &tex[1])) < 0)
+    if ((rc = nc_texture_measure(real, w, h, &to, &tex[0])) < 0 ||
+        (rc = nc_texture_measure(moved, w, h, &to, &tex[1])) < 0)
         goto done;
     if (dir && (rc = plots(dir, rel, w, h, &res)) < 0)
         goto done;
