@@ -1,8 +1,10 @@
 /* cli.c - the commands' shared start-up, error reporting and JSON members (cli.h). */
 #include "app/cli.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -20,6 +22,19 @@ int nc_cli_fail(void)
 {
     fprintf(stderr, "%s: %s\n", name, nc_errmsg());
     return 1;
+}
+
+int nc_cli_out_open(const char *path, FILE **f)
+{
+    *f = path ? fopen(path, "w") : stdout;
+    return *f ? 0 : nc_error(-errno, "%s: %s", path, strerror(errno));
+}
+
+int nc_cli_out_close(FILE *f, const char *path)
+{
+    if (!path)
+        return fflush(f) != 0 ? nc_error(-errno, "standard output: %s", strerror(errno)) : 0;
+    return fclose(f) != 0 ? nc_error(-errno, "%s: %s", path, strerror(errno)) : 0;
 }
 
 void nc_cli_json_num(FILE *f, const char *key, double v, const char *sep)

@@ -12,6 +12,13 @@ void nc_cli_init(const char *command);
 /* Prints "navcam CMD: <last error>" and returns 1 (the exit status). */
 int nc_cli_fail(void);
 
+/* Where a command writes its results: *f is the file path (opened for
+ * writing), or standard output when path is NULL; 0 or a negative error
+ * code. Closing reports a failed write (0 or a negative error code);
+ * standard output is flushed, not closed. */
+int nc_cli_out_open(const char *path, FILE **f);
+int nc_cli_out_close(FILE *f, const char *path);
+
 /* JSON members: "key": v then sep (null when v is not finite), and
  * "key": "v", (the string escaped). */
 void nc_cli_json_num(FILE *f, const char *key, double v, const char *sep);

@@ -187,11 +187,9 @@ int main(int argc, char **argv)
         goto done;
     if (dir && (rc = plots(dir, rel, w, h, &res)) < 0)
         goto done;
-    FILE *out = json ? fopen(json, "w") : stdout;
-    if (!out) {
-        rc = nc_error(-errno, "%s: %s", json, strerror(errno));
+    FILE *out;
+    if ((rc = nc_cli_out_open(json, &out)) < 0)
         goto done;
-    }
     fprintf(out, "{");
     nc_cli_json_str(out, "real", real_path);
     nc_cli_json_str(out, "render", render_path);
@@ -217,8 +215,7 @@ int main(int argc, char **argv)
     fprintf(out, "}, \"render\": {");
     nc_cli_json_texture(out, &tex[1]);
     fprintf(out, "}}}\n");
-    if (json)
-        fclose(out);
+    rc = nc_cli_out_close(out, json);
 done:
     free(real);
     free(render);

@@ -148,11 +148,9 @@ int main(int argc, char **argv)
     }
     if (rc < 0)
         goto done;
-    FILE *out = json ? fopen(json, "w") : stdout;
-    if (!out) {
-        rc = nc_error(-errno, "%s: %s", json, strerror(errno));
+    FILE *out;
+    if ((rc = nc_cli_out_open(json, &out)) < 0)
         goto done;
-    }
     fprintf(out, "[");
     for (int k = 0; k < nimg; k++) {
         const struct nc_texture *t = &res[k];
@@ -167,8 +165,7 @@ int main(int argc, char **argv)
         fprintf(out, "}");
     }
     fprintf(out, "]\n");
-    if (json && fclose(out) != 0)
-        rc = nc_error(-errno, "%s: %s", json, strerror(errno));
+    rc = nc_cli_out_close(out, json);
 done:
     free(res);
     free(wh);
