@@ -6,8 +6,8 @@
  * corner density and the gradient and flatten the power spectrum by at
  * least the margins below (the example scenes at 20 cm per pixel show 1.7
  * to 3.9 times the corners, 1.7 to 9 times the gradient and slopes 0.3 to
- * 2.1 lower: docs/terrain.md, "Texture"). The range real rubble-pile images
- * fall in is not asserted: no citable figures yet (docs/terrain.md). */
+ * 2.1 lower: docs/terrain.md, "Texture"). That a rubble pile's figures lie
+ * in the range of real images is tests/camera/test_real_texture.c's. */
 #include <math.h>
 
 #include "core/error.h"

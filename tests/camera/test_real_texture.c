@@ -1,0 +1,95 @@
+/* test_real_texture.c - a rendered rubble pile at 20 cm per pixel has the
+ * texture of real ones: configs/examples/rubble_closeup.yaml (rocks of the
+ * Bennu preset from 0.3 m, lit and seen as OSIRIS-REx MapCam saw Bennu at
+ * about 9 deg phase) rendered and put through its camera model to a DN
+ * frame, as `navcam render -q dn` does (frame 0), measured as `navcam texture
+ * --band 0.03125,0.25` does. Every figure must lie in the range of eleven
+ * 256x256 crops of three MapCam frames of Bennu at 0.25 and 0.33 m per pixel
+ * (docs/terrain.md, "Texture": the frames, where they come from, the crops).
+ * The scene's albedo spread and PSF were set from those frames' brightness
+ * distribution and their spectrum's fall near the Nyquist frequency; the
+ * figures below were not fitted. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "camera/camsys.h"
+#include "camera/load.h"
+#include "core/error.h"
+#include "core/texture.h"
+#include "render/render.h"
+#include "testutil.h"
+
+/* docs/terrain.md, "Texture": the lowest and highest of the eleven crops */
+static const struct {
+    const char *name;
+    double lo, hi;
+} real[] = {
+    {"corners per Mpx", 53741, 70557}, {"psd_beta", 1.37, 2.58},      {"grad_mean", 0.048, 0.106},
+    {"grad_rms", 0.064, 0.136},        {"grad_kurtosis", 5.49, 9.78},
+};
+
+int main(void)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/configs/examples/rubble_closeup.yaml", NC_SOURCE_DIR);
+    struct nc_scene s;
+    struct nc_camsys cs;
+    CHECK(nc_setup_load(path, NULL, 0, &s, &cs) == 0, "%s", nc_errmsg());
+    if (nc_test_failed)
+        return nc_test_end();
+    const int w = cs.width_px, h = cs.height_px;
+    const size_t n = (size_t)w * (size_t)h;
+    nc_camsys_render_camera(&cs, &s.camera, &s.camera);
+    struct nc_renderer r;
+    struct nc_frame f;
+    float *el = malloc(n * sizeof *el), *img = malloc(n * sizeof *img);
+    uint16_t *dn = malloc(n * sizeof *dn);
+    CHECK(el && img && dn, "out of memory");
+    if (nc_test_failed)
+        return nc_test_end();
+    CHECK(nc_renderer_init(&r, &s, 2) == 0 && nc_frame_alloc(&f, s.camera.width_px, s.camera.height_px) == 0 &&
+              nc_render_frame(&r, &s, &f) == 0,
+          "%s", nc_errmsg());
+    CHECK(nc_camsys_electrons(&cs, f.radiance, cs.exposure_s, el) == 0 &&
+              nc_camsys_digitise(&cs, el, cs.exposure_s, 0, dn) == 0,
+          "%s", nc_errmsg());
+
+    /* the ground sample distance: the mean range over the render (all of it
+     * on the surface) over the focal length in pixels */
+    double sum = 0;
+    size_t on = 0, all = (size_t)f.width_px * (size_t)f.height_px, top = 0;
+    for (size_t i = 0; i < all; i++)
+        if (f.range_m[i] > 0)
+            sum += f.range_m[i], on++;
+    CHECK(on == all, "the surface fills the frame (%zu of %zu px)", on, all);
+    const double gsd_m = sum / (double)on / s.camera.fx_px;
+    CHECK(fabs(gsd_m / 0.2 - 1) < 0.03, "ground sample %.3f m", gsd_m);
+    for (size_t i = 0; i < n; i++) {
+        img[i] = dn[i];
+        top += dn[i] >= (1u << cs.sensor.adc_bits) - 1;
+    }
+    CHECK(top == 0, "%zu pixels saturated", top);
+
+    struct nc_texture_opts o;
+    nc_texture_defaults(&o);
+    o.f_lo = 1.0 / 32; /* 8 cycles across 256 px (docs/compare.md) */
+    struct nc_texture t;
+    CHECK(nc_texture_measure(img, w, h, &o, &t) == 0, "%s", nc_errmsg());
+    const double got[] = {t.corners_per_mpx, t.psd_beta, t.grad_mean, t.grad_rms, t.grad_kurtosis};
+    printf("%dx%d DN at %.3f m/px:", w, h, gsd_m);
+    for (size_t k = 0; k < sizeof real / sizeof real[0]; k++) {
+        printf(" %s %.5g (real %.5g .. %.5g)%s", real[k].name, got[k], real[k].lo, real[k].hi,
+               k + 1 < sizeof real / sizeof real[0] ? "," : "\n");
+        CHECK(got[k] >= real[k].lo && got[k] <= real[k].hi, "%s %.4g outside the real frames' %.4g .. %.4g",
+              real[k].name, got[k], real[k].lo, real[k].hi);
+    }
+    free(el);
+    free(img);
+    free(dn);
+    nc_frame_free(&f);
+    nc_renderer_free(&r);
+    nc_camsys_free(&cs);
+    nc_scene_free(&s);
+    return nc_test_end();
+}
