@@ -15,7 +15,7 @@
 
 static const char texture_help[] =
     "Usage: navcam texture IMAGE... [--threshold T] [--range LO,HI] [--region R]\n"
-    "                       [--band FLO,FHI] [--gsd M] [--json FILE]\n"
+    "                       [--band FLO,FHI] [--crop X,Y,W,H] [--gsd M] [--json FILE]\n"
     "\n"
     "The texture of images (any format navcam reads: FITS, TIFF, EXR, PNG; the\n"
     "first channel) as feature trackers see it, the same way for a render and a\n"
@@ -46,18 +46,23 @@ static const char texture_help[] =
     "                      Otsu's threshold (a body against the sky)\n"
     "  -b, --band FLO,FHI  the spectrum's band, cycles per pixel, 0 < FLO < FHI <= 0.5\n"
     "                      (default 0.015625,0.25: wavelengths of 4 to 64 px)\n"
+    "  -c, --crop X,Y,W,H  measure only W x H pixels of each image from column X,\n"
+    "                      row Y (0-based; row 0 is the top row: FITS files are\n"
+    "                      read top-down whatever their ROWORDER)\n"
     "  -g, --gsd M         ground sample distance, m per pixel: also corners per m^2\n"
     "  -j, --json FILE     the results in FILE (default: standard output)\n"
     "  -h, --help          this help\n"
     "\n"
     "The JSON: an array, one object per image: image, width, height, region,\n"
+    "crop [X, Y, W, H] (null without --crop; width and height are the crop's),\n"
     "region_px, scale [LO, HI], threshold, corners, corners_per_mpx,\n"
     "corners_per_m2 (null without --gsd), band_cpp [FLO, FHI], psd_beta, psd_r2,\n"
     "grad_mean, grad_rms, grad_kurtosis (null where undefined).\n"
     "\n"
     "Example:\n"
     "  navcam render configs/examples/bennu_rubble.yaml -o r.fits --quantity radiance\n"
-    "  navcam texture r.fits real_image.fits --gsd 0.2\n";
+    "  navcam texture r.fits real_image.fits --gsd 0.2\n"
+    "  navcam texture frame.tif --crop 256,128,256,256 --band 0.03125,0.25\n";
 
 /* "A,B" into two numbers; 0, or -1 if it is not that. */
 static int pair(const char *s, double *a, double *b)
@@ -69,6 +74,35 @@ static int pair(const char *s, double *a, double *b)
     const char *t = end + 1;
     *b = strtod(t, &end);
     return end == t || *end ? -1 : 0;
+}
+
+/* "X,Y,W,H": four integers, X and Y >= 0, W and H > 0; 0, or -1. */
+static int crop4(const char *s, int c[4])
+{
+    for (int k = 0; k < 4; k++) {
+        char *end;
+        long v = strtol(s, &end, 10);
+        if (end == s || *end != (k < 3 ? ',' : '\0') || v < (k < 2 ? 0 : 1) || v > 1000000)
+            return -1;
+        c[k] = (int)v;
+        s = end + 1;
+    }
+    return 0;
+}
+
+/* px (w x h) cut to crop c in place (*w, *h become its size), or an error
+ * naming path if it does not fit. */
+static int cut(const char *path, float *px, int *w, int *h, const int c[4])
+{
+    if (c[0] + c[2] > *w || c[1] + c[3] > *h)
+        return nc_error(NC_ECONFIG, "%s: --crop %d,%d,%d,%d reaches beyond its %dx%d pixels", path, c[0], c[1], c[2],
+                        c[3], *w, *h);
+    for (int y = 0; y < c[3]; y++)
+        memmove(px + (size_t)y * (size_t)c[2], px + (size_t)(c[1] + y) * (size_t)*w + (size_t)c[0],
+                (size_t)c[2] * sizeof *px);
+    *w = c[2];
+    *h = c[3];
+    return 0;
 }
 
 static int usage(const char *msg, const char *arg)
@@ -84,15 +118,16 @@ int main(int argc, char **argv)
         {"threshold", required_argument, NULL, 't'}, {"range", required_argument, NULL, 'r'},
         {"region", required_argument, NULL, 'R'},    {"band", required_argument, NULL, 'b'},
         {"gsd", required_argument, NULL, 'g'},       {"json", required_argument, NULL, 'j'},
-        {"help", no_argument, NULL, 'h'},            {NULL, 0, NULL, 0},
+        {"crop", required_argument, NULL, 'c'},      {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
     };
     struct nc_texture_opts o;
     nc_texture_defaults(&o);
     const char *json = NULL;
     double gsd = 0;
-    int c;
+    int c, crop[4] = {0, 0, 0, 0};
     optind = 1;
-    while ((c = getopt_long(argc, argv, "t:r:R:b:g:j:h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "t:r:R:b:g:j:c:h", opts, NULL)) != -1) {
         char *end;
         switch (c) {
         case 't': {
@@ -120,6 +155,10 @@ int main(int argc, char **argv)
             if (end == optarg || *end || !(gsd > 0) || !isfinite(gsd))
                 return usage("--gsd expects metres per pixel, > 0", optarg);
             break;
+        case 'c':
+            if (crop4(optarg, crop) < 0)
+                return usage("--crop expects X,Y,W,H in pixels: X, Y >= 0, W, H > 0", optarg);
+            break;
         case 'j': json = optarg; break;
         case 'h': fputs(texture_help, stdout); return 0;
         default: fputs("Try 'navcam texture --help'.\n", stderr); return 2;
@@ -138,8 +177,9 @@ int main(int argc, char **argv)
     }
     for (int k = 0; k < nimg && rc == 0; k++) {
         float *px = NULL;
-        if ((rc = nc_image_read(argv[optind + k], &px, &wh[2 * k], &wh[2 * k + 1])) == 0 &&
-            (rc = nc_texture_measure(px, wh[2 * k], wh[2 * k + 1], &o, &res[k])) < 0) {
+        if ((rc = nc_image_read(argv[optind + k], &px, &wh[2 * k], &wh[2 * k + 1])) == 0 && crop[2] > 0)
+            rc = cut(argv[optind + k], px, &wh[2 * k], &wh[2 * k + 1], crop);
+        if (rc == 0 && (rc = nc_texture_measure(px, wh[2 * k], wh[2 * k + 1], &o, &res[k])) < 0) {
             char msg[512];
             snprintf(msg, sizeof msg, "%s", nc_errmsg());
             nc_error(rc, "%s: %s", argv[optind + k], msg);
@@ -157,6 +197,10 @@ int main(int argc, char **argv)
         fprintf(out, "%s{", k ? ",\n " : "");
         nc_cli_json_str(out, "image", argv[optind + k]);
         fprintf(out, "\"width\": %d, \"height\": %d, ", wh[2 * k], wh[2 * k + 1]);
+        if (crop[2] > 0)
+            fprintf(out, "\"crop\": [%d, %d, %d, %d], ", crop[0], crop[1], crop[2], crop[3]);
+        else
+            fprintf(out, "\"crop\": null, ");
         nc_cli_json_str(out, "region", o.otsu ? "otsu" : "all");
         fprintf(out, "\"threshold\": %d, \"band_cpp\": [%.9g, %.9g], ", o.threshold, o.f_lo, o.f_hi);
         nc_cli_json_num(out, "corners_per_m2", gsd > 0 ? (double)t->corners / ((double)t->region_px * gsd * gsd) : NAN,

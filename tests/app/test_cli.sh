@@ -236,6 +236,18 @@ a = d[0]
 assert 0 < a['region_px'] < 96 * 96 and a['corners'] > 0 and a['psd_beta'] is not None and a['grad_mean'] > 0, a
 assert abs(a['corners_per_m2'] - a['corners'] / (a['region_px'] * 4.0)) < 1e-9 * a['corners_per_m2'], a" \
   "$tmp/tex.json" && [ ! -s "$tmp/tex.err" ] && ok || bad "navcam texture: $(cat "$tmp/tex.json" "$tmp/tex.err")"
+# --crop: the whole frame as a crop measures as the frame; a window is its own size.
+"$navcam" texture "$tmp/real.fits" --region otsu > "$tmp/tex_all.json" &&
+  "$navcam" texture "$tmp/real.fits" "$tmp/real.fits" --region otsu --crop 0,0,96,96 > "$tmp/tex_c.json" &&
+  "$navcam" texture "$tmp/real.fits" --crop 16,8,64,80 > "$tmp/tex_w.json" &&
+  python3 -c "
+import json, sys; a, c, w = (json.load(open(f)) for f in sys.argv[1:])
+assert a[0]['crop'] is None and c[0]['crop'] == [0, 0, 96, 96], (a, c)
+assert all(c[0][k] == a[0][k] for k in a[0] if k != 'crop'), (a, c)
+assert w[0]['width'] == 64 and w[0]['height'] == 80 and w[0]['region_px'] == 64 * 80, w" \
+  "$tmp/tex_all.json" "$tmp/tex_c.json" "$tmp/tex_w.json" && ok || bad "navcam texture --crop"
+expect 1 "--crop 40,0,64,64 reaches beyond its 96x96 pixels" -- "$navcam" texture "$tmp/real.fits" --crop 40,0,64,64
+expect 2 "--crop expects X,Y,W,H in pixels" -- "$navcam" texture a.fits --crop 1,2,0,4
 expect 2 "--band expects FLO,FHI cycles per pixel" -- "$navcam" texture a.fits --band 0.3,0.2
 expect 2 "--threshold expects an integer 0..254" -- "$navcam" texture a.fits -t 300
 expect 2 "give at least one image" -- "$navcam" texture
