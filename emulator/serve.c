@@ -21,6 +21,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/proc.h"
 #include "emulator/serve_internal.h"
 
 /* Scene, camera model, serve section and outputs from the configuration. */
@@ -70,9 +71,12 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
     e->slots = calloc((size_t)e->nslots, sizeof *e->slots);
     if (!e->jobs || !e->slots)
         return nc_error(-ENOMEM, "out of memory");
-    for (int i = 0; i < e->nslots; i++)
-        if (!(e->slots[i].dn = malloc((size_t)e->scene.camera.width_px * e->scene.camera.height_px * sizeof(uint16_t))))
+    const size_t dn_bytes = (size_t)e->scene.camera.width_px * e->scene.camera.height_px * sizeof(uint16_t);
+    for (int i = 0; i < e->nslots; i++) {
+        if (!(e->slots[i].dn = malloc(dn_bytes)))
             return nc_error(-ENOMEM, "out of memory");
+        nc_touch_pages(e->slots[i].dn, dn_bytes); /* faulted in now, not by the first frames (nc_frame_alloc) */
+    }
     return 0;
 }
 
