@@ -240,17 +240,18 @@ static int gather(const struct grid *g, const struct nc_mesh *m, const double *n
     return 0;
 }
 
-int nc_craters_apply(struct nc_crater_field *f, struct nc_mesh *m)
+int nc_craters_apply(struct nc_crater_field *f, struct nc_mesh *m, const double *dir)
 {
     f->applied = 0;
     if (!f->n || !m->nv)
         return 0;
     struct grid g = {0};
     struct near nb = {0};
-    double *nrm = malloc(3 * m->nv * sizeof *nrm), *h = calloc(m->nv, sizeof *h);
+    double *own = dir ? NULL : malloc(3 * m->nv * sizeof *own), *h = calloc(m->nv, sizeof *h);
+    const double *nrm = dir ? dir : own;
     int rc = nrm && h ? grid_build(m, &g) : nc_error(-ENOMEM, "out of memory for %zu vertices", m->nv);
-    if (rc == 0)
-        nc_mesh_vertex_normals(m, nrm);
+    if (rc == 0 && own)
+        nc_mesh_vertex_normals(m, own);
     for (size_t i = 0; i < f->n && rc == 0; i++) {
         const struct nc_crater *c = &f->crater[i];
         double R = 0.5 * c->d_m, ref = 0;
@@ -281,7 +282,7 @@ int nc_craters_apply(struct nc_crater_field *f, struct nc_mesh *m)
     free(g.idx);
     free(nb.v);
     free(nb.dist);
-    free(nrm);
+    free(own);
     free(h);
     return rc;
 }

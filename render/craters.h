@@ -61,9 +61,13 @@ double nc_craters_density_for(const struct nc_crater_params *p, double area_km2,
 int nc_craters_generate(const struct nc_mesh *m, const struct nc_crater_params *p, size_t max_craters,
                         struct nc_crater_field *out);
 /* Carve the field into m, oldest crater first: each vertex moves along its
- * (pre-crater) normal. A crater whose cavity holds no vertex is below the
- * mesh's resolution and left out (f->applied counts the others). */
-int nc_craters_apply(struct nc_crater_field *f, struct nc_mesh *m);
+ * direction in dir (3 nv unit vectors; NULL: the mesh's pre-crater vertex
+ * normals). On a mesh with relief, pass the surface normals under the relief
+ * (nc_mesh_relief's base_normals): its rough vertex normals would turn a
+ * deep crater's displacement from vertex to vertex and fold the mesh. A
+ * crater whose cavity holds no vertex is below the mesh's resolution and
+ * left out (f->applied counts the others). */
+int nc_craters_apply(struct nc_crater_field *f, struct nc_mesh *m, const double *dir);
 void nc_craters_free(struct nc_crater_field *f);
 
 #endif

@@ -55,8 +55,14 @@ struct nc_relief_info {
     double edge_m;       /* and after (halved per level) */
     double s;            /* the s used, m^(1-H) */
 };
+/* base_normals (NULL: not wanted): on success with at least one level,
+ * *base_normals holds each vertex's normal of the model's surface under it
+ * (3 nv doubles, unit, malloc'd: the caller frees), interpolated from the
+ * model's vertex normals: smooth at the model's scale, free of the relief's
+ * roughness, so that a further displacement along them (craters) cannot
+ * fold the relief; NULL when nothing was subdivided. */
 int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t max_triangles,
-                   struct nc_relief_info *info);
+                   struct nc_relief_info *info, double **base_normals);
 #define NC_RELIEF_MAX_TRIANGLES 8000000
 
 int nc_mesh_asteroid(const struct nc_asteroid_params *p, struct nc_mesh *out);

@@ -94,7 +94,7 @@ int nc_mesh_asteroid(const struct nc_asteroid_params *ap, struct nc_mesh *out)
     struct nc_crater_field cf;
     int rc = nc_craters_generate(&m, &cp, NC_CRATERS_MAX, &cf);
     if (rc == 0)
-        rc = nc_craters_apply(&cf, &m);
+        rc = nc_craters_apply(&cf, &m, NULL);
     nc_craters_free(&cf);
     if (rc < 0) {
         nc_mesh_free(&m);

@@ -107,9 +107,11 @@ static void displace(void *ctx, const struct nc_mesh *m, uint32_t a, uint32_t b,
 }
 
 int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t max_triangles,
-                   struct nc_relief_info *info)
+                   struct nc_relief_info *info, double **base_normals)
 {
     memset(info, 0, sizeof *info);
+    if (base_normals)
+        *base_normals = NULL;
     if (!(p->edge_m > 0) || !(p->hurst > 0 && p->hurst < 1) || !(p->amplitude >= 0))
         return nc_error(NC_ERANGE, "relief: need edge_m > 0, 0 < hurst < 1, amplitude >= 0");
     struct relief r = {.hurst = p->hurst, .factor = midpoint_factor(p->hurst), .seed = p->seed};
@@ -155,6 +157,10 @@ int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t m
         rc = nc_mesh_subdivide(m, &displace, &r);
         info->edge_m /= 2;
         info->levels = k + 1;
+    }
+    if (rc == 0 && base_normals) { /* the model's own vertices keep their vertex normals */
+        *base_normals = r.nrm;
+        r.nrm = NULL;
     }
     free(r.base);
     free(r.nrm);

@@ -8,6 +8,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -26,7 +27,7 @@ int nc__scene_error_at(const struct nc_cfg_node *n)
 /* `shape.craters` of a mesh or asteroid: a mean count of the default
  * population (a number), or a map of its parameters. An asteroid without
  * the key gets 100. */
-static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir)
 {
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
     if (!node && b->shape != NC_SHAPE_ASTEROID)
@@ -80,7 +81,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         p.c_per_km2 = nc_craters_density_for(&p, area_km2, count);
     struct nc_crater_field f;
     if ((rc = nc_craters_generate(&b->mesh, &p, NC_CRATERS_MAX, &f)) == 0)
-        rc = nc_craters_apply(&f, &b->mesh);
+        rc = nc_craters_apply(&f, &b->mesh, dir);
     if (rc < 0) {
         nc_craters_free(&f);
         return nc__scene_error_at(node ? node : sh);
@@ -155,9 +156,11 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
     return 0;
 }
 
-/* `shape.relief` of a mesh or asteroid: fBm relief below its resolution. */
-static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+/* `shape.relief` of a mesh or asteroid: fBm relief below its resolution;
+ * *base_normals the normals under it (nc_mesh_relief), NULL without relief. */
+static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double **base_normals)
 {
+    *base_normals = NULL;
     struct nc_cfg_node *map;
     int rc;
     if ((rc = nc_cfg_map(sh, "relief", &map)) <= 0)
@@ -172,7 +175,7 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
         return rc;
     struct nc_relief_info info;
-    if ((rc = nc_mesh_relief(&b->mesh, &p, NC_RELIEF_MAX_TRIANGLES, &info)) < 0) {
+    if ((rc = nc_mesh_relief(&b->mesh, &p, NC_RELIEF_MAX_TRIANGLES, &info, base_normals)) < 0) {
         return nc__scene_error_at(map);
     }
     nc_log_info("scene", "body '%s': relief from mean edges of %.4g m down to %.4g m (%d subdivisions, %zu triangles; "
@@ -222,7 +225,14 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
     if (rc && !has_mesh(b))
         return nc_cfg_error(nc_cfg_get(shape, "normals"), "normals apply to mesh and asteroid shapes");
     b->smooth_normals = smooth;
-    if ((rc = relief_from_config(shape, b)) < 0 || (rc = craters_from_config(shape, b)) < 0)
+    /* Craters displace the relief along the surface under it, not along
+     * its own rough normals (craters.h). */
+    double *under = NULL;
+    rc = relief_from_config(shape, b, &under);
+    if (rc >= 0)
+        rc = craters_from_config(shape, b, under);
+    free(under);
+    if (rc < 0)
         return rc;
     if ((rc = boulders_from_config(item, b)) < 0)
         return rc;

@@ -5,15 +5,19 @@
  * ejecta at the heights of the profile, an old one shallower by its age, a
  * young crater erasing the older relief inside its cavity, and a crater
  * smaller than the mesh spacing left out; the config forms (count,
- * density, saturation) and their errors; and the population counted in
- * rendered frames (cavities that show) recovering the slope and density. */
+ * density, saturation) and their errors; the population counted in
+ * rendered frames (cavities that show) recovering the slope and density;
+ * and a deep crater on a rough relief mesh, carved along the surface under
+ * the relief, folding no face over. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "render/craters.h"
 #include "render/image_io.h"
+#include "render/mesh.h"
 #include "render/render.h"
 #include "testutil.h"
 
@@ -117,7 +121,7 @@ static void carve(struct nc_mesh *m, struct nc_crater *c, size_t n, struct nc_cr
     nc_crater_params_default(m, &f->params);
     f->crater = c;
     f->n = n;
-    CHECK(nc_craters_apply(f, m) == 0, "%s", nc_errmsg());
+    CHECK(nc_craters_apply(f, m, NULL) == 0, "%s", nc_errmsg());
 }
 
 static void check_morphology(void)
@@ -330,8 +334,76 @@ static void check_frame_count(void)
     free(seen);
 }
 
+/* Faces of m whose normal points against the direction the relief and the
+ * craters displaced their corners along (dir): folded over. */
+static size_t folded(const struct nc_mesh *m, const double *dir)
+{
+    size_t n = 0;
+    for (size_t t = 0; t < m->nt; t++) {
+        const uint32_t *f = m->tri + 3 * t;
+        const double *a = m->v + 3 * f[0], *b = m->v + 3 * f[1], *c = m->v + 3 * f[2];
+        double u[3], v[3], dot = 0;
+        for (int k = 0; k < 3; k++)
+            u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+        const double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        for (int k = 0; k < 3; k++)
+            dot += nrm[k] * (dir[3 * f[0] + k] + dir[3 * f[1] + k] + dir[3 * f[2] + k]);
+        n += dot <= 0;
+    }
+    return n;
+}
+
+/* A rough model (an icosphere of 100 m with its vertices moved along their
+ * radii by up to +-1.5 m), relief to a quarter of its edge continuing that
+ * roughness, and a crater 60 m across (12 m deep) on it. Carved along the
+ * normals under the relief it adds no folded face; along the relief's own
+ * vertex normals (the old way) it folded some, which a camera sees as holes
+ * (the faces' backs, unlit). */
+static void check_relief_fold(void)
+{
+    size_t fold[2];
+    for (int way = 0; way < 2; way++) {
+        struct nc_mesh m;
+        struct nc_asteroid_params ap = {.radii_m = {100, 100, 100}, .subdivisions = 4}; /* no lumps, no craters */
+        CHECK(nc_mesh_asteroid(&ap, &m) == 0, "%s", nc_errmsg());
+        for (size_t i = 0; i < m.nv; i++) {
+            double *p = m.v + 3 * i, r = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+            double k = (100 + 3 * ((double)(nc_rng_seed(7, 0, i) >> 11) * 0x1.0p-53 - 0.5)) / r;
+            p[0] *= k, p[1] *= k, p[2] *= k;
+        }
+        struct nc_relief_params rp = {.edge_m = 0.25 * nc_mesh_mean_edge_m(&m), .hurst = 0.8, .amplitude = 1, .seed = 3};
+        struct nc_relief_info info;
+        double *under = NULL, *own = malloc(3 * (m.nv + 3 * 16 * m.nt) * sizeof *own);
+        CHECK(own && nc_mesh_relief(&m, &rp, NC_RELIEF_MAX_TRIANGLES, &info, &under) == 0 && under && info.levels == 2,
+              "%s", nc_errmsg());
+        if (!own || !under) {
+            free(own);
+            free(under);
+            nc_mesh_free(&m);
+            return;
+        }
+        const size_t before = folded(&m, under);
+        struct nc_crater c = {.centre_m = {0, 0, 100}, .normal = {0, 0, 1}, .d_m = 60, .age = 0};
+        struct nc_crater_field f;
+        memset(&f, 0, sizeof f);
+        nc_crater_params_default(&m, &f.params);
+        f.crater = &c;
+        f.n = 1;
+        nc_mesh_vertex_normals(&m, own);
+        CHECK(nc_craters_apply(&f, &m, way ? own : under) == 0 && f.applied == 1, "%s", nc_errmsg());
+        fold[way] = folded(&m, under) - before;
+        printf("crater on rough relief (%zu faces, s %.3g), carved along %s: %zu faces folded over (%zu before)\n",
+               m.nt, info.s, way ? "the relief's vertex normals" : "the normals under the relief", fold[way], before);
+        free(own);
+        free(under);
+        nc_mesh_free(&m);
+    }
+    CHECK(fold[0] == 0, "%zu faces folded over by the crater", fold[0]);
+}
+
 int main(void)
 {
+    check_relief_fold();
     check_population();
     check_frame_count();
     check_morphology();

@@ -85,7 +85,7 @@ int main(void)
     for (int k = 0; k < 2; k++) {
         struct nc_mesh *m = k ? &b : &a;
         copy_mesh(&model, m);
-        CHECK(nc_mesh_relief(m, &p, NC_RELIEF_MAX_TRIANGLES, k ? &ib : &ia) == 0, "%s", nc_errmsg());
+        CHECK(nc_mesh_relief(m, &p, NC_RELIEF_MAX_TRIANGLES, k ? &ib : &ia, NULL) == 0, "%s", nc_errmsg());
     }
     CHECK(ia.levels == 4 && a.nt == 256 * model.nt, "4 levels: %d, %zu triangles", ia.levels, a.nt);
     CHECK(!memcmp(a.v, model.v, 3 * model.nv * sizeof *a.v), "the model's own vertices do not move");
@@ -101,7 +101,7 @@ int main(void)
         copy_mesh(&model, &m);
         struct nc_relief_params q = p;
         q.edge_m = edge0 / exp2(level) * 1.001;
-        CHECK(nc_mesh_relief(&m, &q, NC_RELIEF_MAX_TRIANGLES, &info) == 0 && info.levels == level, "level %d", level);
+        CHECK(nc_mesh_relief(&m, &q, NC_RELIEF_MAX_TRIANGLES, &info, NULL) == 0 && info.levels == level, "level %d", level);
         lx[level - 1] = log(10.0 / exp2(level - 1)); /* the parent edge */
         ly[level - 1] = log(midpoint_rms(&m, &prev));
         printf("level %d: parent edge %.4g m, midpoint RMS %.4g m\n", level, exp(lx[level - 1]), exp(ly[level - 1]));
@@ -123,7 +123,7 @@ int main(void)
     struct nc_relief_params tiny = p;
     tiny.edge_m = 1e-4;
     struct nc_relief_info info;
-    CHECK(nc_mesh_relief(&model, &tiny, NC_RELIEF_MAX_TRIANGLES, &info) == NC_ERANGE &&
+    CHECK(nc_mesh_relief(&model, &tiny, NC_RELIEF_MAX_TRIANGLES, &info, NULL) == NC_ERANGE &&
               nc_test_contains(nc_errmsg(), "edge_m"), "refused: %s", nc_errmsg());
     nc_mesh_free(&model);
     return nc_test_end();

@@ -4,9 +4,9 @@
  * nothing folded), measured by core/texture.h as `navcam texture` does.
  * Asserted: the ground sample distance, and that the rocks raise the FAST
  * corner density and the gradient and flatten the power spectrum by at
- * least the margins below (the example scenes at 20 cm per pixel show 1.7
- * to 3.9 times the corners, 1.7 to 9 times the gradient and slopes 0.3 to
- * 2.1 lower: docs/terrain.md, "Texture"). That a rubble pile's figures lie
+ * least the margins below (the example scenes at 20 cm per pixel show 1.9
+ * and 6.4 times the corners, 1.9 and 11 times the gradient and slopes 1.0
+ * and 2.5 lower: docs/terrain.md, "Texture"). That a rubble pile's figures lie
  * in the range of real images is tests/camera/test_real_texture.c's. */
 #include <math.h>
 
