@@ -361,11 +361,13 @@ static size_t folded(const struct nc_mesh *m, const double *dir)
  * (the faces' backs, unlit). */
 static void check_relief_fold(void)
 {
-    size_t fold[2];
+    long fold[2]; /* faces the crater folded over, net */
     for (int way = 0; way < 2; way++) {
         struct nc_mesh m;
         struct nc_asteroid_params ap = {.radii_m = {100, 100, 100}, .subdivisions = 4}; /* no lumps, no craters */
         CHECK(nc_mesh_asteroid(&ap, &m) == 0, "%s", nc_errmsg());
+        if (nc_test_failed)
+            return;
         for (size_t i = 0; i < m.nv; i++) {
             double *p = m.v + 3 * i, r = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
             double k = (100 + 3 * ((double)(nc_rng_seed(7, 0, i) >> 11) * 0x1.0p-53 - 0.5)) / r;
@@ -373,9 +375,10 @@ static void check_relief_fold(void)
         }
         struct nc_relief_params rp = {.edge_m = 0.25 * nc_mesh_mean_edge_m(&m), .hurst = 0.8, .amplitude = 1, .seed = 3};
         struct nc_relief_info info;
-        double *under = NULL, *own = malloc(3 * (m.nv + 3 * 16 * m.nt) * sizeof *own);
-        CHECK(own && nc_mesh_relief(&m, &rp, NC_RELIEF_MAX_TRIANGLES, &info, &under) == 0 && under && info.levels == 2,
-              "%s", nc_errmsg());
+        double *under = NULL;
+        CHECK(nc_mesh_relief(&m, &rp, NC_RELIEF_MAX_TRIANGLES, &info, &under) == 0 && under && info.levels == 2, "%s",
+              nc_errmsg());
+        double *own = malloc(3 * m.nv * sizeof *own);
         if (!own || !under) {
             free(own);
             free(under);
@@ -391,14 +394,14 @@ static void check_relief_fold(void)
         f.n = 1;
         nc_mesh_vertex_normals(&m, own);
         CHECK(nc_craters_apply(&f, &m, way ? own : under) == 0 && f.applied == 1, "%s", nc_errmsg());
-        fold[way] = folded(&m, under) - before;
-        printf("crater on rough relief (%zu faces, s %.3g), carved along %s: %zu faces folded over (%zu before)\n",
+        fold[way] = (long)folded(&m, under) - (long)before;
+        printf("crater on rough relief (%zu faces, s %.3g), carved along %s: %ld faces folded over (%zu before)\n",
                m.nt, info.s, way ? "the relief's vertex normals" : "the normals under the relief", fold[way], before);
         free(own);
         free(under);
         nc_mesh_free(&m);
     }
-    CHECK(fold[0] == 0, "%zu faces folded over by the crater", fold[0]);
+    CHECK(fold[0] <= 0, "%ld faces folded over by the crater", fold[0]);
 }
 
 int main(void)
