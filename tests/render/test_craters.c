@@ -373,7 +373,8 @@ static void check_relief_fold(void)
             double k = (100 + 3 * ((double)(nc_rng_seed(7, 0, i) >> 11) * 0x1.0p-53 - 0.5)) / r;
             p[0] *= k, p[1] *= k, p[2] *= k;
         }
-        struct nc_relief_params rp = {.edge_m = 0.25 * nc_mesh_mean_edge_m(&m), .hurst = 0.8, .amplitude = 1, .seed = 3};
+        const double edge_m = 0.25 * nc_mesh_mean_edge_m(&m);
+        struct nc_relief_params rp = {.edge_m = edge_m, .hurst = 0.8, .amplitude = 1, .seed = 3};
         struct nc_relief_info info;
         double *under = NULL;
         CHECK(nc_mesh_relief(&m, &rp, NC_RELIEF_MAX_TRIANGLES, &info, &under) == 0 && under && info.levels == 2, "%s",
