@@ -23,8 +23,9 @@ static inline long nc_resident_kb(void)
 }
 
 /* A zero byte written at every 4096th byte of p[0 .. bytes): its pages are
- * faulted in now rather than by whoever writes them first (a fault costs
- * about 10 us on this project's virtual machines). A memset of zeros right
+ * faulted in now rather than by whoever writes them first (a first write
+ * to a fresh 4 KiB page of malloc'd memory took 11.6-11.8 us on this
+ * project's 2-core virtual machine, 64 MiB touched five times). A memset of zeros right
  * after malloc would not do: the compiler turns the pair into calloc, which
  * touches nothing. */
 static inline void nc_touch_pages(void *p, size_t bytes)

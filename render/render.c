@@ -32,10 +32,11 @@ int nc_frame_alloc(struct nc_frame *f, int w, int h)
         nc_frame_free(f);
         return nc_error(-ENOMEM, "out of memory for a %dx%d frame", w, h);
     }
-    /* Pages faulted in here, not by the first frame rendered into them: on
-     * this project's virtual machines a fault costs about 10 us, and the
-     * four planes of a 512x512 frame with its margin take over a thousand
-     * (the emulator's second render buffer made its first frame 13 ms slower). */
+    /* Pages faulted in here, not by the first frame rendered into them: a
+     * fault costs about 12 us on this project's virtual machine (core/proc.h),
+     * and the four planes of a 512x512 frame with its margin take over a
+     * thousand (the emulator's second render buffer made its first frame
+     * 13-17 ms slower). */
     nc_touch_pages(f->radiance, n * sizeof(float));
     nc_touch_pages(f->iof, n * sizeof(float));
     nc_touch_pages(f->range_m, n * sizeof(float));
