@@ -12,6 +12,10 @@ B: a storm: every edge is accounted for (accepted, debounced, wrong edge),
    every pose sent was received.
 C: the V4L2 device failed mid-run: the failure was reported and counted,
    the file output kept every frame, and the output came back.
+D: v4l2-ctl, a reader that is not NavCam's, streams 5 free-run frames by
+   mmap (docs/setup.md's check) of a 12-bit camera: each is Y16, little-endian,
+   DN << 4 (y16_align msb), of a frame the file output wrote, in the order
+   delivered.
 """
 import os
 import sys
@@ -176,6 +180,20 @@ blind = sum(any(g0 < r["exposure_start_mono_ns"] and r["exposure_end_mono_ns"] +
 check(seen > 0 and seen + missed + blind >= len(crecs) and missed + blind <= max(2, len(crecs) // 50),
       f"C: strobe low during {seen} of {len(crecs)} free-run exposures; {missed} windows reported missed by the "
       f"driver, {blind} unobserved (the watcher stalled over them; {len(cgaps)} gaps over 5 ms)")
+
+# ---- D ----------------------------------------------------------------------
+drecs = records(os.path.join(out, "d/files/frames.jsonl"))
+dframes = [fits_dn(os.path.join(out, "d/files/frame_%06d.fits" % r["frame"])) for r in drecs]
+with open(os.path.join(out, "d/frames.raw"), "rb") as f:
+    raw = f.read()
+size = 2 * dframes[0][0] * dframes[0][1] if dframes else 0
+got = [raw[i:i + size] for i in range(0, len(raw), size)] if size else []
+check(len(got) == 5 and len(raw) == 5 * size, f"D: v4l2-ctl wrote {len(raw)} bytes: {len(got)} frames of {size}")
+check("'Y16 '" in open(os.path.join(out, "d/fmt.log")).read(), "D: the reader negotiated Y16")
+index = {b"".join((v << 4).to_bytes(2, "little") for v in dn): k for k, (_, _, dn) in enumerate(dframes)}
+where = [index.get(g, -1) for g in got]
+check(got and all(k >= 0 for k in where) and where == sorted(set(where)),
+      f"D: the frames v4l2-ctl read are file-output frames {where} of {len(dframes)}, in order")
 
 print(f"{len(failures)} checks failed" if failures else "all checks passed")
 if lat:

@@ -11,7 +11,7 @@ out=$1 navcam=$2 helpers=$3 src=$4
 mods=/run/vm/root
 edges=${5:-12}
 cd "$out"
-rm -rf a b c && mkdir -p a b c
+rm -rf a b c d && mkdir -p a b c d
 
 . "$(dirname "$0")/guest_lib.sh"
 trap 'echo "guest_v4l2_gpio.sh: line $LINENO: $BASH_COMMAND failed"' ERR
@@ -120,6 +120,16 @@ sleep 3
 stop_serve c
 touch c/stop-watch
 wait "$watch_pid"
+
+# ---- D: another reader: v4l2-ctl, as docs/setup.md's check runs it -----------
+step "D: free-run Y16 frames read by v4l2-ctl --stream-mmap"
+start_serve d --set serve.mode=freerun --set serve.frame_rate_hz=10 --set sensor.adc_bits=12 \
+    --set serve.udp_port=5780 --set serve.tcp_port=5781 \
+    --set "outputs=[{driver: v4l2, card: NavCam}, {driver: file, directory: files, pattern: frame_%06llu.fits}]"
+timeout 60 v4l2-ctl -d /dev/video3 --stream-mmap --stream-count 5 --stream-to d/frames.raw >d/ctl.log 2>&1 ||
+    { echo "v4l2-ctl failed"; cat d/ctl.log; }
+v4l2-ctl -d /dev/video3 --get-fmt-video >d/fmt.log 2>&1 || true
+stop_serve d
 
 step "checks"
 python3 "$src/tests/vm/check.py" "$out" "$edges"
