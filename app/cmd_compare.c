@@ -17,10 +17,13 @@
 #include "render/image_io.h"
 
 static const char compare_help[] =
-    "Usage: navcam compare REAL RENDER [-o DIR] [--fit F] [--register R] [--json FILE]\n"
+    "Usage: navcam compare REAL RENDER [-o DIR] [--fit F] [--register R] [--flip-real AXES]\n"
+    "                      [--json FILE]\n"
     "\n"
     "Compare a real image with a rendered one of the same size (any format\n"
-    "navcam reads: FITS, TIFF, EXR, PNG; the first channel):\n"
+    "navcam reads: FITS, TIFF, EXR, PNG; the first channel; rows top first, a\n"
+    "FITS file with ROWORDER = 'BOTTOM-UP' turned so; --flip-real for a REAL\n"
+    "stored otherwise):\n"
     "  1. Otsu's threshold on REAL splits foreground (the body) from background;\n"
     "     only the foreground is compared (the background is not simulated).\n"
     "  2. --register R: RENDER is moved by the shift, found to 1/64 px within\n"
@@ -43,10 +46,13 @@ static const char compare_help[] =
     "                       (the map), DIR/error_histogram.png and .csv (gnuplot)\n"
     "  -f, --fit F          scale, histogram or none (default scale)\n"
     "  -r, --register R     search shifts within R px (default 0: no registration)\n"
+    "  -F, --flip-real AXES mirror REAL before anything else: y top to bottom (an\n"
+    "                       image stored bottom row first), x left to right, xy\n"
+    "                       both (turned by 180 degrees); default none\n"
     "  -j, --json FILE      the results as JSON in FILE (default: standard output)\n"
     "  -h, --help           this help\n"
     "\n"
-    "The JSON: real, render, width, height, fit, scale, shift_px [dx, dy]\n"
+    "The JSON: real, render, width, height, flip_real, fit, scale, shift_px [dx, dy]\n"
     "(RENDER moved right and down), threshold_real, threshold_render,\n"
     "foreground_px, relative_error {mean, median, rms, p95, bias}, ncc {1, 2, 4,\n"
     "8, 16: NCC of block means, null when undefined}, limb_iou, texture {real,\n"
@@ -99,26 +105,35 @@ static int plots(const char *dir, const float *rel, int w, int h, const struct n
     return nc_image_write(path, rel, w, h, NULL, 0, NULL);
 }
 
+/* Where word is in the NULL-terminated words, or -1. */
+static int word_index(const char *const *words, const char *word)
+{
+    for (int i = 0; words[i]; i++)
+        if (!strcmp(words[i], word))
+            return i;
+    return -1;
+}
+
 int main(int argc, char **argv)
 {
     nc_cli_init("compare");
     static const struct option opts[] = {
         {"output", required_argument, NULL, 'o'}, {"fit", required_argument, NULL, 'f'},
         {"register", required_argument, NULL, 'r'}, {"json", required_argument, NULL, 'j'},
-        {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
+        {"flip-real", required_argument, NULL, 'F'}, {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
     };
+    static const char *const flips[] = {"none", "x", "y", "xy", NULL}; /* bit 0: x, bit 1: y */
     static const char *const fits[] = {"none", "scale", "histogram", NULL};
     const char *dir = NULL, *json = NULL;
-    int fit = NC_FIT_SCALE, radius = 0, c;
+    int fit = NC_FIT_SCALE, radius = 0, flip = 0, c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:f:r:j:h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:f:r:j:F:h", opts, NULL)) != -1) {
         switch (c) {
         case 'o': dir = optarg; break;
         case 'j': json = optarg; break;
         case 'f':
-            for (fit = 0; fits[fit] && strcmp(fits[fit], optarg); fit++)
-                ;
-            if (!fits[fit]) {
+            if ((fit = word_index(fits, optarg)) < 0) {
                 fprintf(stderr, "navcam compare: --fit expects scale, histogram or none, got '%s'\n", optarg);
                 return 2;
             }
@@ -133,6 +148,12 @@ int main(int argc, char **argv)
             radius = (int)v;
             break;
         }
+        case 'F':
+            if ((flip = word_index(flips, optarg)) < 0) {
+                fprintf(stderr, "navcam compare: --flip-real expects none, x, y or xy, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
         case 'h': fputs(compare_help, stdout); return 0;
         default: fputs("Try 'navcam compare --help'.\n", stderr); return 2;
         }
@@ -155,6 +176,7 @@ int main(int argc, char **argv)
                       render_path, w2, h2);
         goto done;
     }
+    nc_imgcmp_flip(real, w, h, flip & 1, flip & 2);
     if (dir && mkdir(dir, 0777) < 0 && errno != EEXIST) {
         rc = nc_error(-errno, "%s: %s", dir, strerror(errno));
         goto done;
@@ -194,6 +216,7 @@ int main(int argc, char **argv)
     nc_cli_json_str(out, "real", real_path);
     nc_cli_json_str(out, "render", render_path);
     fprintf(out, "\"width\": %d, \"height\": %d, ", w, h);
+    nc_cli_json_str(out, "flip_real", flips[flip]);
     nc_cli_json_str(out, "fit", fits[fit]);
     nc_cli_json_num(out, "scale", res.scale, ", ");
     fprintf(out, "\"shift_px\": [%.6f, %.6f], ", dx, dy);

@@ -227,6 +227,25 @@ done
 expect 1 "is 96x96 but $tmp/other.fits is 64x96: the images must have the same size" -- \
   "$navcam" compare "$tmp/real.fits" "$tmp/other.fits"
 expect 2 "--fit expects scale, histogram or none" -- "$navcam" compare a b --fit gamma
+# --flip-real: a copy of the render turned by 180 degrees (its float32 rows
+# and columns reversed, the header kept) compares exactly once turned back.
+python3 - "$tmp/real.fits" "$tmp/turned.fits" <<'PY'
+import sys
+d = open(sys.argv[1], "rb").read()
+end = next(i for i in range(0, len(d), 80) if d[i:i + 8] == b"END     ")
+start = (end // 2880 + 1) * 2880
+n = 96 * 96 * 4
+px = [d[start + i:start + i + 4] for i in range(0, n, 4)]
+open(sys.argv[2], "wb").write(d[:start] + b"".join(reversed(px)) + d[start + n:])
+PY
+"$navcam" compare "$tmp/turned.fits" "$tmp/real.fits" --flip-real xy > "$tmp/flip.json" &&
+  "$navcam" compare "$tmp/turned.fits" "$tmp/real.fits" --flip-real y > "$tmp/flip_y.json" &&
+  python3 -c "
+import json, sys; a, b = (json.load(open(f)) for f in sys.argv[1:])
+assert a['flip_real'] == 'xy' and a['relative_error']['p95'] == 0 and a['limb_iou'] == 1, a
+assert b['flip_real'] == 'y' and b['relative_error']['p95'] > 0.01, b" "$tmp/flip.json" "$tmp/flip_y.json" &&
+  ok || bad "navcam compare --flip-real: $(cat "$tmp/flip.json" "$tmp/flip_y.json")"
+expect 2 "--flip-real expects none, x, y or xy" -- "$navcam" compare a b --flip-real z
 expect 1 "no.SUM: No such file or directory" -- "$navcam" render -o "$tmp/s.fits" --sumfile "$tmp/no.SUM" \
   --set sun.distance_au=1
 # navcam texture: two renders at once (JSON fields, the region, --gsd), and
