@@ -3,6 +3,9 @@
 #include "render/render.h"
 
 #include <errno.h>
+#ifdef __SSE2__
+#include <immintrin.h>
+#endif
 #include <math.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -719,6 +722,22 @@ static void trace_camera(const struct job *j, int px0, int py0, const struct nc_
     }
 }
 
+/* A frame plane's pixel, stored past the caches (SSE2's MOVNTI; plain
+ * elsewhere). The planes are megabytes and written once a frame: an
+ * ordinary store first reads its line from memory, which cost about 5 % of
+ * a 512x512 crop frame's CPU (bench figures in docs/emulator.md). The
+ * same values either way; shade_tile fences them before it returns. */
+static inline void stream_f(float *p, float v)
+{
+#ifdef __SSE2__
+    int32_t b;
+    memcpy(&b, &v, sizeof b);
+    _mm_stream_si32((int *)p, b);
+#else
+    *p = v;
+#endif
+}
+
 static void shade_tile(struct job *j, int tile)
 {
     const struct nc_scene *s = j->s;
@@ -887,15 +906,18 @@ static void shade_tile(struct job *j, int tile)
             if (!mine[(y - y0) / 4][(x - x0) / 4])
                 continue;
             size_t o = (size_t)y * (size_t)W + (size_t)x;
-            j->f->radiance[o] = (float)(acc_L[k] * inv);
-            j->f->iof[o] = (float)(acc_iof[k] * inv);
-            j->f->range_m[o] = hits[k] ? (float)(acc_range[k] / hits[k]) : 0.0f;
-            j->f->coverage[o] = (float)(hits[k] * inv);
+            stream_f(&j->f->radiance[o], (float)(acc_L[k] * inv));
+            stream_f(&j->f->iof[o], (float)(acc_iof[k] * inv));
+            stream_f(&j->f->range_m[o], hits[k] ? (float)(acc_range[k] / hits[k]) : 0.0f);
+            stream_f(&j->f->coverage[o], (float)(hits[k] * inv));
             if (j->f->direct)
                 j->f->direct[o] = (float)(acc_dir[k] * inv);
             if (j->f->direct_hard)
                 j->f->direct_hard[o] = (float)(acc_hard[k] * inv);
         }
+#ifdef __SSE2__
+    _mm_sfence(); /* the streamed stores visible before the tile counts as done */
+#endif
 }
 
 static void *worker(void *arg)
