@@ -176,7 +176,7 @@ int main(int argc, char **argv)
                       render_path, w2, h2);
         goto done;
     }
-    nc_imgcmp_flip(real, w, h, flip & 1, flip & 2);
+    nc_image_flip(real, sizeof *real, w, h, flip & 2, flip & 1);
     if (dir && mkdir(dir, 0777) < 0 && errno != EEXIST) {
         rc = nc_error(-errno, "%s: %s", dir, strerror(errno));
         goto done;

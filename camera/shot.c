@@ -14,28 +14,6 @@
 
 static double now_ms(void) { return (double)nc_mono_ns() * 1e-6; }
 
-static void flip_plane(void *px, size_t elem, int w, int h, int rows, int cols)
-{
-    unsigned char *p = px, tmp[8];
-    const size_t W = (size_t)w, H = (size_t)h;
-    if (rows)
-        for (size_t y = 0; y < H / 2; y++)
-            for (size_t x = 0; x < W; x++) {
-                unsigned char *a = p + (y * W + x) * elem, *b = p + ((H - 1 - y) * W + x) * elem;
-                memcpy(tmp, a, elem);
-                memcpy(a, b, elem);
-                memcpy(b, tmp, elem);
-            }
-    if (cols)
-        for (size_t y = 0; y < H; y++)
-            for (size_t x = 0; x < W / 2; x++) {
-                unsigned char *a = p + (y * W + x) * elem, *b = p + (y * W + W - 1 - x) * elem;
-                memcpy(tmp, a, elem);
-                memcpy(a, b, elem);
-                memcpy(b, tmp, elem);
-            }
-}
-
 int nc_shot_setup(const char *path, const char *const *sets, int nsets, struct nc_scene *scene,
                   struct nc_camsys *cs, struct nc_sky *sky)
 {
@@ -58,11 +36,11 @@ void nc_frame_flip(struct nc_frame *f, int rows, int cols)
     float *planes[] = {f->radiance, f->iof, f->range_m, f->coverage};
     for (int i = 0; i < 4; i++)
         if (planes[i])
-            flip_plane(planes[i], sizeof(float), f->width_px, f->height_px, rows, cols);
+            nc_image_flip(planes[i], sizeof(float), f->width_px, f->height_px, rows, cols);
     if (f->rock_id)
-        flip_plane(f->rock_id, sizeof *f->rock_id, f->width_px, f->height_px, rows, cols);
+        nc_image_flip(f->rock_id, sizeof *f->rock_id, f->width_px, f->height_px, rows, cols);
     for (int k = 0; f->geom && k < NC_GEOM_PLANES; k++)
-        flip_plane(f->geom + (size_t)k * (size_t)f->width_px * (size_t)f->height_px, sizeof(float), f->width_px,
+        nc_image_flip(f->geom + (size_t)k * (size_t)f->width_px * (size_t)f->height_px, sizeof(float), f->width_px,
                    f->height_px, rows, cols);
 }
 

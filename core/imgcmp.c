@@ -62,27 +62,6 @@ static double keys(double x)
     return 0;
 }
 
-void nc_imgcmp_flip(float *px, int w, int h, int flip_x, int flip_y)
-{
-    const size_t W = (size_t)w;
-    for (int y = 0; flip_y && y < h / 2; y++) {
-        float *a = px + (size_t)y * W, *b = px + (size_t)(h - 1 - y) * W;
-        for (size_t x = 0; x < W; x++) {
-            float t = a[x];
-            a[x] = b[x];
-            b[x] = t;
-        }
-    }
-    for (int y = 0; flip_x && y < h; y++) {
-        float *row = px + (size_t)y * W;
-        for (size_t x = 0; x < W / 2; x++) {
-            float t = row[x];
-            row[x] = row[W - 1 - x];
-            row[W - 1 - x] = t;
-        }
-    }
-}
-
 void nc_imgcmp_shift(const float *in, int w, int h, double dx, double dy, float *out)
 {
     /* out(x) = in(x - dx): the source is at x - dx = ix + fx, fx in [0, 1) */

@@ -24,10 +24,6 @@ double nc_otsu_threshold(const float *px, size_t n);
  * NaN. */
 void nc_imgcmp_shift(const float *in, int w, int h, double dx, double dy, float *out);
 
-/* px mirrored in place: left to right when flip_x, top to bottom when
- * flip_y (both: turned by 180 degrees). */
-void nc_imgcmp_flip(float *px, int w, int h, int flip_x, int flip_y);
-
 /* Pearson correlation of a and b over the pixels where both are finite
  * (and mask, if not NULL, is non-zero), after averaging blocks of
  * block x block pixels (a block counts when all its pixels do); NaN when

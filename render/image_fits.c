@@ -193,13 +193,8 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
     fits_close_file(f, &status);
     *w = (int)naxes[0];
     *h = (int)naxes[1];
-    if (!strcmp(order, "BOTTOM-UP")) {
-        float *top = flip_rows(buf, sizeof *buf, *w, *h, 1);
-        free(buf);
-        if (!top)
-            return nc_error(-ENOMEM, "%s: out of memory", path);
-        buf = top;
-    }
+    if (!strcmp(order, "BOTTOM-UP"))
+        nc_image_flip(buf, sizeof *buf, *w, *h, 1, 0);
     *px = buf;
     return 0;
 }

@@ -235,6 +235,28 @@ out:
     return rc;
 }
 
+void nc_image_flip(void *px, size_t elem, int w, int h, int rows, int cols)
+{
+    unsigned char *p = px, tmp[8];
+    const size_t W = (size_t)w, H = (size_t)h;
+    if (rows)
+        for (size_t y = 0; y < H / 2; y++)
+            for (size_t x = 0; x < W; x++) {
+                unsigned char *a = p + (y * W + x) * elem, *b = p + ((H - 1 - y) * W + x) * elem;
+                memcpy(tmp, a, elem);
+                memcpy(a, b, elem);
+                memcpy(b, tmp, elem);
+            }
+    if (cols)
+        for (size_t y = 0; y < H; y++)
+            for (size_t x = 0; x < W / 2; x++) {
+                unsigned char *a = p + (y * W + x) * elem, *b = p + (y * W + W - 1 - x) * elem;
+                memcpy(tmp, a, elem);
+                memcpy(a, b, elem);
+                memcpy(b, tmp, elem);
+            }
+}
+
 int nc_image_read(const char *path, float **px, int *w, int *h)
 {
     return format_of(path) == FMT_FITS ? nc__fits_read(path, px, w, h) : nc__oiio_read(path, px, w, h);

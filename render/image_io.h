@@ -49,6 +49,9 @@ int nc_image_write_dn_cube(const char *path, const uint16_t *dn, int width, int 
  * them. Non-finite values are written as 0. */
 int nc_image_write_planes(const char *path, const float *planes, int width, int height, int nplanes,
                           const char *const *names, const struct nc_image_attr *attrs, int nattrs);
+/* px (w x h pixels of elem <= 8 bytes each) mirrored in place: top to
+ * bottom when rows, left to right when cols (both: turned by 180 degrees). */
+void nc_image_flip(void *px, size_t elem, int w, int h, int rows, int cols);
 /* Read the first channel (first plane of a cube) as float (caller frees *px). */
 int nc_image_read(const char *path, float **px, int *width, int *height);
 /* Read one string attribute; 0 on success, negative if absent. */
