@@ -101,7 +101,8 @@ int main(void)
         copy_mesh(&model, &m);
         struct nc_relief_params q = p;
         q.edge_m = edge0 / exp2(level) * 1.001;
-        CHECK(nc_mesh_relief(&m, &q, NC_RELIEF_MAX_TRIANGLES, &info, NULL) == 0 && info.levels == level, "level %d", level);
+        CHECK(nc_mesh_relief(&m, &q, NC_RELIEF_MAX_TRIANGLES, &info, NULL) == 0 && info.levels == level, "level %d",
+              level);
         lx[level - 1] = log(10.0 / exp2(level - 1)); /* the parent edge */
         ly[level - 1] = log(midpoint_rms(&m, &prev));
         printf("level %d: parent edge %.4g m, midpoint RMS %.4g m\n", level, exp(lx[level - 1]), exp(ly[level - 1]));
