@@ -580,15 +580,16 @@ static void load_ray(struct RTCRay16 *r, const struct nc_ray16 *in)
     }
 }
 
-/* The shading normal of rock k of tile tl, hit at t along lane i of ray:
+/* The shading normal of primitive prim of tile tl, hit at t along lane i of ray:
  * its face's normal n (x, y, z: unnormalised, body frame) tilted by the
  * relief's gradient along the face (nc_boulder_relief's octaves from
  * first on), kept only where it faces the ray as n does (a shading normal
  * never shows a face the geometry hides). */
-static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *tl, size_t k, int first, float t,
+static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *tl, unsigned prim, int first, float t,
                         const struct nc_ray16 *ray, int i, float *x, float *y, float *z)
 {
-    const float *R = b->rot, *M = tl->rocks->rock[k].M, *c = tl->rocks->rock[k].c;
+    const float *R = b->rot, *M = tl->rec[prim].M, *c = tl->rec[prim].c;
+    const size_t k = tl->index[prim];
     /* the hit from the tile's origin (scene frame), into the body frame
      * (R^T), from the rock's centre, into the rock's frame (M) */
     const double h[3] = {ray->ox[i] + (double)t * ray->dx[i] - tl->place_m[0],
@@ -662,7 +663,7 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
         alb = nc_albedo_var_rock(&b->src->albedo_var, k);
         rock = (int32_t)k;
         if (b->src->boulders.relief[0] > 0) /* u 1: a detailed surface's hit, the coarse relief in geometry */
-            rock_relief(b, tl, k, u != 0 ? NC_ROCK_MESH_OCTAVES : 0, t, ray, i, &x, &y, &z);
+            rock_relief(b, tl, prim, u != 0 ? NC_ROCK_MESH_OCTAVES : 0, t, ray, i, &x, &y, &z);
     }
     hit->albedo[i] = alb;
     hit->rock[i] = rock;

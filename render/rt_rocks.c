@@ -14,7 +14,7 @@
 static void rock_bounds(const struct RTCBoundsFunctionArguments *a)
 {
     const struct nc__rt_rock_tile *tl = a->geometryUserPtr;
-    const struct nc__rt_rock *k = &tl->rocks->rock[tl->index[a->primID]];
+    const struct nc__rt_rock *k = &tl->rec[a->primID];
     for (int i = 0; i < 3; i++) {
         double c = k->c[i], e = k->ext[i];
         double pad = 1e-6 * (fabs(c) + e) + 1e-3 * e; /* float rounding and the rotation's */
@@ -128,7 +128,7 @@ static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const 
     static const int comp[8] = {0, 1, 2, 3, 4, 5, 6, 8}; /* RTCRayN: org, tnear, dir, time, tfar */
     const size_t i = tl->index[prim];
     const struct nc__rt_rocks *r = tl->rocks;
-    const struct nc__rt_rock *k = &r->rock[i];
+    const struct nc__rt_rock *k = &tl->rec[prim];
     const struct nc_rock_shape *sh = &r->field->shape[k->shape];
     int mesh = 0;
     if (r->mesh_k2 > 0) { /* (2 half)^2 >= k2 dist^2, half = 1 / |M's row| */
@@ -141,14 +141,22 @@ static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const 
                        (float *)&p.d[0], (float *)&p.d[1], (float *)&p.d[2], (float *)&p.tfar};
         int *v = (int *)&p.valid, any = 0;
         const unsigned m = N - l0 < LANES ? N - l0 : LANES;
-        memset(&p, 0, sizeof p);
-        memcpy(v, valid + l0, m * sizeof *v);
-        for (unsigned l = 0; l < m; l++)
-            any |= v[l];
+        if (m == LANES) { /* fixed sizes: vector moves */
+            memcpy(v, valid + l0, LANES * sizeof *v);
+            any = any_lane(&p.valid);
+        } else {
+            memset(&p, 0, sizeof p);
+            memcpy(v, valid + l0, m * sizeof *v);
+            for (unsigned l = 0; l < m; l++)
+                any |= v[l];
+        }
         if (!any)
             continue;
         for (int c = 0; c < 8; c++)
-            memcpy(f[c], ray + comp[c] * N + l0, m * sizeof *ray);
+            if (m == LANES)
+                memcpy(f[c], ray + comp[c] * N + l0, LANES * sizeof *ray);
+            else
+                memcpy(f[c], ray + comp[c] * N + l0, m * sizeof *ray);
         float t[LANES], t1[LANES];
         int plane[LANES];
         const unsigned lanes = rock_hit(r, k, i, &p, mesh, t, t1, plane);
@@ -252,10 +260,11 @@ static void record(const struct nc_boulder *b, const float (*v)[3], int nv, stru
     k->shape = b->shape;
 }
 
-/* A rock's tile key: its octave and the cube of the body frame its centre
- * falls in. */
+/* A rock's tile key: the cube of the body frame its centre falls in (of
+ * its octave's size), and the Morton code of the centre in the cube. */
 struct tile_key {
     int64_t x, y, z;
+    uint64_t morton;
     uint32_t rock;
 };
 
@@ -268,7 +277,33 @@ static int key_cmp(const void *pa, const void *pb)
         return a->y < b->y ? -1 : 1;
     if (a->z != b->z)
         return a->z < b->z ? -1 : 1;
+    if (a->morton != b->morton)
+        return a->morton < b->morton ? -1 : 1;
     return (a->rock > b->rock) - (a->rock < b->rock);
+}
+
+/* The 21 bits of x spread to every third bit. */
+static uint64_t spread3(uint64_t x)
+{
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
+}
+
+/* Centre c (body frame) in the cube key (its indices) of side S: its
+ * Morton code over 2^21 steps an axis. */
+static uint64_t morton(const double *c, const int64_t *key, double S)
+{
+    uint64_t m = 0;
+    for (int i = 0; i < 3; i++) {
+        double q = (c[i] / S - (double)key[i]) * 2097152.0;
+        m |= spread3(q <= 0 ? 0 : q >= 2097151 ? 2097151 : (uint64_t)q) << i;
+    }
+    return m;
 }
 
 /* Cube edge of octave j's tiles: 1024 times its largest diameter. For the
@@ -325,16 +360,14 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
             nv[i] = 8;
         }
     }
-    for (size_t i = 0; i < f->n; i++)
-        record(&f->rock[i], v + (size_t)f->rock[i].shape * MAX_CORNERS, nv[f->rock[i].shape], &r->rock[i]);
-    free(v);
-    free(nv);
-    /* Tiles: each octave's rocks grouped by cube, in list order inside. */
+    /* Tiles: each octave's rocks grouped by cube, in Morton order inside. */
     struct tile_key *key = malloc((f->n ? f->n : 1) * sizeof *key);
     size_t cap = 64;
     r->tile = calloc(cap, sizeof *r->tile);
     if (!key || !r->tile) {
         free(key);
+        free(v);
+        free(nv);
         return nc_error(-ENOMEM, "out of memory for %zu boulders' tiles", f->n);
     }
     size_t at = 0;
@@ -343,8 +376,10 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
         const double S = tile_size_m(oc->j);
         for (size_t i = 0; i < oc->n; i++) {
             const double *c = f->rock[oc->first + i].centre_m;
-            key[i] = (struct tile_key){(int64_t)floor(c[0] / S), (int64_t)floor(c[1] / S), (int64_t)floor(c[2] / S),
-                                       (uint32_t)(oc->first + i)};
+            struct tile_key *q = &key[i];
+            *q = (struct tile_key){(int64_t)floor(c[0] / S), (int64_t)floor(c[1] / S), (int64_t)floor(c[2] / S), 0,
+                                   (uint32_t)(oc->first + i)};
+            q->morton = morton(c, &q->x, S);
         }
         qsort(key, oc->n, sizeof *key, key_cmp);
         for (size_t i = 0; i < oc->n && rc == 0;) {
@@ -365,17 +400,22 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
             tl->origin_m[2] = (key[i].z + 0.5) * S;
             tl->octave = k;
             tl->index = r->index + at;
+            tl->rec = r->rock + at;
             tl->n = (unsigned)(e - i);
             for (size_t q = i; q < e; q++, at++) {
-                uint32_t id = key[q].rock;
+                const uint32_t id = key[q].rock;
+                const struct nc_boulder *b = &f->rock[id];
                 r->index[at] = id;
+                record(b, v + (size_t)b->shape * MAX_CORNERS, nv[b->shape], &r->rock[at]);
                 for (int c = 0; c < 3; c++)
-                    r->rock[id].c[c] = (float)(f->rock[id].centre_m[c] - tl->origin_m[c]);
+                    r->rock[at].c[c] = (float)(b->centre_m[c] - tl->origin_m[c]);
             }
             i = e;
         }
     }
     free(key);
+    free(v);
+    free(nv);
     for (size_t t = 0; t < r->ntiles && rc == 0; t++)
         rc = make_tile(dev, r, &r->tile[t]);
     r->traced = f->n;

@@ -3,8 +3,9 @@
  * octave's largest diameter on a side; a tile is an Embree scene of its own
  * (one user geometry whose primitives are its rocks, each referring to its
  * shared shape: 48 bytes in the list, 64 here and 4 of index, plus the
- * tree's share) with its rocks stored relative to the tile's own origin,
- * and two instances: in the top-level scene, and in the scene of the rocks
+ * tree's share) with its rocks stored relative to the tile's own origin
+ * in Morton order of their centres (a tree's leaves, visited by nearby
+ * rays, read records near each other in memory), and two instances: in the top-level scene, and in the scene of the rocks
  * alone (rt_embree.c: rays proven clear of the meshes, or whose mesh hits
  * came from the bins, test only the rocks). The tiles' trees are built once:
  * a pose only moves their instances (the float translation from the camera
@@ -40,7 +41,8 @@ struct nc__rt_rock_surface {
 struct nc__rt_rock_tile {
     struct nc__rt_rocks *rocks;
     double origin_m[3];    /* body frame: its rocks' records are relative to it */
-    const uint32_t *index; /* list index of each primitive, ascending (largest rock first) */
+    const struct nc__rt_rock *rec; /* each primitive's record, in Morton order of their centres */
+    const uint32_t *index;         /* and its index in the list (the larger the rock, the lower) */
     unsigned n;
     int octave; /* in the field's octave table */
     RTCScene scene;
@@ -63,7 +65,7 @@ _Static_assert(sizeof(struct nc__rt_rock) == 64, "a rock record is one cache lin
 
 struct nc__rt_rocks {
     const struct nc_boulder_field *field;
-    struct nc__rt_rock *rock; /* field->rock[i] as traced */
+    struct nc__rt_rock *rock; /* the tiles' records, end to end (tile[k].rec) */
     uint32_t *index;          /* the tiles' index arrays, end to end */
     struct nc__rt_rock_tile *tile;
     size_t ntiles;
