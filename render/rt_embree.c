@@ -19,6 +19,7 @@
 
 #include "core/error.h"
 #include "render/rt_bins.h"
+#include "render/rt_rock_bins.h"
 #include "render/rt_rocks.h"
 #include "render/shadow_grid.h"
 
@@ -86,6 +87,10 @@ struct nc_rt {
     struct nc_rt_stats stats;
     atomic_ulong shadow_culled, shadow_traced;
     struct nc__bins bins; /* camera rays of this pass through bins (nc_rt_bin_camera) */
+    /* ... and through the rocks' bins in front of the mesh hits (when
+     * rock_binned; else through the rocks' trees) */
+    struct nc__rock_bins rock_bins;
+    int rock_binned;
 };
 
 static int rt_check(RTCDevice dev, const char *what)
@@ -589,7 +594,7 @@ static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *
                         const struct nc_ray16 *ray, int i, float *x, float *y, float *z)
 {
     const float *R = b->rot, *M = tl->rec[prim].M, *c = tl->rec[prim].c;
-    const size_t k = tl->index[prim];
+    const size_t k = tl->rec[prim].rank;
     /* the hit from the tile's origin (scene frame), into the body frame
      * (R^T), from the rock's centre, into the rock's frame (M) */
     const double h[3] = {ray->ox[i] + (double)t * ray->dx[i] - tl->place_m[0],
@@ -659,7 +664,7 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
         alb = (1 - u - v) * a[tr[0]] + u * a[tr[1]] + v * a[tr[2]];
     } else if (rt->inst_tile[inst]) {
         const struct nc__rt_rock_tile *tl = rt->inst_tile[inst];
-        size_t k = tl->index[prim];
+        size_t k = tl->rec[prim].rank;
         alb = nc_albedo_var_rock(&b->src->albedo_var, k);
         rock = (int32_t)k;
         if (b->src->boulders.relief[0] > 0) /* u 1: a detailed surface's hit, the coarse relief in geometry */
@@ -736,16 +741,28 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
     /* Four parts a thread: a thread that loses its core for a while (in
      * serve, the camera model of the frame before runs beside the render)
      * leaves its share of the build to the others. */
-    return nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, 4 * threads);
+    int rc = nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, 4 * threads);
+    rt->rock_binned = 0;
+    if (rc > 0 && rt->rocks_on) {
+        struct nc__rock_bins_body rb[NC_MAX_BODIES];
+        for (int i = 0; i < rt->nbodies; i++)
+            rb[i] = (struct nc__rock_bins_body){rt->body[i].src->boulders.n ? &rt->body[i].rocks : NULL,
+                                                rt->body[i].rot};
+        const int r2 = nc__rock_bins_build(&rt->rock_bins, &rt->bins, cam->o, rb, rt->nbodies, pool, 4 * threads);
+        if (r2 < 0)
+            return r2;
+        rt->rock_binned = r2;
+    }
+    return rc;
 }
 
 int nc_rt_block_listed(const struct nc_rt *rt, int px0, int py0)
 {
     const struct nc__bins *b = &rt->bins;
-    if (rt->rocks_on)
+    if (rt->rocks_on && !rt->rock_binned)
         return -1;
     const size_t k = (size_t)(py0 / NC_BINS_BLOCK) * (size_t)b->bw + (size_t)(px0 / NC_BINS_BLOCK);
-    return b->start[k + 1] > b->start[k];
+    return b->start[k + 1] > b->start[k] || (rt->rocks_on && nc__rock_bins_listed(&rt->rock_bins, px0, py0));
 }
 
 /* The rocks in front of a packet of camera rays whose meshes the bins
@@ -770,6 +787,22 @@ static void rocks_over(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
             put_hit(rt, inst, rh.hit.primID[i], rh.ray.tfar[i], rh.hit.u[i], rh.hit.v[i], rh.hit.Ng_x[i],
                     rh.hit.Ng_y[i], rh.hit.Ng_z[i], ray, hit, i);
     }
+}
+
+/* The same through the rocks' bins (the block at (px0, py0)). */
+static void rocks_binned(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit)
+{
+    float t[NC_PACKET], n[NC_PACKET][3];
+    int32_t tile[NC_PACKET];
+    uint32_t prim[NC_PACKET];
+    int detailed[NC_PACKET];
+    for (int i = 0; i < NC_PACKET; i++)
+        t[i] = hit->body[i] >= 0 ? hit->t[i] : ray->tfar[i];
+    nc__rock_bins_intersect(&rt->rock_bins, px0, py0, ray, t, tile, prim, n, detailed);
+    for (int i = 0; i < NC_PACKET; i++)
+        if (tile[i] >= 0)
+            put_hit(rt, rt->rock_bins.tile[tile[i]]->inst_id, prim[i], t[i], detailed[i] ? 1.0f : 0.0f, 0, n[i][0],
+                    n[i][1], n[i][2], ray, hit, i);
 }
 
 void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
@@ -799,7 +832,10 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
                 put_hit(rt, b->inst_id, prim, t[q][i], u, v, ct->ng[0], ct->ng[1], ct->ng[2], &ray[q0 + q], h, i);
             }
         for (int q = 0; q < m && rt->rocks_on; q++)
-            rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
+            if (rt->rock_binned)
+                rocks_binned(rt, px0, py0, &ray[q0 + q], &hit[q0 + q]);
+            else
+                rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
     }
 }
 
@@ -1108,6 +1144,7 @@ void nc_rt_destroy(struct nc_rt *rt)
     if (rt->dev)
         rtcReleaseDevice(rt->dev);
     nc__bins_free(&rt->bins);
+    nc__rock_bins_free(&rt->rock_bins);
     for (int i = 0; i < rt->nbodies; i++) {
         free(rt->body[i].verts);
         free(rt->body[i].vnormal);

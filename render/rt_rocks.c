@@ -16,19 +16,16 @@ static void rock_bounds(const struct RTCBoundsFunctionArguments *a)
     const struct nc__rt_rock_tile *tl = a->geometryUserPtr;
     const struct nc__rt_rock *k = &tl->rec[a->primID];
     for (int i = 0; i < 3; i++) {
-        double c = k->c[i], e = k->ext[i];
+        double c = k->c[i], e = tl->ext[a->primID][i];
         double pad = 1e-6 * (fabs(c) + e) + 1e-3 * e; /* float rounding and the rotation's */
         (&a->bounds_o->lower_x)[i] = (float)(c - e - pad);
         (&a->bounds_o->upper_x)[i] = (float)(c + e + pad);
     }
 }
 
-/* Eight lanes at a time (GCC/Clang vector extensions: one AVX2 register
- * where the CPU has it, two SSE or NEON ones otherwise; no FMA, so the
- * same bits on any). */
-#define LANES 8
-typedef float vlf __attribute__((vector_size(4 * LANES)));
-typedef int vli __attribute__((vector_size(4 * LANES)));
+#define LANES NC__RT_LANES
+typedef nc__rt_vlf vlf;
+typedef nc__rt_vli vli;
 
 static inline int any_lane(const vli *m)
 {
@@ -42,12 +39,6 @@ static inline int any_lane(const vli *m)
 /* m ? a : b, lane by lane */
 #define SELECT(m, a, b) ((vlf)(((vli)(a) & (m)) | ((vli)(b) & ~(m))))
 
-/* LANES rays: origin, tnear, direction, tfar, valid (-1: on). */
-struct lanes {
-    vlf o[3], tnear, d[3], tfar;
-    vli valid;
-};
-
 /* The entries of the lanes of p into rock k (list index i) within (tnear,
  * tfar): for lane l hit (bit l of the result), t[l] and the entering plane
  * (its index in the shape) plane[l]. None if the rock is below the cut; a
@@ -60,7 +51,7 @@ struct lanes {
  * which lies within the planes), a lane from inside counts from tnear, and
  * t_out[l] is where the lane leaves. */
 __attribute__((target_clones("avx2", "default"))) static unsigned
-rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, const struct lanes *p, int mesh,
+rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, const struct nc__rt_lanes *p, int mesh,
          float *t, float *t_out, int *plane)
 {
     if (i >= r->traced) /* the list is sorted by size: below the cut */
@@ -115,6 +106,43 @@ rock_hit(const struct nc__rt_rocks *r, const struct nc__rt_rock *k, size_t i, co
     return hit;
 }
 
+unsigned nc__rt_rock_lanes(const struct nc__rt_rock_tile *tl, unsigned prim, const struct nc__rt_lanes *p, float *t,
+                           float (*n)[3], int *detailed)
+{
+    const size_t i = tl->rec[prim].rank;
+    const struct nc__rt_rocks *r = tl->rocks;
+    const struct nc__rt_rock *k = &tl->rec[prim];
+    const struct nc_rock_shape *sh = &r->field->shape[k->shape];
+    int mesh = 0;
+    if (r->mesh_k2 > 0) { /* (2 half)^2 >= k2 dist^2, half = 1 / |M's row| */
+        const float *M = k->M, dx = k->c[0] - tl->cam_m[0], dy = k->c[1] - tl->cam_m[1], dz = k->c[2] - tl->cam_m[2];
+        mesh = 4.0f >= r->mesh_k2 * (dx * dx + dy * dy + dz * dz) * (M[0] * M[0] + M[1] * M[1] + M[2] * M[2]);
+    }
+    float t1[LANES];
+    int plane[LANES];
+    unsigned lanes = rock_hit(r, k, i, p, mesh, t, t1, plane);
+    for (unsigned l = 0; l < LANES && lanes >> l; l++) {
+        if (!(lanes >> l & 1))
+            continue;
+        float nr[3];
+        if (mesh) {
+            const float o[3] = {p->o[0][l], p->o[1][l], p->o[2][l]}, d[3] = {p->d[0][l], p->d[1][l], p->d[2][l]};
+            if (!nc__rt_rock_mesh_hit(r, k, o, d, p->tnear[l], p->tfar[l], t[l], t1[l], &t[l], n ? nr : NULL)) {
+                lanes &= ~(1u << l);
+                continue;
+            }
+        } else if (n)
+            nr[0] = sh->nx[plane[l]], nr[1] = sh->ny[plane[l]], nr[2] = sh->nz[plane[l]];
+        if (!n)
+            continue;
+        const float *M = k->M; /* R n, up to the scale: the tile's frame */
+        for (int j = 0; j < 3; j++)
+            n[l][j] = M[j] * nr[0] + M[3 + j] * nr[1] + M[6 + j] * nr[2];
+    }
+    *detailed = mesh;
+    return lanes;
+}
+
 /* The rocks' packet callbacks: prim against the valid lanes of ray (width
  * N), LANES at a time; a hit is written through hit (intersection) or,
  * without it, ends the lane (occlusion: tfar = -inf). A rock resolved by
@@ -126,17 +154,8 @@ static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const 
                         const struct RTCIntersectFunctionNArguments *hit)
 {
     static const int comp[8] = {0, 1, 2, 3, 4, 5, 6, 8}; /* RTCRayN: org, tnear, dir, time, tfar */
-    const size_t i = tl->index[prim];
-    const struct nc__rt_rocks *r = tl->rocks;
-    const struct nc__rt_rock *k = &tl->rec[prim];
-    const struct nc_rock_shape *sh = &r->field->shape[k->shape];
-    int mesh = 0;
-    if (r->mesh_k2 > 0) { /* (2 half)^2 >= k2 dist^2, half = 1 / |M's row| */
-        const float *M = k->M, dx = k->c[0] - tl->cam_m[0], dy = k->c[1] - tl->cam_m[1], dz = k->c[2] - tl->cam_m[2];
-        mesh = 4.0f >= r->mesh_k2 * (dx * dx + dy * dy + dz * dz) * (M[0] * M[0] + M[1] * M[1] + M[2] * M[2]);
-    }
     for (unsigned l0 = 0; l0 < N; l0 += LANES) {
-        struct lanes p;
+        struct nc__rt_lanes p;
         float *f[8] = {(float *)&p.o[0], (float *)&p.o[1], (float *)&p.o[2], (float *)&p.tnear,
                        (float *)&p.d[0], (float *)&p.d[1], (float *)&p.d[2], (float *)&p.tfar};
         int *v = (int *)&p.valid, any = 0;
@@ -157,29 +176,18 @@ static void rock_packet(const struct nc__rt_rock_tile *tl, unsigned prim, const 
                 memcpy(f[c], ray + comp[c] * N + l0, LANES * sizeof *ray);
             else
                 memcpy(f[c], ray + comp[c] * N + l0, m * sizeof *ray);
-        float t[LANES], t1[LANES];
-        int plane[LANES];
-        const unsigned lanes = rock_hit(r, k, i, &p, mesh, t, t1, plane);
-        for (unsigned l = 0; l < LANES && lanes; l++) {
+        float t[LANES], n[LANES][3];
+        int detailed;
+        const unsigned lanes = nc__rt_rock_lanes(tl, prim, &p, t, hit ? n : NULL, &detailed);
+        for (unsigned l = 0; l < LANES && lanes >> l; l++) {
             if (!(lanes >> l & 1))
                 continue;
-            float n[3];
-            if (mesh) {
-                const float o[3] = {p.o[0][l], p.o[1][l], p.o[2][l]}, d[3] = {p.d[0][l], p.d[1][l], p.d[2][l]};
-                if (!nc__rt_rock_mesh_hit(r, k, o, d, p.tnear[l], p.tfar[l], t[l], t1[l], &t[l], hit ? n : NULL))
-                    continue;
-            } else if (hit)
-                n[0] = sh->nx[plane[l]], n[1] = sh->ny[plane[l]], n[2] = sh->nz[plane[l]];
             if (!hit) {
                 ray[8 * N + l0 + l] = -INFINITY;
                 continue;
             }
-            const float *M = k->M;
-            float nt[3]; /* R n, up to the scale: the tile's frame */
-            for (int j = 0; j < 3; j++)
-                nt[j] = M[j] * n[0] + M[3 + j] * n[1] + M[6 + j] * n[2];
-            nc__rt_user_hit(hit, l0 + l, t[l], nt);
-            if (mesh)
+            nc__rt_user_hit(hit, l0 + l, t[l], n[l]);
+            if (detailed)
                 ((float *)hit->rayhit)[12 * N + 3 * N + l0 + l] = 1.0f; /* u: a detailed surface's hit */
         }
     }
@@ -238,9 +246,9 @@ static int corners(const struct nc_rock_shape *sh, float (*v)[3], int max)
 
 /* The traced record of rock b, whose shape has the nv corners v: R^T / s
  * for its rotation q (renormalised, as the generator placed it) and half
- * size s, and its extent along the body axes (the corners turned); the
- * centre comes with its tile. */
-static void record(const struct nc_boulder *b, const float (*v)[3], int nv, struct nc__rt_rock *k)
+ * size s; and its extent along the body axes (the corners turned) into
+ * ext. The centre and rank come with its tile. */
+static void record(const struct nc_boulder *b, const float (*v)[3], int nv, struct nc__rt_rock *k, float *ext)
 {
     double w = b->q[0], x = b->q[1], y = b->q[2], z = b->q[3];
     double n = sqrt(w * w + x * x + y * y + z * z);
@@ -253,7 +261,7 @@ static void record(const struct nc_boulder *b, const float (*v)[3], int nv, stru
         double e = 0;
         for (int j = 0; j < nv; j++)
             e = fmax(e, fabs(R[i][0] * v[j][0] + R[i][1] * v[j][1] + R[i][2] * v[j][2]));
-        k->ext[i] = (float)(e * b->half_m);
+        ext[i] = (float)(e * b->half_m);
         for (int c = 0; c < 3; c++)
             k->M[3 * i + c] = (float)(R[c][i] / b->half_m);
     }
@@ -340,12 +348,13 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
     int rc = nc__rt_rock_meshes(dev, r);
     if (rc < 0)
         return rc;
-    if (!(r->rock = aligned_alloc(64, (f->n ? f->n : 1) * sizeof *r->rock)) ||
-        !(r->index = malloc((f->n ? f->n : 1) * sizeof *r->index)))
+    if (!(r->rock = aligned_alloc(64, (f->n ? f->n : 1) * sizeof *r->rock)))
         return nc_error(-ENOMEM, "out of memory for %zu boulders", f->n);
     float(*v)[3] = malloc((size_t)f->nshapes * MAX_CORNERS * sizeof *v);
     int *nv = malloc((size_t)f->nshapes * sizeof *nv);
-    if (!v || !nv) {
+    float(*ext)[3] = malloc((f->n ? f->n : 1) * sizeof *ext); /* the extents, until the trees are built */
+    if (!v || !nv || !ext) {
+        free(ext);
         free(v);
         free(nv);
         return nc_error(-ENOMEM, "out of memory");
@@ -368,6 +377,7 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
         free(key);
         free(v);
         free(nv);
+        free(ext);
         return nc_error(-ENOMEM, "out of memory for %zu boulders' tiles", f->n);
     }
     size_t at = 0;
@@ -399,14 +409,14 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
             tl->origin_m[0] = (key[i].x + 0.5) * S, tl->origin_m[1] = (key[i].y + 0.5) * S;
             tl->origin_m[2] = (key[i].z + 0.5) * S;
             tl->octave = k;
-            tl->index = r->index + at;
+            tl->ext = ext + at;
             tl->rec = r->rock + at;
             tl->n = (unsigned)(e - i);
             for (size_t q = i; q < e; q++, at++) {
                 const uint32_t id = key[q].rock;
                 const struct nc_boulder *b = &f->rock[id];
-                r->index[at] = id;
-                record(b, v + (size_t)b->shape * MAX_CORNERS, nv[b->shape], &r->rock[at]);
+                record(b, v + (size_t)b->shape * MAX_CORNERS, nv[b->shape], &r->rock[at], ext[at]);
+                r->rock[at].rank = id;
                 for (int c = 0; c < 3; c++)
                     r->rock[at].c[c] = (float)(b->centre_m[c] - tl->origin_m[c]);
             }
@@ -418,6 +428,9 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
     free(nv);
     for (size_t t = 0; t < r->ntiles && rc == 0; t++)
         rc = make_tile(dev, r, &r->tile[t]);
+    for (size_t t = 0; t < r->ntiles; t++)
+        r->tile[t].ext = NULL;
+    free(ext);
     r->traced = f->n;
     return rc;
 }
@@ -497,6 +510,5 @@ void nc__rt_rocks_free(struct nc__rt_rocks *r)
     nc__rt_rock_meshes_free(r);
     free(r->tile);
     free(r->rock);
-    free(r->index);
     memset(r, 0, sizeof *r);
 }

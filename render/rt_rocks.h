@@ -2,12 +2,14 @@
  * of diameter is split into tiles, cubes of the body frame 1024 times the
  * octave's largest diameter on a side; a tile is an Embree scene of its own
  * (one user geometry whose primitives are its rocks, each referring to its
- * shared shape: 48 bytes in the list, 64 here and 4 of index, plus the
- * tree's share) with its rocks stored relative to the tile's own origin
- * in Morton order of their centres (a tree's leaves, visited by nearby
- * rays, read records near each other in memory), and two instances: in the top-level scene, and in the scene of the rocks
- * alone (rt_embree.c: rays proven clear of the meshes, or whose mesh hits
- * came from the bins, test only the rocks). The tiles' trees are built once:
+ * shared shape: 48 bytes in the list and 64 here, plus the tree's share)
+ * with its rocks stored relative to the tile's own origin in Morton order
+ * of their centres (a tree's leaves, visited by nearby rays, read records
+ * near each other in memory), and two instances: in the top-level scene,
+ * and in the scene of the rocks alone (rt_embree.c: rays proven clear of
+ * the meshes, or whose mesh hits came from the bins, test only the rocks;
+ * where the rocks' own bins, rt_rock_bins.h, serve a pass, its camera rays
+ * test only the rocks listed in their block). The tiles' trees are built once:
  * a pose only moves their instances (the float translation from the camera
  * to a tile's origin costs 6e-8 of that distance, a record 6e-8 of its
  * distance from the origin: under 1e-4 of the rock's own size), so nothing
@@ -42,7 +44,7 @@ struct nc__rt_rock_tile {
     struct nc__rt_rocks *rocks;
     double origin_m[3];    /* body frame: its rocks' records are relative to it */
     const struct nc__rt_rock *rec; /* each primitive's record, in Morton order of their centres */
-    const uint32_t *index;         /* and its index in the list (the larger the rock, the lower) */
+    const float (*ext)[3];         /* while its tree is built: each primitive's extent (nc__rt_rocks_init) */
     unsigned n;
     int octave; /* in the field's octave table */
     RTCScene scene;
@@ -55,10 +57,11 @@ struct nc__rt_rock_tile {
 
 /* What the intersection test reads of a rock: one cache line. */
 struct nc__rt_rock {
-    float c[3];   /* centre relative to its tile's origin, body frame, m */
-    float M[9];   /* body frame -> rock frame over half_m: R^T / half_m, row-major */
-    float ext[3]; /* the rock's extent from c along each body axis, m */
+    float c[3];    /* centre relative to its tile's origin, body frame, m */
+    float M[9];    /* body frame -> rock frame over half_m: R^T / half_m, row-major */
+    uint32_t rank; /* its index in the field's list (the larger the rock, the lower) */
     uint32_t shape;
+    uint32_t spare[2];
 };
 
 _Static_assert(sizeof(struct nc__rt_rock) == 64, "a rock record is one cache line");
@@ -66,7 +69,6 @@ _Static_assert(sizeof(struct nc__rt_rock) == 64, "a rock record is one cache lin
 struct nc__rt_rocks {
     const struct nc_boulder_field *field;
     struct nc__rt_rock *rock; /* the tiles' records, end to end (tile[k].rec) */
-    uint32_t *index;          /* the tiles' index arrays, end to end */
     struct nc__rt_rock_tile *tile;
     size_t ntiles;
     double min_d_m;   /* the cut: the smallest diameter traced */
@@ -100,6 +102,27 @@ static inline void nc__rt_user_hit(const struct RTCIntersectFunctionNArguments *
     ((unsigned *)hit)[6 * N + i] = a->geomID;
     ((unsigned *)hit)[7 * N + i] = a->context->instID[0];
 }
+
+/* Rays for the rocks' test, eight lanes at a time (GCC/Clang vector
+ * extensions: one AVX2 register where the CPU has it, two SSE or NEON ones
+ * otherwise; no FMA, so the same bits on any): origin, tnear, direction,
+ * tfar, valid (-1: on), in a tile's frame. */
+#define NC__RT_LANES 8
+typedef float nc__rt_vlf __attribute__((vector_size(4 * NC__RT_LANES)));
+typedef int nc__rt_vli __attribute__((vector_size(4 * NC__RT_LANES)));
+struct nc__rt_lanes {
+    nc__rt_vlf o[3], tnear, d[3], tfar;
+    nc__rt_vli valid;
+};
+
+/* The lanes of p against primitive prim of tile tl, a rock above the cut:
+ * bit l of the result set where lane l meets it within (tnear, tfar), at
+ * t[l], with the normal there in n[l] (the tile's frame, unnormalised;
+ * occlusion only if n is NULL). *detailed: the rock is traced as its
+ * detailed surface (its hits take only the relief's octaves the geometry
+ * does not carry). A lane from inside the rock sees nothing of it. */
+unsigned nc__rt_rock_lanes(const struct nc__rt_rock_tile *tl, unsigned prim, const struct nc__rt_lanes *p, float *t,
+                           float (*n)[3], int *detailed);
 
 /* The tiles of field f, every rock traced until the first cut. */
 int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc__rt_rocks *r);

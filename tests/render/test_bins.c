@@ -278,6 +278,13 @@ static void check_frames(const struct nc_scene *s)
     }
     CHECK(nc_render_frame(&ra, s, &a) == 0 && nc_render_frame(&rb, s, &b) == 0, "frames");
     if (rocky) {
+        /* the rocks' own bins served the camera rays: their lists tell a
+         * block with nothing in it (else -1) */
+        int told = 1;
+        for (int y = 0; y < s->camera.height_px; y += 4)
+            for (int x = 0; x < s->camera.width_px; x += 4)
+                told &= nc_rt_block_listed(ra.rt, x, y) >= 0;
+        CHECK(told, "the rocks' bins did not serve the frame");
         size_t rock = 0, other = 0;
         for (size_t i = 0; i < n; i++)
             rock += a.rock_id[i] >= 0, other += a.rock_id[i] != b.rock_id[i];

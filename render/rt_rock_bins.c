@@ -1,0 +1,300 @@
+/* rt_rock_bins.c - camera rays against binned rocks (rt_rock_bins.h).
+ *
+ * A point q (relative to the rays' origin) lies on the ray through image
+ * point (x, y) where x = (a . q) / (c . q), y = (b . q) / (c . q), a, b, c
+ * the rows of the image map Mi (rt_bins.h). A sphere (centre C, radius r)
+ * wholly in front (c . C > r |c|) spans the x between the two planes
+ * (a - x c) . q = 0 tangent to it: ((a - x c) . C)^2 = r^2 |a - x c|^2, a
+ * quadratic in x whose roots bound its image; the same for y.
+ */
+#include "render/rt_rock_bins.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/pool.h"
+
+static int grow(void **p, size_t *cap, size_t n, size_t size)
+{
+    if (n <= *cap)
+        return 0;
+    void *q = realloc(*p, n * size);
+    if (!q)
+        return nc_error(-ENOMEM, "out of memory for the rocks' camera-ray bins");
+    *p = q;
+    *cap = n;
+    return 0;
+}
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* The image span [*lo, *hi] along the row u of Mi (c the depth row) of
+ * the sphere (C, r), wholly in front. */
+static void span(const double *u, const double *c, const double *C, double r, double *lo, double *hi)
+{
+    const double al = dot3(u, C), ga = dot3(c, C), r2 = r * r;
+    const double D = ga * ga - r2 * dot3(c, c), B = al * ga - r2 * dot3(u, c);
+    const double disc = B * B - D * (al * al - r2 * dot3(u, u)), sq = disc > 0 ? sqrt(disc) : 0;
+    *lo = (B - sq) / D;
+    *hi = (B + sq) / D;
+}
+
+/* Pixels [lo, hi] a sample of which can fall in image span [x0, x1]
+ * padded by pad (pixel centres at integers, samples within half a pixel
+ * of them), clipped to [0, n): 0 if none. */
+static int pixels(double x0, double x1, double pad, int n, int *lo, int *hi)
+{
+    const double a = ceil(x0 - pad - 0.5), b = floor(x1 + pad + 0.5);
+    if (!(a <= b) || a > n - 1 || b < 0)
+        return 0;
+    *lo = a < 0 ? 0 : (int)a;
+    *hi = b > n - 1 ? n - 1 : (int)b;
+    return 1;
+}
+
+/* Rock g (the build's numbering, tile k, primitive prim): its pixels
+ * px[0..1] x px[2..3] and nearest s. Returns 1 if listed, 0 if not
+ * (below the cut, outside the image, behind the origin), -1 if its
+ * sphere crosses the plane through the origin parallel to the image. */
+static int rock_pixels(const struct nc__rock_bins *rb, size_t k, size_t prim, int *px, float *s_near)
+{
+    const struct nc__rt_rock_tile *tl = rb->tile[k];
+    const struct nc__rt_rocks *r = tl->rocks;
+    if (!tl->enabled || tl->rec[prim].rank >= r->traced)
+        return 0;
+    const struct nc__rt_rock *rk = &tl->rec[prim];
+    const float *R = rb->rot[rb->tile_body[k]], *h = r->field->shape[rk->shape].half;
+    double C[3];
+    for (int i = 0; i < 3; i++)
+        C[i] = (double)tl->place_m[i] - rb->o[i] + (double)R[3 * i] * rk->c[0] + (double)R[3 * i + 1] * rk->c[1] +
+               (double)R[3 * i + 2] * rk->c[2];
+    /* the test's sphere (rt_rocks.c rock_hit: 1.01 in its square), and more */
+    const double m2 = (double)rk->M[0] * rk->M[0] + (double)rk->M[1] * rk->M[1] + (double)rk->M[2] * rk->M[2];
+    const double r_m = 1.01 * sqrt(((double)h[0] * h[0] + (double)h[1] * h[1] + (double)h[2] * h[2]) / m2) +
+                       1e-6 * sqrt(dot3(C, C));
+    const double *Mi = rb->view->Mi[0], *c = rb->view->Mi[2], cn = sqrt(dot3(c, c)), ga = dot3(c, C);
+    if (ga + r_m * cn <= 0)
+        return 0; /* wholly behind: a ray's points have s > 0 */
+    if (ga - r_m * cn <= 1e-9 * r_m * cn)
+        return -1;
+    double x0, x1, y0, y1;
+    span(Mi, c, C, r_m, &x0, &x1);
+    span(rb->view->Mi[1], c, C, r_m, &y0, &y1);
+    const double pad = rb->view->pad_px;
+    if (!pixels(x0, x1, pad, rb->view->bw * NC_BINS_BLOCK, &px[0], &px[1]) ||
+        !pixels(y0, y1, pad, rb->view->bh * NC_BINS_BLOCK, &px[2], &px[3]))
+        return 0;
+    *s_near = (float)((ga - r_m * cn) * (1 - 1e-6));
+    return 1;
+}
+
+static size_t part_begin(size_t n, int p, int nparts) { return n * (size_t)p / (size_t)nparts; }
+
+enum { PHASE_COUNT, PHASE_FILL };
+
+/* Part p's rocks: counted into its blocks, or entered at its cursors. */
+static void part(struct nc__rock_bins *rb, int p)
+{
+    const size_t total = rb->tile_first[rb->ntiles], g0 = part_begin(total, p, rb->nparts),
+                 g1 = part_begin(total, p + 1, rb->nparts);
+    const int bw = rb->view->bw;
+    uint32_t *cnt = rb->count + (size_t)p * rb->view->nblocks;
+    size_t k = 0;
+    while (k + 1 < rb->ntiles && rb->tile_first[k + 1] <= g0)
+        k++;
+    for (size_t g = g0; g < g1; g++) {
+        while (g >= rb->tile_first[k + 1])
+            k++;
+        const size_t prim = g - rb->tile_first[k];
+        int px[4];
+        float s_near;
+        const int rc = rock_pixels(rb, k, prim, px, &s_near);
+        if (rc < 0) {
+            atomic_store(&rb->straddle, 1);
+            return;
+        }
+        if (!rc)
+            continue;
+        for (int by = px[2] / NC_BINS_BLOCK; by <= px[3] / NC_BINS_BLOCK; by++)
+            for (int bx = px[0] / NC_BINS_BLOCK; bx <= px[1] / NC_BINS_BLOCK; bx++) {
+                uint32_t *c = &cnt[(size_t)by * (size_t)bw + (size_t)bx];
+                if (rb->phase == PHASE_COUNT) {
+                    ++*c;
+                    continue;
+                }
+                const int x0 = px[0] > bx * 4 ? px[0] - bx * 4 : 0, x1 = px[1] < bx * 4 + 3 ? px[1] - bx * 4 : 3;
+                const int y0 = px[2] > by * 4 ? px[2] - by * 4 : 0, y1 = px[3] < by * 4 + 3 ? px[3] - by * 4 : 3;
+                const unsigned row = (2u << x1) - (1u << x0);
+                unsigned lanes = 0;
+                for (int y = y0; y <= y1; y++)
+                    lanes |= row << 4 * y;
+                rb->list[(*c)++] = (struct nc__rock_entry){(uint32_t)prim, (uint16_t)k, (uint16_t)lanes, s_near};
+            }
+    }
+}
+
+static void *worker(void *arg)
+{
+    struct nc__rock_bins *rb = arg;
+    for (int p; (p = atomic_fetch_add(&rb->next, 1)) < rb->nparts;)
+        part(rb, p);
+    return NULL;
+}
+
+static void run(struct nc__rock_bins *rb, struct nc_pool *pool, int phase)
+{
+    rb->phase = phase;
+    atomic_store(&rb->next, 0);
+    nc_pool_run(pool, worker, rb);
+}
+
+int nc__rock_bins_build(struct nc__rock_bins *rb, const struct nc__bins *view, struct nc_vec3 o,
+                        const struct nc__rock_bins_body *bodies, int nbodies, struct nc_pool *pool, int nparts)
+{
+    rb->view = view;
+    rb->nparts = nparts < 1 ? 1 : nparts;
+    rb->o[0] = o.x, rb->o[1] = o.y, rb->o[2] = o.z;
+    for (int i = 0; i < 3; i++)
+        rb->s_of[i] = (float)view->Mi[2][i];
+    size_t nt = 0;
+    for (int b = 0; b < nbodies; b++)
+        nt += bodies[b].rocks ? bodies[b].rocks->ntiles : 0;
+    if (nt > UINT16_MAX + 1u || nbodies > NC_MAX_BODIES)
+        return 0;
+    free(rb->tile);
+    free(rb->tile_body);
+    free(rb->tile_first);
+    rb->tile = malloc((nt + 1) * sizeof *rb->tile);
+    rb->tile_body = malloc((nt + 1) * sizeof *rb->tile_body);
+    rb->tile_first = malloc((nt + 1) * sizeof *rb->tile_first);
+    if (!rb->tile || !rb->tile_body || !rb->tile_first)
+        return nc_error(-ENOMEM, "out of memory for the rocks' camera-ray bins");
+    rb->ntiles = 0;
+    rb->tile_first[0] = 0;
+    for (int b = 0; b < nbodies; b++) {
+        const float *R = bodies[b].rot;
+        memcpy(rb->rot[b], R, sizeof rb->rot[b]);
+        for (int j = 0; j < 3; j++)
+            rb->o_body[b][j] = (float)(R[j] * o.x + R[3 + j] * o.y + R[6 + j] * o.z);
+        for (size_t t = 0; bodies[b].rocks && t < bodies[b].rocks->ntiles; t++) {
+            const struct nc__rt_rock_tile *tl = &bodies[b].rocks->tile[t];
+            rb->tile[rb->ntiles] = tl;
+            rb->tile_body[rb->ntiles] = (uint8_t)b;
+            rb->tile_first[rb->ntiles + 1] = rb->tile_first[rb->ntiles] + tl->n;
+            rb->ntiles++;
+        }
+    }
+    if (!rb->ntiles)
+        return 0;
+    const size_t nb = view->nblocks;
+    int rc;
+    if ((rc = grow((void **)&rb->count, &rb->count_cap, (size_t)rb->nparts * nb, sizeof *rb->count)) < 0 ||
+        (rc = grow((void **)&rb->start, &rb->start_cap, nb + 1, sizeof *rb->start)) < 0)
+        return rc;
+    memset(rb->count, 0, (size_t)rb->nparts * nb * sizeof *rb->count);
+    atomic_store(&rb->straddle, 0);
+    run(rb, pool, PHASE_COUNT);
+    if (atomic_load(&rb->straddle))
+        return 0;
+    /* Block k's entries: part 0's, part 1's, ... each in the rocks' order. */
+    size_t total = 0;
+    for (size_t k = 0; k < nb; k++) {
+        rb->start[k] = (uint32_t)total;
+        for (int p = 0; p < rb->nparts; p++) {
+            uint32_t *c = &rb->count[(size_t)p * nb + k];
+            const size_t n = *c;
+            *c = (uint32_t)total;
+            total += n;
+        }
+        if (total > UINT32_MAX)
+            return 0;
+    }
+    rb->start[nb] = (uint32_t)total;
+    if ((rc = grow((void **)&rb->list, &rb->list_cap, total ? total : 1, sizeof *rb->list)) < 0)
+        return rc;
+    run(rb, pool, PHASE_FILL);
+    return 1;
+}
+
+void nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const struct nc_ray16 *ray, float *t,
+                             int32_t *tile, uint32_t *prim, float (*n)[3], int *detailed)
+{
+    for (int i = 0; i < NC_PACKET; i++)
+        tile[i] = -1;
+    const size_t k = (size_t)(py0 / NC_BINS_BLOCK) * (size_t)rb->view->bw + (size_t)(px0 / NC_BINS_BLOCK);
+    const uint32_t b = rb->start[k], e = rb->start[k + 1];
+    if (b == e)
+        return;
+    /* each lane's s per unit t, and the s of its closest hit so far */
+    float sd[NC_PACKET], s_far[NC_PACKET];
+    unsigned on = 0;
+    for (int i = 0; i < NC_PACKET; i++) {
+        sd[i] = rb->s_of[0] * ray->dx[i] + rb->s_of[1] * ray->dy[i] + rb->s_of[2] * ray->dz[i];
+        s_far[i] = t[i] * sd[i];
+        on |= (unsigned)(ray->valid[i] == -1) << i;
+    }
+    float d[NC_MAX_BODIES][3][NC_PACKET]; /* the directions in the bodies' frames, when first needed */
+    unsigned have = 0;
+    for (uint32_t q = b; q < e; q++) {
+        const struct nc__rock_entry *en = &rb->list[q];
+        unsigned m = en->lanes & on, near = 0;
+        if (!m)
+            continue;
+        for (int i = 0; i < NC_PACKET; i++)
+            near |= (unsigned)(s_far[i] >= en->s_near) << i;
+        if (!(m &= near))
+            continue;
+        const struct nc__rt_rock_tile *tl = rb->tile[en->tile];
+        const int body = rb->tile_body[en->tile];
+        if (!(have >> body & 1)) {
+            const float *R = rb->rot[body];
+            for (int j = 0; j < 3; j++)
+                for (int i = 0; i < NC_PACKET; i++)
+                    d[body][j][i] = R[j] * ray->dx[i] + R[3 + j] * ray->dy[i] + R[6 + j] * ray->dz[i];
+            have |= 1u << body;
+        }
+        for (int g = 0; g < NC_PACKET; g += NC__RT_LANES) {
+            const unsigned mg = m >> g & ((1u << NC__RT_LANES) - 1);
+            if (!mg)
+                continue;
+            struct nc__rt_lanes p;
+            for (int l = 0; l < NC__RT_LANES; l++) {
+                for (int j = 0; j < 3; j++) {
+                    p.o[j][l] = tl->cam_m[j] + rb->o_body[body][j];
+                    p.d[j][l] = d[body][j][g + l];
+                }
+                p.tnear[l] = ray->tnear[g + l];
+                p.tfar[l] = t[g + l];
+                p.valid[l] = mg >> l & 1 ? -1 : 0;
+            }
+            float th[NC__RT_LANES], nh[NC__RT_LANES][3];
+            int det;
+            const unsigned h = nc__rt_rock_lanes(tl, en->prim, &p, th, nh, &det);
+            for (int l = 0; l < NC__RT_LANES && h >> l; l++)
+                if (h >> l & 1) {
+                    const int i = g + l;
+                    t[i] = th[l];
+                    s_far[i] = th[l] * sd[i];
+                    tile[i] = en->tile;
+                    prim[i] = en->prim;
+                    detailed[i] = det;
+                    memcpy(n[i], nh[l], sizeof n[i]);
+                }
+        }
+    }
+}
+
+void nc__rock_bins_free(struct nc__rock_bins *rb)
+{
+    free(rb->tile);
+    free(rb->tile_body);
+    free(rb->tile_first);
+    free(rb->count);
+    free(rb->start);
+    free(rb->list);
+    memset(rb, 0, sizeof *rb);
+}
