@@ -257,6 +257,24 @@ void nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, c
                     d[body][j][i] = R[j] * ray->dx[i] + R[3 + j] * ray->dy[i] + R[6 + j] * ray->dz[i];
             have |= 1u << body;
         }
+        /* the lanes that pass near enough its centre (rt_rocks.c's first
+         * test, on the whole packet at once) */
+        const struct nc__rt_rock *rk = &tl->rec[en->prim];
+        const float *h = tl->rocks->field->shape[rk->shape].half;
+        const float m2 = rk->M[0] * rk->M[0] + rk->M[1] * rk->M[1] + rk->M[2] * rk->M[2];
+        const float r2 = 1.02f * (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]) / m2;
+        float rel[3];
+        for (int j = 0; j < 3; j++)
+            rel[j] = tl->cam_m[j] + rb->o_body[body][j] - rk->c[j];
+        unsigned pass = 0;
+        for (int i = 0; i < NC_PACKET; i++) {
+            const float dx = d[body][0][i], dy = d[body][1][i], dz = d[body][2][i];
+            const float tc = -(rel[0] * dx + rel[1] * dy + rel[2] * dz) / (dx * dx + dy * dy + dz * dz);
+            const float qx = rel[0] + tc * dx, qy = rel[1] + tc * dy, qz = rel[2] + tc * dz;
+            pass |= (unsigned)(qx * qx + qy * qy + qz * qz <= r2) << i;
+        }
+        if (!(m &= pass))
+            continue;
         for (int g = 0; g < NC_PACKET; g += NC__RT_LANES) {
             const unsigned mg = m >> g & ((1u << NC__RT_LANES) - 1);
             if (!mg)
@@ -273,9 +291,9 @@ void nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, c
             }
             float th[NC__RT_LANES], nh[NC__RT_LANES][3];
             int det;
-            const unsigned h = nc__rt_rock_lanes(tl, en->prim, &p, th, nh, &det);
-            for (int l = 0; l < NC__RT_LANES && h >> l; l++)
-                if (h >> l & 1) {
+            const unsigned hits = nc__rt_rock_lanes(tl, en->prim, &p, th, nh, &det);
+            for (int l = 0; l < NC__RT_LANES && hits >> l; l++)
+                if (hits >> l & 1) {
                     const int i = g + l;
                     t[i] = th[l];
                     s_far[i] = th[l] * sd[i];

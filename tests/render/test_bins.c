@@ -6,6 +6,7 @@
  * triangles skipped whole without changing the lists, the cases the bins
  * refuse, and whole frames. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -261,7 +262,7 @@ static void check_clusters(const struct nc_scene *s, double min_skip, const char
  * With boulders, the bins' mesh hits and the rocks traced alone in front of
  * them (rt_embree.c rocks_over) against Embree over both: the same rock in
  * every pixel but a few at the rocks' edges. */
-static void check_frames(const struct nc_scene *s)
+static void check_frames(const struct nc_scene *s, int rock_bins)
 {
     struct nc_frame a, b;
     struct nc_renderer ra, rb;
@@ -278,13 +279,13 @@ static void check_frames(const struct nc_scene *s)
     }
     CHECK(nc_render_frame(&ra, s, &a) == 0 && nc_render_frame(&rb, s, &b) == 0, "frames");
     if (rocky) {
-        /* the rocks' own bins served the camera rays: their lists tell a
-         * block with nothing in it (else -1) */
+        /* whether the rocks' own bins served the camera rays: their lists
+         * tell a block with nothing in it (else -1) */
         int told = 1;
         for (int y = 0; y < s->camera.height_px; y += 4)
             for (int x = 0; x < s->camera.width_px; x += 4)
                 told &= nc_rt_block_listed(ra.rt, x, y) >= 0;
-        CHECK(told, "the rocks' bins did not serve the frame");
+        CHECK(told == rock_bins, "the rocks' bins %s the frame", told ? "served" : "did not serve");
         size_t rock = 0, other = 0;
         for (size_t i = 0; i < n; i++)
             rock += a.rock_id[i] >= 0, other += a.rock_id[i] != b.rock_id[i];
@@ -322,7 +323,7 @@ int main(void)
     compare_rays(&s, 0, "default scene, 256x256 crop");
     compare_rays(&s, 1, "default scene, pixel centres");
     check_clusters(&s, 0.35, "clusters, the body in the frame (back faces)");
-    check_frames(&s);
+    check_frames(&s, 0);
     /* Smooth normals and albedo variation (the barycentric points) at 128x128, the whole body. */
     const char *smooth[] = {"camera.width_px=128", "camera.height_px=128", "camera.pixel_pitch_m=2.2e-5",
                             "bodies.0.shape.subdivisions=5", "bodies.0.shape.normals=smooth",
@@ -349,9 +350,23 @@ int main(void)
                            "bodies.0.boulders={preset: bennu, min_diameter_m: 1}"};
     struct nc_scene s8;
     nc_test_scene(nc_default_scene_yaml, rocks, 6, &s8);
-    check_frames(&s8);
+    check_frames(&s8, 1);
+    /* The camera within the largest rock's bounding sphere, above its
+     * centre (which may lie under the ground): the sphere's image is
+     * unbounded, so the rocks' bins give way to their trees. */
+    const struct nc_boulder *big = &s8.body[0].boulders.rock[0];
+    const double *c = big->centre_m, up = 0.95 * big->half_m / sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    char at[96];
+    snprintf(at, sizeof at, "camera.position_m=[%.6f,%.6f,%.6f]", c[0] * (1 + up), c[1] * (1 + up), c[2] * (1 + up));
+    const char *inside[] = {"camera.width_px=128", "camera.height_px=128", "bodies.0.shape.subdivisions=6",
+                            at, "camera.look_at_m=[0,0,0]", "bodies.0.attitude_q=[1,0,0,0]",
+                            "render.boulder_min_px=0", "bodies.0.boulders={preset: bennu, min_diameter_m: 1}"};
+    struct nc_scene s9;
+    nc_test_scene(nc_default_scene_yaml, inside, 8, &s9);
+    check_frames(&s9, 0);
     nc_scene_free(&s7);
     nc_scene_free(&s8);
+    nc_scene_free(&s9);
     /* Two meshes, the small one in front of the large one. */
     static const char two[] =
         "bodies:\n"
