@@ -748,7 +748,8 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
         for (int i = 0; i < rt->nbodies; i++)
             rb[i] = (struct nc__rock_bins_body){rt->body[i].src->boulders.n ? &rt->body[i].rocks : NULL,
                                                 rt->body[i].rot};
-        const int r2 = nc__rock_bins_build(&rt->rock_bins, &rt->bins, cam->o, rb, rt->nbodies, pool, 4 * threads);
+        /* two parts a thread: each part's counts take 4 bytes a block */
+        const int r2 = nc__rock_bins_build(&rt->rock_bins, &rt->bins, cam->o, rb, rt->nbodies, pool, 2 * threads);
         if (r2 < 0)
             return r2;
         rt->rock_binned = r2;
