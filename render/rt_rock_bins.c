@@ -109,6 +109,10 @@ static void part(struct nc__rock_bins *rb, int p)
     for (size_t g = g0; g < g1; g++) {
         while (g >= rb->tile_first[k + 1])
             k++;
+        if (!rb->tile[k]->enabled) { /* an octave wholly below the cut */
+            g = rb->tile_first[k + 1] - 1;
+            continue;
+        }
         const size_t prim = g - rb->tile_first[k];
         int px[4];
         float s_near;
