@@ -271,8 +271,8 @@ static void record(const struct nc_boulder *b, const float (*v)[3], int nv, stru
 /* A rock's tile key: the cube of the body frame its centre falls in (of
  * its octave's size), and the Morton code of the centre in the cube. */
 struct tile_key {
-    int64_t x, y, z;
     uint64_t morton;
+    int32_t x, y, z; /* within 2^31 cubes of the origin (checked) */
     uint32_t rock;
 };
 
@@ -290,8 +290,7 @@ static int key_cmp(const void *pa, const void *pb)
     return (a->rock > b->rock) - (a->rock < b->rock);
 }
 
-/* The 21 bits of x spread to every third bit. */
-static uint64_t spread3(uint64_t x)
+static uint64_t spread3(uint64_t x) /* the 21 bits of x spread to every third bit */
 {
     x &= 0x1fffff;
     x = (x | x << 32) & 0x1f00000000ffffull;
@@ -302,9 +301,8 @@ static uint64_t spread3(uint64_t x)
     return x;
 }
 
-/* Centre c (body frame) in the cube key (its indices) of side S: its
- * Morton code over 2^21 steps an axis. */
-static uint64_t morton(const double *c, const int64_t *key, double S)
+/* Centre c (body frame) in the cube key of side S: its Morton code, 2^21 steps an axis. */
+static uint64_t morton(const double *c, const int32_t *key, double S)
 {
     uint64_t m = 0;
     for (int i = 0; i < 3; i++) {
@@ -385,12 +383,19 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
         const struct nc_boulder_octave *oc = &f->octave[k];
         const double S = tile_size_m(oc->j);
         for (size_t i = 0; i < oc->n; i++) {
-            const double *c = f->rock[oc->first + i].centre_m;
+            const double *c = f->rock[oc->first + i].centre_m, far = fmax(fabs(c[0]), fmax(fabs(c[1]), fabs(c[2])));
+            if (!(far / S < 2147483647.0)) {
+                rc = nc_error(NC_ERANGE, "boulder %zu lies %g m from the body's origin: too far for rocks of %g m",
+                              oc->first + i, far, 2 * f->rock[oc->first].half_m);
+                break;
+            }
             struct tile_key *q = &key[i];
-            *q = (struct tile_key){(int64_t)floor(c[0] / S), (int64_t)floor(c[1] / S), (int64_t)floor(c[2] / S), 0,
+            *q = (struct tile_key){0, (int32_t)floor(c[0] / S), (int32_t)floor(c[1] / S), (int32_t)floor(c[2] / S),
                                    (uint32_t)(oc->first + i)};
             q->morton = morton(c, &q->x, S);
         }
+        if (rc)
+            break;
         qsort(key, oc->n, sizeof *key, key_cmp);
         for (size_t i = 0; i < oc->n && rc == 0;) {
             size_t e = i;
