@@ -70,7 +70,8 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
  * spends on a sample, per triangle), 0 when it does not, or a negative
  * error code. The lists are built on pool's threads (NULL: the caller's
  * alone), the same for any number. Boulders are traced in front of the
- * lists' hits, through the rocks alone. Call after nc_rt_update. */
+ * lists' hits, through the rocks' own lists (rt_rock_bins.h) or, where
+ * those cannot serve the pass, the rocks alone. Call after nc_rt_update. */
 struct nc_rt_pinhole {
     struct nc_vec3 o, d00, ex, ey;
     int width_px, height_px;
@@ -84,9 +85,9 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
 void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
                            int n);
 /* What the lists say of the 4x4 pixel block at (px0, py0), in a pass that
- * nc_rt_bin_camera serves: 1 if they hold a triangle for it, 0 if no
- * camera ray of it can hit anything (no triangle listed, no rock traced),
- * -1 if they cannot tell (rocks are traced). */
+ * nc_rt_bin_camera serves: 1 if they hold a triangle or a rock for it, 0
+ * if no camera ray of it can hit anything, -1 if they cannot tell (rocks
+ * are traced and their own lists do not serve the pass). */
 int nc_rt_block_listed(const struct nc_rt *rt, int px0, int py0);
 /* For a hit on an analytic body, recompute range t and unit normal n (scene
  * frame) in double precision for the exact camera-relative ray origin + t d (d unit):
