@@ -16,18 +16,12 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/grow.h"
 #include "core/pool.h"
 
 static int grow(void **p, size_t *cap, size_t n, size_t size)
 {
-    if (n <= *cap)
-        return 0;
-    void *q = realloc(*p, n * size);
-    if (!q)
-        return nc_error(-ENOMEM, "out of memory for the rocks' camera-ray bins");
-    *p = q;
-    *cap = n;
-    return 0;
+    return nc_grow(p, cap, n, size) < 0 ? nc_error(-ENOMEM, "out of memory for %zu rock-bin entries", n) : 0;
 }
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
