@@ -78,7 +78,9 @@ struct nc_renderer {
     int no_shadow_cull;
     /* 1: trace camera rays in packets of one sample of 4x4 pixels, as the
      * shading takes them, instead of 2x2 pixels x 4 samples (trace_camera in
-     * render.c); tests compare the two (the frames are the same). */
+     * render.c), and where the bins serve, hand them to the bins one at a
+     * time instead of up to 4 together; tests compare the two (the frames
+     * are the same). */
     int one_sample_packets;
     /* 1: trace camera rays through Embree even where a pass's camera is a
      * pinhole at rest over meshes (nc_rt_bin_camera's binned triangles serve

@@ -791,19 +791,20 @@ static void rocks_over(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
 }
 
 /* The same through the rocks' bins (the block at (px0, py0)). */
-static void rocks_binned(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit)
+static void rocks_binned(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit, int npk)
 {
-    float t[NC_PACKET], n[NC_PACKET][3];
-    int32_t tile[NC_PACKET];
-    uint32_t prim[NC_PACKET];
-    int detailed[NC_PACKET];
-    for (int i = 0; i < NC_PACKET; i++)
-        t[i] = hit->body[i] >= 0 ? hit->t[i] : ray->tfar[i];
-    nc__rock_bins_intersect(&rt->rock_bins, px0, py0, ray, t, tile, prim, n, detailed);
-    for (int i = 0; i < NC_PACKET; i++)
-        if (tile[i] >= 0)
-            put_hit(rt, rt->rock_bins.tile[tile[i]]->inst_id, prim[i], t[i], detailed[i] ? 1.0f : 0.0f, 0, n[i][0],
-                    n[i][1], n[i][2], ray, hit, i);
+    struct nc__rock_bins_hits h;
+    for (int q = 0; q < NC_BINS_GROUP; q++) /* (lanes past npk's packets are off) */
+        for (int i = 0; i < NC_PACKET; i++)
+            h.t[q * NC_PACKET + i] = q >= npk ? 0.0f : hit[q].body[i] >= 0 ? hit[q].t[i] : ray[q].tfar[i];
+    nc__rock_bins_intersect(&rt->rock_bins, px0, py0, ray, npk, &h);
+    for (int q = 0; q < npk; q++)
+        for (int i = 0; i < NC_PACKET; i++) {
+            const int k = q * NC_PACKET + i;
+            if (h.tile[k] >= 0)
+                put_hit(rt, rt->rock_bins.tile[h.tile[k]]->inst_id, h.prim[k], h.t[k], h.detailed[k] ? 1.0f : 0.0f, 0,
+                        h.n[k][0], h.n[k][1], h.n[k][2], &ray[q], &hit[q], i);
+        }
 }
 
 void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit,
@@ -832,11 +833,10 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
                 }
                 put_hit(rt, b->inst_id, prim, t[q][i], u, v, ct->ng[0], ct->ng[1], ct->ng[2], &ray[q0 + q], h, i);
             }
-        for (int q = 0; q < m && rt->rocks_on; q++)
-            if (rt->rock_binned)
-                rocks_binned(rt, px0, py0, &ray[q0 + q], &hit[q0 + q]);
-            else
-                rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
+        if (rt->rocks_on && rt->rock_binned)
+            rocks_binned(rt, px0, py0, ray + q0, hit + q0, m);
+        for (int q = 0; q < m && rt->rocks_on && !rt->rock_binned; q++)
+            rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
     }
 }
 

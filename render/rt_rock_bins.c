@@ -218,89 +218,136 @@ int nc__rock_bins_build(struct nc__rock_bins *rb, const struct nc__bins *view, s
     return 1;
 }
 
-void nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const struct nc_ray16 *ray, float *t,
-                             int32_t *tile, uint32_t *prim, float (*n)[3], int *detailed)
+/* The lanes of the group's packets (bit 16 q + i: lane i of packet q) of
+ * those in m that reach s_near, or that pass within sqrt(r2) of the rock's
+ * centre (rel: the rays' origin from it; d the directions in its body's
+ * frame). A packet at a time: 16-lane loops the compiler vectorises (the
+ * clones' registers). */
+static inline __attribute__((always_inline)) uint64_t lanes_near(const float *s_far, float s_near, uint64_t m)
 {
-    for (int i = 0; i < NC_PACKET; i++)
-        tile[i] = -1;
+    for (int q = 0; q < NC_BINS_GROUP; q++) {
+        if (!(m >> NC_PACKET * q & 0xffff))
+            continue;
+        unsigned near = 0;
+#pragma GCC unroll 1 /* a vectorised loop, not 16 compares */
+        for (int i = 0; i < NC_PACKET; i++)
+            near |= (unsigned)(s_far[NC_PACKET * q + i] >= s_near) << i;
+        m &= ~((uint64_t)(~near & 0xffff) << NC_PACKET * q);
+    }
+    return m;
+}
+
+static inline __attribute__((always_inline)) uint64_t lanes_pass(const float (*d)[NC_ROCK_BINS_LANES],
+                                                                 const float *rel, float r2, uint64_t m)
+{
+    for (int q = 0; q < NC_BINS_GROUP; q++) {
+        if (!(m >> NC_PACKET * q & 0xffff))
+            continue;
+        unsigned pass = 0;
+        const float *dx = d[0] + NC_PACKET * q, *dy = d[1] + NC_PACKET * q, *dz = d[2] + NC_PACKET * q;
+#pragma GCC unroll 1
+        for (int i = 0; i < NC_PACKET; i++) {
+            const float tc = -(rel[0] * dx[i] + rel[1] * dy[i] + rel[2] * dz[i]) /
+                             (dx[i] * dx[i] + dy[i] * dy[i] + dz[i] * dz[i]);
+            const float qx = rel[0] + tc * dx[i], qy = rel[1] + tc * dy[i], qz = rel[2] + tc * dz[i];
+            pass |= (unsigned)(qx * qx + qy * qy + qz * qz <= r2) << i;
+        }
+        m &= ~((uint64_t)(~pass & 0xffff) << NC_PACKET * q);
+    }
+    return m;
+}
+
+/* Entry en's exact test on the lanes m, NC__RT_LANES at a time (packed
+ * whatever their packets): closer hits written to the group's lanes. */
+static void entry_test(const struct nc__rock_bins *rb, const struct nc__rock_entry *en, int body, uint64_t m,
+                       const float (*d)[NC_ROCK_BINS_LANES], const float *tnear, const float *sd,
+                       struct nc__rock_bins_hits *h, float *s_far)
+{
+    const struct nc__rt_rock_tile *tl = rb->tile[en->tile];
+    while (m) {
+        struct nc__rt_lanes p;
+        int lane[NC__RT_LANES], nl = 0;
+        for (; m && nl < NC__RT_LANES; m &= m - 1)
+            lane[nl++] = __builtin_ctzll(m);
+        for (int l = 0; l < NC__RT_LANES; l++) {
+            const int i = lane[l < nl ? l : 0];
+            for (int j = 0; j < 3; j++) {
+                p.o[j][l] = tl->cam_m[j] + rb->o_body[body][j];
+                p.d[j][l] = d[j][i];
+            }
+            p.tnear[l] = tnear[i];
+            p.tfar[l] = h->t[i];
+            p.valid[l] = l < nl ? -1 : 0;
+        }
+        float th[NC__RT_LANES], nh[NC__RT_LANES][3];
+        int det;
+        const unsigned hits = nc__rt_rock_lanes(tl, en->prim, &p, th, nh, &det);
+        for (int l = 0; l < nl; l++)
+            if (hits >> l & 1) {
+                const int i = lane[l];
+                h->t[i] = th[l];
+                s_far[i] = th[l] * sd[i];
+                h->tile[i] = en->tile;
+                h->prim[i] = en->prim;
+                h->detailed[i] = det;
+                memcpy(h->n[i], nh[l], sizeof h->n[i]);
+            }
+    }
+}
+
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void
+nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const struct nc_ray16 *ray, int npk,
+                        struct nc__rock_bins_hits *h)
+{
+    for (int i = 0; i < NC_ROCK_BINS_LANES; i++)
+        h->tile[i] = -1;
     const size_t k = (size_t)(py0 / NC_BINS_BLOCK) * (size_t)rb->view->bw + (size_t)(px0 / NC_BINS_BLOCK);
     const uint32_t b = rb->start[k], e = rb->start[k + 1];
     if (b == e)
         return;
     /* each lane's s per unit t, and the s of its closest hit so far */
-    float sd[NC_PACKET], s_far[NC_PACKET];
-    unsigned on = 0;
-    for (int i = 0; i < NC_PACKET; i++) {
-        sd[i] = rb->s_of[0] * ray->dx[i] + rb->s_of[1] * ray->dy[i] + rb->s_of[2] * ray->dz[i];
-        s_far[i] = t[i] * sd[i];
-        on |= (unsigned)(ray->valid[i] == -1) << i;
+    float sd[NC_ROCK_BINS_LANES], s_far[NC_ROCK_BINS_LANES], tnear[NC_ROCK_BINS_LANES];
+    uint64_t on = 0;
+    for (int i = 0; i < NC_ROCK_BINS_LANES; i++) {
+        const struct nc_ray16 *r = &ray[i / NC_PACKET < npk ? i / NC_PACKET : 0];
+        const int l = i % NC_PACKET;
+        sd[i] = rb->s_of[0] * r->dx[l] + rb->s_of[1] * r->dy[l] + rb->s_of[2] * r->dz[l];
+        s_far[i] = h->t[i] * sd[i];
+        tnear[i] = r->tnear[l];
+        on |= (uint64_t)(i / NC_PACKET < npk && r->valid[l] == -1) << i;
     }
-    float d[NC_MAX_BODIES][3][NC_PACKET]; /* the directions in the bodies' frames, when first needed */
+    /* the directions in the bodies' frames, when first needed */
+    float d[NC_MAX_BODIES][3][NC_ROCK_BINS_LANES];
     unsigned have = 0;
     for (uint32_t q = b; q < e; q++) {
         const struct nc__rock_entry *en = &rb->list[q];
-        unsigned m = en->lanes & on, near = 0;
-        if (!m)
-            continue;
-        for (int i = 0; i < NC_PACKET; i++)
-            near |= (unsigned)(s_far[i] >= en->s_near) << i;
-        if (!(m &= near))
+        const uint64_t lanes = en->lanes;
+        uint64_t m = on & (lanes | lanes << 16 | lanes << 32 | lanes << 48);
+        if (!m || !(m = lanes_near(s_far, en->s_near, m)))
             continue;
         const struct nc__rt_rock_tile *tl = rb->tile[en->tile];
         const int body = rb->tile_body[en->tile];
         if (!(have >> body & 1)) {
             const float *R = rb->rot[body];
             for (int j = 0; j < 3; j++)
-                for (int i = 0; i < NC_PACKET; i++)
-                    d[body][j][i] = R[j] * ray->dx[i] + R[3 + j] * ray->dy[i] + R[6 + j] * ray->dz[i];
+                for (int i = 0; i < NC_ROCK_BINS_LANES; i++) {
+                    const struct nc_ray16 *r = &ray[i / NC_PACKET < npk ? i / NC_PACKET : 0];
+                    const int l = i % NC_PACKET;
+                    d[body][j][i] = R[j] * r->dx[l] + R[3 + j] * r->dy[l] + R[6 + j] * r->dz[l];
+                }
             have |= 1u << body;
         }
         /* the lanes that pass near enough its centre (rt_rocks.c's first
-         * test, on the whole packet at once) */
+         * test, on the whole group at once) */
         const struct nc__rt_rock *rk = &tl->rec[en->prim];
-        const float *h = tl->rocks->field->shape[rk->shape].half;
+        const float *hf = tl->rocks->field->shape[rk->shape].half;
         const float m2 = rk->M[0] * rk->M[0] + rk->M[1] * rk->M[1] + rk->M[2] * rk->M[2];
-        const float r2 = 1.02f * (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]) / m2;
+        const float r2 = 1.02f * (hf[0] * hf[0] + hf[1] * hf[1] + hf[2] * hf[2]) / m2;
         float rel[3];
         for (int j = 0; j < 3; j++)
             rel[j] = tl->cam_m[j] + rb->o_body[body][j] - rk->c[j];
-        unsigned pass = 0;
-        for (int i = 0; i < NC_PACKET; i++) {
-            const float dx = d[body][0][i], dy = d[body][1][i], dz = d[body][2][i];
-            const float tc = -(rel[0] * dx + rel[1] * dy + rel[2] * dz) / (dx * dx + dy * dy + dz * dz);
-            const float qx = rel[0] + tc * dx, qy = rel[1] + tc * dy, qz = rel[2] + tc * dz;
-            pass |= (unsigned)(qx * qx + qy * qy + qz * qz <= r2) << i;
-        }
-        if (!(m &= pass))
-            continue;
-        for (int g = 0; g < NC_PACKET; g += NC__RT_LANES) {
-            const unsigned mg = m >> g & ((1u << NC__RT_LANES) - 1);
-            if (!mg)
-                continue;
-            struct nc__rt_lanes p;
-            for (int l = 0; l < NC__RT_LANES; l++) {
-                for (int j = 0; j < 3; j++) {
-                    p.o[j][l] = tl->cam_m[j] + rb->o_body[body][j];
-                    p.d[j][l] = d[body][j][g + l];
-                }
-                p.tnear[l] = ray->tnear[g + l];
-                p.tfar[l] = t[g + l];
-                p.valid[l] = mg >> l & 1 ? -1 : 0;
-            }
-            float th[NC__RT_LANES], nh[NC__RT_LANES][3];
-            int det;
-            const unsigned hits = nc__rt_rock_lanes(tl, en->prim, &p, th, nh, &det);
-            for (int l = 0; l < NC__RT_LANES && hits >> l; l++)
-                if (hits >> l & 1) {
-                    const int i = g + l;
-                    t[i] = th[l];
-                    s_far[i] = th[l] * sd[i];
-                    tile[i] = en->tile;
-                    prim[i] = en->prim;
-                    detailed[i] = det;
-                    memcpy(n[i], nh[l], sizeof n[i]);
-                }
-        }
+        if ((m = lanes_pass(d[body], rel, r2, m)))
+            entry_test(rb, en, body, m, d[body], tnear, sd, h, s_far);
     }
 }
 

@@ -67,14 +67,28 @@ static inline int nc__rock_bins_listed(const struct nc__rock_bins *rb, int px0, 
     return rb->start[k + 1] > rb->start[k];
 }
 
-/* The closest rocks in front of the packet ray (camera rays from o, lane
- * i in pixel (px0 + i % 4, py0 + i / 4) of the block at (px0, py0)) within
- * (tnear, t[i]): where one is met, t[i] becomes its distance, tile[i] its
- * tile (the build's numbering; -1 where none is), prim[i] its primitive,
- * n[i] the normal there (its tile's frame, unnormalised) and detailed[i]
- * whether it was traced as its detailed surface. */
-void nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const struct nc_ray16 *ray, float *t,
-                             int32_t *tile, uint32_t *prim, float (*n)[3], int *detailed);
+/* Each lane's closest rock (nc__rock_bins_intersect): lane 16 q + i is
+ * lane i of packet q. */
+#define NC_ROCK_BINS_LANES (NC_BINS_GROUP * NC_PACKET)
+struct nc__rock_bins_hits {
+    float t[NC_ROCK_BINS_LANES];
+    int32_t tile[NC_ROCK_BINS_LANES];
+    uint32_t prim[NC_ROCK_BINS_LANES];
+    float n[NC_ROCK_BINS_LANES][3];
+    int detailed[NC_ROCK_BINS_LANES];
+};
+
+/* The closest rocks in front of the npk (1 to NC_BINS_GROUP) packets ray
+ * (camera rays from o, lane i of each in pixel (px0 + i % 4, py0 + i / 4)
+ * of the block at (px0, py0)) within (tnear, h->t): where one is met, h->t
+ * becomes its distance, h->tile its tile (the build's numbering; -1 where
+ * none is), h->prim its primitive, h->n the normal there (its tile's frame,
+ * unnormalised) and h->detailed whether it was traced as its detailed
+ * surface. Each entry is tested on the passing lanes of all the packets at
+ * once, NC__RT_LANES at a time: each lane meets the same entries in the
+ * same order as alone, so the same hits. */
+void nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const struct nc_ray16 *ray, int npk,
+                             struct nc__rock_bins_hits *h);
 
 void nc__rock_bins_free(struct nc__rock_bins *rb);
 
