@@ -26,64 +26,64 @@ static int grow(void **p, size_t *cap, size_t n, size_t size)
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* The image span [*lo, *hi] along the row u of Mi (c the depth row) of
- * the sphere (C, r), wholly in front. */
-static void span(const double *u, const double *c, const double *C, double r, double *lo, double *hi)
-{
-    const double al = dot3(u, C), ga = dot3(c, C), r2 = r * r;
-    const double D = ga * ga - r2 * dot3(c, c), B = al * ga - r2 * dot3(u, c);
-    const double disc = B * B - D * (al * al - r2 * dot3(u, u)), sq = disc > 0 ? sqrt(disc) : 0;
-    *lo = (B - sq) / D;
-    *hi = (B + sq) / D;
-}
-
-/* Pixels [lo, hi] a sample of which can fall in image span [x0, x1]
- * padded by pad (pixel centres at integers, samples within half a pixel
- * of them), clipped to [0, n): 0 if none. */
-static int pixels(double x0, double x1, double pad, int n, int *lo, int *hi)
-{
-    const double a = ceil(x0 - pad - 0.5), b = floor(x1 + pad + 0.5);
-    if (!(a <= b) || a > n - 1 || b < 0)
-        return 0;
-    *lo = a < 0 ? 0 : (int)a;
-    *hi = b > n - 1 ? n - 1 : (int)b;
-    return 1;
-}
-
-/* Rock g (the build's numbering, tile k, primitive prim): its pixels
- * px[0..1] x px[2..3] and nearest s. Returns 1 if listed, 0 if not
- * (below the cut, outside the image, behind the origin), -1 if its
- * sphere crosses the plane through the origin parallel to the image. */
-static int rock_pixels(const struct nc__rock_bins *rb, size_t k, size_t prim, int *px, float *s_near)
+/* Rocks prim0 .. prim0 + n - 1 (n <= BATCH) of tile k (the build's
+ * numbering), enabled: each one's pixels px[0..1][j] x px[2..3][j] and
+ * nearest s; st[j] 1 if listed, 0 if not (below the cut, outside the
+ * image, behind the origin), -1 if its sphere crosses the plane through
+ * the origin parallel to the image. Branch-free loops over the batch that
+ * the compiler vectorises (the clones' registers): the same operations
+ * lane by lane, so the same bits on every path. */
+#define BATCH 16
+static inline __attribute__((always_inline)) void
+rock_pixels(const struct nc__rock_bins *rb, size_t k, size_t prim0, int n, int (*px)[BATCH], float *s_near, int *st)
 {
     const struct nc__rt_rock_tile *tl = rb->tile[k];
     const struct nc__rt_rocks *r = tl->rocks;
-    if (!tl->enabled || tl->rec[prim].rank >= r->traced)
-        return 0;
-    const struct nc__rt_rock *rk = &tl->rec[prim];
-    const float *R = rb->rot[rb->tile_body[k]], *h = r->field->shape[rk->shape].half;
-    double C[3];
-    for (int i = 0; i < 3; i++)
-        C[i] = (double)tl->place_m[i] - rb->o[i] + (double)R[3 * i] * rk->c[0] + (double)R[3 * i + 1] * rk->c[1] +
-               (double)R[3 * i + 2] * rk->c[2];
-    /* the test's sphere (rt_rocks.c rock_hit: 1.01 in its square), and more */
-    const double m2 = (double)rk->M[0] * rk->M[0] + (double)rk->M[1] * rk->M[1] + (double)rk->M[2] * rk->M[2];
-    const double r_m = 1.01 * sqrt(((double)h[0] * h[0] + (double)h[1] * h[1] + (double)h[2] * h[2]) / m2) +
-                       1e-6 * sqrt(dot3(C, C));
-    const double *Mi = rb->view->Mi[0], *c = rb->view->Mi[2], cn = sqrt(dot3(c, c)), ga = dot3(c, C);
-    if (ga + r_m * cn <= 0)
-        return 0; /* wholly behind: a ray's points have s > 0 */
-    if (ga - r_m * cn <= 1e-9 * r_m * cn)
-        return -1;
-    double x0, x1, y0, y1;
-    span(Mi, c, C, r_m, &x0, &x1);
-    span(rb->view->Mi[1], c, C, r_m, &y0, &y1);
-    const double pad = rb->view->pad_px;
-    if (!pixels(x0, x1, pad, rb->view->bw * NC_BINS_BLOCK, &px[0], &px[1]) ||
-        !pixels(y0, y1, pad, rb->view->bh * NC_BINS_BLOCK, &px[2], &px[3]))
-        return 0;
-    *s_near = (float)((ga - r_m * cn) * (1 - 1e-6));
-    return 1;
+    const float *R = rb->rot[rb->tile_body[k]];
+    const double *u = rb->view->Mi[0], *v = rb->view->Mi[1], *c = rb->view->Mi[2], pad = rb->view->pad_px;
+    const double cn = sqrt(dot3(c, c)), cc = dot3(c, c), uc = dot3(u, c), uu = dot3(u, u), vc = dot3(v, c),
+                 vv = dot3(v, v), W = rb->view->bw * NC_BINS_BLOCK - 1, H = rb->view->bh * NC_BINS_BLOCK - 1;
+    double Cx[BATCH], Cy[BATCH], Cz[BATCH], h2[BATCH], m2[BATCH];
+    int live[BATCH];
+    for (int j = 0; j < BATCH; j++) {
+        const struct nc__rt_rock *rk = &tl->rec[prim0 + (j < n ? j : 0)];
+        const float *h = r->field->shape[rk->shape].half;
+        live[j] = j < n && rk->rank < r->traced;
+        double C[3];
+        for (int i = 0; i < 3; i++)
+            C[i] = (double)tl->place_m[i] - rb->o[i] + (double)R[3 * i] * rk->c[0] + (double)R[3 * i + 1] * rk->c[1] +
+                   (double)R[3 * i + 2] * rk->c[2];
+        Cx[j] = C[0], Cy[j] = C[1], Cz[j] = C[2];
+        h2[j] = (double)h[0] * h[0] + (double)h[1] * h[1] + (double)h[2] * h[2];
+        m2[j] = (double)rk->M[0] * rk->M[0] + (double)rk->M[1] * rk->M[1] + (double)rk->M[2] * rk->M[2];
+    }
+#pragma GCC unroll 1
+    for (int j = 0; j < BATCH; j++) {
+        const double X = Cx[j], Y = Cy[j], Z = Cz[j];
+#define DOT(w) ((w)[0] * X + (w)[1] * Y + (w)[2] * Z)
+        /* the test's sphere (rt_rocks.c rock_hit: 1.01 in its square), and more */
+        const double r_m = 1.01 * sqrt(h2[j] / m2[j]) + 1e-6 * sqrt(X * X + Y * Y + Z * Z), ga = DOT(c);
+        const double lo_s = ga - r_m * cn, r2 = r_m * r_m, D = ga * ga - r2 * cc;
+        /* the image spans along u and v: the roots of the tangent planes' quadratics */
+        const double au = DOT(u), Bu = au * ga - r2 * uc, du = Bu * Bu - D * (au * au - r2 * uu);
+        const double av = DOT(v), Bv = av * ga - r2 * vc, dv = Bv * Bv - D * (av * av - r2 * vv);
+#undef DOT
+        const double su = sqrt(du > 0 ? du : 0), sv = sqrt(dv > 0 ? dv : 0);
+        /* pixels a sample of which can fall in the spans padded by pad
+         * (pixel centres at integers, samples within half a pixel) */
+        const double x0 = ceil((Bu - su) / D - pad - 0.5), x1 = floor((Bu + su) / D + pad + 0.5),
+                     y0 = ceil((Bv - sv) / D - pad - 0.5), y1 = floor((Bv + sv) / D + pad + 0.5);
+        const int in = (x0 <= x1) & (x0 <= W) & (x1 >= 0) & (y0 <= y1) & (y0 <= H) & (y1 >= 0);
+        const int behind = ga + r_m * cn <= 0, straddle = !behind & (lo_s <= 1e-9 * r_m * cn);
+        st[j] = (!live[j]) | behind ? 0 : straddle ? -1 : in;
+        /* clipped to the image (a NaN to its edge: it is not listed) before the conversions */
+        const double xa = x0 < W ? x0 : W, xb = x1 < W ? x1 : W, ya = y0 < H ? y0 : H, yb = y1 < H ? y1 : H;
+        px[0][j] = (int)(xa > 0 ? xa : 0);
+        px[1][j] = (int)(xb > 0 ? xb : 0);
+        px[2][j] = (int)(ya > 0 ? ya : 0);
+        px[3][j] = (int)(yb > 0 ? yb : 0);
+        s_near[j] = (float)(lo_s * (1 - 1e-6));
+    }
 }
 
 static size_t part_begin(size_t n, int p, int nparts) { return n * (size_t)p / (size_t)nparts; }
@@ -91,7 +91,7 @@ static size_t part_begin(size_t n, int p, int nparts) { return n * (size_t)p / (
 enum { PHASE_COUNT, PHASE_FILL };
 
 /* Part p's rocks: counted into its blocks, or entered at its cursors. */
-static void part(struct nc__rock_bins *rb, int p)
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void part(struct nc__rock_bins *rb, int p)
 {
     const size_t total = rb->tile_first[rb->ntiles], g0 = part_begin(total, p, rb->nparts),
                  g1 = part_begin(total, p + 1, rb->nparts);
@@ -100,38 +100,46 @@ static void part(struct nc__rock_bins *rb, int p)
     size_t k = 0;
     while (k + 1 < rb->ntiles && rb->tile_first[k + 1] <= g0)
         k++;
-    for (size_t g = g0; g < g1; g++) {
+    for (size_t g = g0; g < g1;) {
         while (g >= rb->tile_first[k + 1])
             k++;
         if (!rb->tile[k]->enabled) { /* an octave wholly below the cut */
-            g = rb->tile_first[k + 1] - 1;
+            g = rb->tile_first[k + 1];
             continue;
         }
-        const size_t prim = g - rb->tile_first[k];
-        int px[4];
-        float s_near;
-        const int rc = rock_pixels(rb, k, prim, px, &s_near);
-        if (rc < 0) {
-            atomic_store(&rb->straddle, 1);
-            return;
-        }
-        if (!rc)
-            continue;
-        for (int by = px[2] / NC_BINS_BLOCK; by <= px[3] / NC_BINS_BLOCK; by++)
-            for (int bx = px[0] / NC_BINS_BLOCK; bx <= px[1] / NC_BINS_BLOCK; bx++) {
-                uint32_t *c = &cnt[(size_t)by * (size_t)bw + (size_t)bx];
-                if (rb->phase == PHASE_COUNT) {
-                    ++*c;
-                    continue;
-                }
-                const int x0 = px[0] > bx * 4 ? px[0] - bx * 4 : 0, x1 = px[1] < bx * 4 + 3 ? px[1] - bx * 4 : 3;
-                const int y0 = px[2] > by * 4 ? px[2] - by * 4 : 0, y1 = px[3] < by * 4 + 3 ? px[3] - by * 4 : 3;
-                const unsigned row = (2u << x1) - (1u << x0);
-                unsigned lanes = 0;
-                for (int y = y0; y <= y1; y++)
-                    lanes |= row << 4 * y;
-                rb->list[(*c)++] = (struct nc__rock_entry){(uint32_t)prim, (uint16_t)k, (uint16_t)lanes, s_near};
+        /* a batch within the tile and the part */
+        const size_t prim0 = g - rb->tile_first[k], end = rb->tile_first[k + 1] < g1 ? rb->tile_first[k + 1] : g1;
+        const int n = end - g < BATCH ? (int)(end - g) : BATCH;
+        int px[4][BATCH], st[BATCH];
+        float s_near[BATCH];
+        rock_pixels(rb, k, prim0, n, px, s_near, st);
+        g += (size_t)n;
+        for (int j = 0; j < n; j++) {
+            if (st[j] < 0) {
+                atomic_store(&rb->straddle, 1);
+                return;
             }
+            if (!st[j])
+                continue;
+            for (int by = px[2][j] / NC_BINS_BLOCK; by <= px[3][j] / NC_BINS_BLOCK; by++)
+                for (int bx = px[0][j] / NC_BINS_BLOCK; bx <= px[1][j] / NC_BINS_BLOCK; bx++) {
+                    uint32_t *c = &cnt[(size_t)by * (size_t)bw + (size_t)bx];
+                    if (rb->phase == PHASE_COUNT) {
+                        ++*c;
+                        continue;
+                    }
+                    const int x0 = px[0][j] > bx * 4 ? px[0][j] - bx * 4 : 0,
+                              x1 = px[1][j] < bx * 4 + 3 ? px[1][j] - bx * 4 : 3;
+                    const int y0 = px[2][j] > by * 4 ? px[2][j] - by * 4 : 0,
+                              y1 = px[3][j] < by * 4 + 3 ? px[3][j] - by * 4 : 3;
+                    const unsigned row = (2u << x1) - (1u << x0);
+                    unsigned lanes = 0;
+                    for (int y = y0; y <= y1; y++)
+                        lanes |= row << 4 * y;
+                    rb->list[(*c)++] =
+                        (struct nc__rock_entry){(uint32_t)(prim0 + (size_t)j), (uint16_t)k, (uint16_t)lanes, s_near[j]};
+                }
+        }
     }
 }
 
