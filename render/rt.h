@@ -1,6 +1,6 @@
 /* rt.h - ray-tracing back-end interface (implemented with Embree 3 in
- * rt_embree.c and, for boulders, rt_rocks.c: the only files that include
- * Embree headers).
+ * rt_embree.c and, for boulders, rt_rocks.c, rt_rocks_build.c and
+ * rt_rock_mesh.c: the only files that include Embree headers).
  *
  * Rays live in the camera-relative scene frame: origin at the camera position,
  * axes of the scene frame. Each body is an instance whose geometry is stored

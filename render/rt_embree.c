@@ -1,8 +1,8 @@
 /* rt_embree.c - the Embree 3 back-end: device, per-body scenes, instances,
  * the exact analytic ellipsoid as user geometry, and packet tracing.
  *
- * Every Embree call in NavCam is in this file or rt_rocks.c (Embree 4
- * changes the API).
+ * Every Embree call in NavCam is in this file or the rocks' (rt_rocks.c,
+ * rt_rocks_build.c, rt_rock_mesh.c; Embree 4 changes the API).
  * Nothing here knows about reflectance, cameras or images.
  */
 #include "render/rt.h"

@@ -124,6 +124,10 @@ struct nc__rt_lanes {
 unsigned nc__rt_rock_lanes(const struct nc__rt_rock_tile *tl, unsigned prim, const struct nc__rt_lanes *p, float *t,
                            float (*n)[3], int *detailed);
 
+/* The rocks' bounds, intersection and occlusion callbacks on tile geometry g
+ * (its user data the tile). */
+void nc__rt_rock_callbacks(RTCGeometry g);
+
 /* The tiles of field f, every rock traced until the first cut. */
 int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc__rt_rocks *r);
 /* Each tile's instances, attached to top (tile[k].inst_id) and under the
