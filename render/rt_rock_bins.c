@@ -227,10 +227,9 @@ int nc__rock_bins_build(struct nc__rock_bins *rb, const struct nc__bins *view, s
 }
 
 /* The lanes of the group's packets (bit 16 q + i: lane i of packet q) of
- * those in m that reach s_near, or that pass within sqrt(r2) of the rock's
- * centre (rel: the rays' origin from it; d the directions in its body's
- * frame). A packet at a time: 16-lane loops the compiler vectorises (the
- * clones' registers). */
+ * those in m whose closest hit so far reaches s_near. A packet at a time:
+ * 16-lane loops the compiler vectorises (the clones' registers), as in
+ * lanes_box. */
 static inline __attribute__((always_inline)) uint64_t lanes_near(const float *s_far, float s_near, uint64_t m)
 {
     for (int q = 0; q < NC_BINS_GROUP; q++) {
@@ -245,22 +244,39 @@ static inline __attribute__((always_inline)) uint64_t lanes_near(const float *s_
     return m;
 }
 
-static inline __attribute__((always_inline)) uint64_t lanes_pass(const float (*d)[NC_ROCK_BINS_LANES],
-                                                                 const float *rel, float r2, uint64_t m)
+/* Of the lanes m, those whose ray (d: the directions in the rock's body's
+ * frame) can meet the rock's box [lo, hi] (its frame, padded) in front of
+ * the origin and before t, the lane's closest hit so far: ol the rays'
+ * origin in the rock's frame, M the record's body -> rock map (rock_hit's).
+ * The box holds the rock (its shape lies within half), a tighter bound than
+ * rock_hit's first sphere: about half the lanes that pass the sphere miss
+ * the box. A lane whose direction has a zero component along an axis, or
+ * whose slabs give a NaN, passes. */
+static inline __attribute__((always_inline)) uint64_t lanes_box(const float (*d)[NC_ROCK_BINS_LANES], const float *ol,
+                                                                const float *M, const float *lo, const float *hi,
+                                                                const float *t, uint64_t m)
 {
     for (int q = 0; q < NC_BINS_GROUP; q++) {
         if (!(m >> NC_PACKET * q & 0xffff))
             continue;
-        unsigned pass = 0;
+        unsigned miss = 0;
         const float *dx = d[0] + NC_PACKET * q, *dy = d[1] + NC_PACKET * q, *dz = d[2] + NC_PACKET * q;
+        const float *tq = t + NC_PACKET * q;
 #pragma GCC unroll 1
         for (int i = 0; i < NC_PACKET; i++) {
-            const float tc = -(rel[0] * dx[i] + rel[1] * dy[i] + rel[2] * dz[i]) /
-                             (dx[i] * dx[i] + dy[i] * dy[i] + dz[i] * dz[i]);
-            const float qx = rel[0] + tc * dx[i], qy = rel[1] + tc * dy[i], qz = rel[2] + tc * dz[i];
-            pass |= (unsigned)(qx * qx + qy * qy + qz * qz <= r2) << i;
+            float enter = -INFINITY, leave = INFINITY;
+            int zero = 0;
+            for (int a = 0; a < 3; a++) {
+                const float dl = M[3 * a] * dx[i] + M[3 * a + 1] * dy[i] + M[3 * a + 2] * dz[i];
+                const float t0 = (lo[a] - ol[a]) / dl, t1 = (hi[a] - ol[a]) / dl;
+                const float tn = t0 < t1 ? t0 : t1, tf = t0 < t1 ? t1 : t0;
+                enter = tn > enter ? tn : enter;
+                leave = tf < leave ? tf : leave;
+                zero |= !(dl != 0) | (t0 != t0) | (t1 != t1);
+            }
+            miss |= (unsigned)((!zero) & ((leave < enter) | (leave < 0) | (enter > tq[i]))) << i;
         }
-        m &= ~((uint64_t)(~pass & 0xffff) << NC_PACKET * q);
+        m &= ~((uint64_t)(miss & 0xffff) << NC_PACKET * q);
     }
     return m;
 }
@@ -345,17 +361,23 @@ nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const 
                 }
             have |= 1u << body;
         }
-        /* the lanes that pass near enough its centre (rt_rocks.c's first
-         * test, on the whole group at once) */
+        /* the lanes whose ray meets its box before their closest hit so far
+         * (padded for the float transforms: 1 % of the rock and 1e-6 of its distance) */
         const struct nc__rt_rock *rk = &tl->rec[en->prim];
         const float *hf = tl->rocks->field->shape[rk->shape].half;
         const float m2 = rk->M[0] * rk->M[0] + rk->M[1] * rk->M[1] + rk->M[2] * rk->M[2];
-        const float r2 = 1.02f * (hf[0] * hf[0] + hf[1] * hf[1] + hf[2] * hf[2]) / m2;
-        float rel[3];
+        float rel[3], ol[3], lo[3], hi[3];
         for (int j = 0; j < 3; j++)
             rel[j] = tl->cam_m[j] + rb->o_body[body][j] - rk->c[j];
-        if ((m = lanes_pass(d[body], rel, r2, m)))
-            entry_test(rb, en, body, m, d[body], tnear, sd, h, s_far);
+        const float pad = 0.01f + 1e-6f * sqrtf((rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]) * m2);
+        for (int a = 0; a < 3; a++) {
+            ol[a] = rk->M[3 * a] * rel[0] + rk->M[3 * a + 1] * rel[1] + rk->M[3 * a + 2] * rel[2];
+            lo[a] = -hf[a] - pad;
+            hi[a] = hf[a] + pad;
+        }
+        if (!(m = lanes_box(d[body], ol, rk->M, lo, hi, h->t, m)))
+            continue;
+        entry_test(rb, en, body, m, d[body], tnear, sd, h, s_far);
     }
 }
 

@@ -4,7 +4,8 @@
  * the pixels of the block it can reach and the nearest depth of its
  * sphere; a packet of camera rays is tested against its block's list
  * alone, with the rocks' own test (nc__rt_rock_lanes) on the lanes the
- * entry names whose ray reaches that depth: no tree of tiles to walk. The
+ * entry names whose ray reaches that depth and meets the rock's box before
+ * its closest hit so far: no tree of tiles to walk. The
  * lists are conservative (the sphere's image is bounded exactly, padded
  * for the float rays); a sphere across the plane through the rays' origin
  * parallel to the image has no bounded image, and the lists then cannot
