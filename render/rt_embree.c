@@ -790,7 +790,8 @@ static void rocks_over(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
     }
 }
 
-/* The same through the rocks' bins (the block at (px0, py0)). */
+/* The same for the npk packets of the block at (px0, py0), through the
+ * rocks' bins. */
 static void rocks_binned(struct nc_rt *rt, int px0, int py0, const struct nc_ray16 *ray, struct nc_hit16 *hit, int npk)
 {
     struct nc__rock_bins_hits h;

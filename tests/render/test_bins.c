@@ -4,7 +4,9 @@
  * grid whose lines run through the pixel centres (no ray slips between
  * triangles), the AVX-512 and plain tests and list builds bit for bit, clusters of
  * triangles skipped whole without changing the lists, the cases the bins
- * refuse, and whole frames. */
+ * refuse, and whole frames; with boulders, the rocks' bins against
+ * Embree's trees, and a block's packets through them together and one at
+ * a time bit for bit. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
