@@ -681,9 +681,10 @@ static void trace_camera(const struct job *j, int px0, int py0, const struct nc_
     if (j->bins) { /* a pinhole at rest: the block's own triangles */
         for (int q = 0; q < ns && j->r->ray_hook; q++)
             j->r->ray_hook(j->r->ray_hook_user, 0, &ray[q]);
-        for (int q = 0; q < ns && j->r->one_sample_packets; q++)
-            nc_rt_intersect_block(j->rt, px0, py0, &ray[q], &hit[q], 1);
-        if (!j->r->one_sample_packets)
+        if (j->r->one_sample_packets)
+            for (int q = 0; q < ns; q++)
+                nc_rt_intersect_block(j->rt, px0, py0, &ray[q], &hit[q], 1);
+        else
             nc_rt_intersect_block(j->rt, px0, py0, ray, hit, ns);
         return;
     }

@@ -836,8 +836,9 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
             }
         if (rt->rocks_on && rt->rock_binned)
             rocks_binned(rt, px0, py0, ray + q0, hit + q0, m);
-        for (int q = 0; q < m && rt->rocks_on && !rt->rock_binned; q++)
-            rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
+        else if (rt->rocks_on)
+            for (int q = 0; q < m; q++)
+                rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
     }
 }
 

@@ -41,7 +41,7 @@ rock_pixels(const struct nc__rock_bins *rb, size_t k, size_t prim0, int n, int (
     const struct nc__rt_rocks *r = tl->rocks;
     const float *R = rb->rot[rb->tile_body[k]];
     const double *u = rb->view->Mi[0], *v = rb->view->Mi[1], *c = rb->view->Mi[2], pad = rb->view->pad_px;
-    const double cn = sqrt(dot3(c, c)), cc = dot3(c, c), uc = dot3(u, c), uu = dot3(u, u), vc = dot3(v, c),
+    const double cc = dot3(c, c), cn = sqrt(cc), uc = dot3(u, c), uu = dot3(u, u), vc = dot3(v, c),
                  vv = dot3(v, v), W = rb->view->bw * NC_BINS_BLOCK - 1, H = rb->view->bh * NC_BINS_BLOCK - 1;
     double Cx[BATCH], Cy[BATCH], Cz[BATCH], h2[BATCH], m2[BATCH];
     int live[BATCH];
@@ -288,6 +288,9 @@ static void entry_test(const struct nc__rock_bins *rb, const struct nc__rock_ent
                        struct nc__rock_bins_hits *h, float *s_far)
 {
     const struct nc__rt_rock_tile *tl = rb->tile[en->tile];
+    float o[3]; /* the rays' origin in the tile's frame */
+    for (int j = 0; j < 3; j++)
+        o[j] = tl->cam_m[j] + rb->o_body[body][j];
     while (m) {
         struct nc__rt_lanes p;
         int lane[NC__RT_LANES], nl = 0;
@@ -296,7 +299,7 @@ static void entry_test(const struct nc__rock_bins *rb, const struct nc__rock_ent
         for (int l = 0; l < NC__RT_LANES; l++) {
             const int i = lane[l < nl ? l : 0];
             for (int j = 0; j < 3; j++) {
-                p.o[j][l] = tl->cam_m[j] + rb->o_body[body][j];
+                p.o[j][l] = o[j];
                 p.d[j][l] = d[j][i];
             }
             p.tnear[l] = tnear[i];
@@ -319,6 +322,12 @@ static void entry_test(const struct nc__rock_bins *rb, const struct nc__rock_ent
     }
 }
 
+/* The packet of the group's lane i (lanes past npk's packets read packet 0; they are off). */
+static inline const struct nc_ray16 *lane_ray(const struct nc_ray16 *ray, int npk, int i)
+{
+    return &ray[i / NC_PACKET < npk ? i / NC_PACKET : 0];
+}
+
 __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void
 nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const struct nc_ray16 *ray, int npk,
                         struct nc__rock_bins_hits *h)
@@ -333,7 +342,7 @@ nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const 
     float sd[NC_ROCK_BINS_LANES], s_far[NC_ROCK_BINS_LANES], tnear[NC_ROCK_BINS_LANES];
     uint64_t on = 0;
     for (int i = 0; i < NC_ROCK_BINS_LANES; i++) {
-        const struct nc_ray16 *r = &ray[i / NC_PACKET < npk ? i / NC_PACKET : 0];
+        const struct nc_ray16 *r = lane_ray(ray, npk, i);
         const int l = i % NC_PACKET;
         sd[i] = rb->s_of[0] * r->dx[l] + rb->s_of[1] * r->dy[l] + rb->s_of[2] * r->dz[l];
         s_far[i] = h->t[i] * sd[i];
@@ -355,7 +364,7 @@ nc__rock_bins_intersect(const struct nc__rock_bins *rb, int px0, int py0, const 
             const float *R = rb->rot[body];
             for (int j = 0; j < 3; j++)
                 for (int i = 0; i < NC_ROCK_BINS_LANES; i++) {
-                    const struct nc_ray16 *r = &ray[i / NC_PACKET < npk ? i / NC_PACKET : 0];
+                    const struct nc_ray16 *r = lane_ray(ray, npk, i);
                     const int l = i % NC_PACKET;
                     d[body][j][i] = R[j] * r->dx[l] + R[3 + j] * r->dy[l] + R[6 + j] * r->dz[l];
                 }
