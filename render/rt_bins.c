@@ -75,8 +75,8 @@ test_list_avx512(const struct nc__bins_tri *restrict cand, const uint32_t *restr
     }
     const __m512 zero = _mm512_setzero_ps();
     for (uint32_t k = 0; k < n; k++) {
-        if (k + 2 < n) /* candidates are scattered: fetch ahead */
-            _mm_prefetch((const char *)&cand[list[k + 2]], _MM_HINT_T0);
+        if (k + 6 < n) /* candidates are scattered: fetch ahead (6 gained 1 % over 2 on the crop) */
+            _mm_prefetch((const char *)&cand[list[k + 6]], _MM_HINT_T0);
         const struct nc__bins_tri *c = &cand[list[k]];
         const __m512 a0 = _mm512_set1_ps(c->e[0][0]), a1 = _mm512_set1_ps(c->e[0][1]), a2 = _mm512_set1_ps(c->e[0][2]);
         const __m512 b0 = _mm512_set1_ps(c->e[1][0]), b1 = _mm512_set1_ps(c->e[1][1]), b2 = _mm512_set1_ps(c->e[1][2]);

@@ -900,10 +900,10 @@ static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct
     return 1;
 }
 
-int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked)
+/* proven_lit lane by lane: proven[i] = -1 where proven; returns how many. */
+static int proven_lanes(const struct nc_rt *rt, const struct nc_ray16 *ray, const int *from, int *proven)
 {
-    int culled = 0, proven[NC_PACKET] = {0};
-    int last = -1, ok = 0; /* the direction test, redone when body or direction changes */
+    int culled = 0, last = -1, ok = 0; /* the direction test, redone when body or direction changes */
     float ld[3] = {0, 0, 0};
     for (int i = 0; i < NC_PACKET; i++) {
         if (ray->valid[i] && from[i] >= 0) {
@@ -919,6 +919,34 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from,
             if (proven_lit(rt, from[i], ok, ray, i))
                 proven[i] = -1, culled++;
         }
+    }
+    return culled;
+}
+
+int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked)
+{
+    int culled = 0, proven[NC_PACKET] = {0};
+    /* One mesh body and one direction (hard shadows): proven_lit for the
+     * whole packet in one grid query. */
+    int want[NC_PACKET], f = -1, alike = rt->nbodies == 1;
+    for (int i = 0; i < NC_PACKET; i++) {
+        want[i] = ray->valid[i] && from[i] >= 0;
+        if (want[i] && f < 0)
+            f = i;
+        else if (want[i])
+            alike &= ray->dx[i] == ray->dx[f] && ray->dy[i] == ray->dy[f] && ray->dz[i] == ray->dz[f];
+    }
+    if (f < 0)
+        return 0;
+    const struct rt_body *b = &rt->body[from[f]];
+    if (alike && !b->analytic) {
+        if (b->grid_level == b->level &&
+            nc_shadow_grid_dir_ok(b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(nc_v3(ray->dx[f], ray->dy[f], ray->dz[f])))))
+            nc_shadow_grid_lit16(b->grid, b->grid_axis, b->grid_off, ray->ox, ray->oy, ray->oz, want, proven);
+        for (int i = 0; i < NC_PACKET; i++)
+            culled -= proven[i];
+    } else {
+        culled = proven_lanes(rt, ray, from, proven);
     }
     if (culled && rt->rocks_on) {
         /* Clear of every mesh, but rocks may stand in the way: the proven

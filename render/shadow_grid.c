@@ -4,6 +4,7 @@
 #include "render/shadow_grid.h"
 
 #include <errno.h>
+#include <immintrin.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -149,6 +150,61 @@ int nc_shadow_grid_lit(const struct nc_shadow_grid *g, struct nc_vec3 p, struct 
 {
     return nc_shadow_grid_dir_ok(g, d) &&
            nc_shadow_grid_lit_at(g, nc_v3_dot(p, g->u), nc_v3_dot(p, g->v), nc_v3_dot(p, g->sun));
+}
+
+/* Point i of nc_shadow_grid_lit16. */
+static inline int lit_one(const struct nc_shadow_grid *g, const struct nc_vec3 axis[3], const double off[3], double px,
+                          double py, double pz)
+{
+    const double pu = px * axis[0].x + py * axis[0].y + pz * axis[0].z - off[0];
+    const double pv = px * axis[1].x + py * axis[1].y + pz * axis[1].z - off[1];
+    const double ph = px * axis[2].x + py * axis[2].y + pz * axis[2].z - off[2];
+    return nc_shadow_grid_lit_at(g, pu, pv, ph);
+}
+
+/* Eight points of nc_shadow_grid_lit16 in AVX-512 registers, their cells
+ * read by one gather (the scalar reads wait on memory one after another):
+ * the same operations in the same order, so the same answers. */
+__attribute__((target("avx512f,avx512vl"))) static __mmask8 lit8_avx512(const struct nc_shadow_grid *g,
+                                                                const struct nc_vec3 axis[3], const double off[3],
+                                                                const float *x, const float *y, const float *z)
+{
+    typedef __m512d V;
+    const V px = _mm512_cvtps_pd(_mm256_loadu_ps(x)), py = _mm512_cvtps_pd(_mm256_loadu_ps(y)),
+            pz = _mm512_cvtps_pd(_mm256_loadu_ps(z));
+    V c[3];
+    for (int k = 0; k < 3; k++) {
+        V t = _mm512_add_pd(_mm512_mul_pd(px, _mm512_set1_pd(axis[k].x)), _mm512_mul_pd(py, _mm512_set1_pd(axis[k].y)));
+        t = _mm512_add_pd(t, _mm512_mul_pd(pz, _mm512_set1_pd(axis[k].z)));
+        c[k] = _mm512_sub_pd(t, _mm512_set1_pd(off[k]));
+    }
+    const V cell = _mm512_set1_pd(g->cell_m), n = _mm512_set1_pd(g->n), zero = _mm512_setzero_pd();
+    const V a = _mm512_div_pd(_mm512_sub_pd(c[0], _mm512_set1_pd(g->u0)), cell),
+            b = _mm512_div_pd(_mm512_sub_pd(c[1], _mm512_set1_pd(g->v0)), cell);
+    __mmask8 in = _mm512_cmp_pd_mask(a, zero, _CMP_GE_OQ);
+    in = _mm512_mask_cmp_pd_mask(in, b, zero, _CMP_GE_OQ);
+    in = _mm512_mask_cmp_pd_mask(in, a, n, _CMP_LT_OQ);
+    in = _mm512_mask_cmp_pd_mask(in, b, n, _CMP_LT_OQ);
+    const __m256i k = _mm256_add_epi32(_mm256_mullo_epi32(_mm512_cvttpd_epi32(b), _mm256_set1_epi32(g->n)),
+                                       _mm512_cvttpd_epi32(a));
+    const __m256 h = _mm256_mmask_i32gather_ps(_mm256_setzero_ps(), in, k, g->hmax, 4);
+    const __mmask8 above = _mm512_mask_cmp_pd_mask(in, c[2], _mm512_cvtps_pd(h), _CMP_GT_OQ);
+    __mmask8 beyond = _mm512_cmp_pd_mask(a, a, _CMP_ORD_Q) & _mm512_cmp_pd_mask(b, b, _CMP_ORD_Q) &
+                      _mm512_cmp_pd_mask(c[2], c[2], _CMP_ORD_Q);
+    return above | (beyond & (__mmask8)~in);
+}
+
+void nc_shadow_grid_lit16(const struct nc_shadow_grid *g, const struct nc_vec3 axis[3], const double off[3],
+                          const float *x, const float *y, const float *z, const int *want, int *lit)
+{
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")) {
+        const unsigned m = lit8_avx512(g, axis, off, x, y, z) | (unsigned)lit8_avx512(g, axis, off, x + 8, y + 8, z + 8) << 8;
+        for (int i = 0; i < 16; i++)
+            lit[i] = want[i] && (m >> i & 1) ? -1 : 0;
+        return;
+    }
+    for (int i = 0; i < 16; i++)
+        lit[i] = want[i] && lit_one(g, axis, off, x[i], y[i], z[i]) ? -1 : 0;
 }
 
 void nc_shadow_grid_free(struct nc_shadow_grid *g)

@@ -62,6 +62,51 @@ static void check_closed(const struct nc_mesh *m)
     free(t);
 }
 
+/* The grid's 16-point query (nc_shadow_grid_lit16; AVX-512 where the CPU
+ * has it) against the two steps one point at a time, as the renderer asks
+ * them: float points of a turned and shifted frame, inside and around the
+ * body, beyond the grid and NaN, some lanes not wanted. */
+static void check_lit16(const struct nc_shadow_grid *g, double R, const char *what)
+{
+    const struct nc_quat q0 = {0.9, -0.2, 0.3, 0.25};
+    const double qn = nc_quat_norm(q0);
+    const struct nc_mat3 rot = nc_quat_to_mat((struct nc_quat){q0.w / qn, q0.x / qn, q0.y / qn, q0.z / qn});
+    const struct nc_vec3 O = nc_v3(-812.5, 4031.25, 97.0), ax[3] = {g->u, g->v, g->sun};
+    struct nc_vec3 axis[3];
+    double off[3];
+    for (int k = 0; k < 3; k++) {
+        axis[k] = nc_mat_mul_v(&rot, ax[k]);
+        off[k] = nc_v3_dot(O, axis[k]);
+    }
+    unsigned seed = 777;
+    int differ = 0, lit = 0, n = 0;
+    for (int batch = 0; batch < 4096; batch++) {
+        float x[16], y[16], z[16];
+        int want[16], got[16];
+        for (int i = 0; i < 16; i++) {
+            double c[3];
+            for (int k = 0; k < 3; k++)
+                c[k] = 2.6 * R * ((seed = seed * 1103515245u + 12345u) / 4294967296.0 - 0.5);
+            const struct nc_vec3 q = nc_v3_add(nc_mat_mul_v(&rot, nc_v3(c[0], c[1], c[2])), O);
+            x[i] = (float)q.x, y[i] = (float)q.y, z[i] = (float)q.z;
+            if (batch % 7 == 0 && i == 3)
+                y[i] = NAN;
+            want[i] = (seed >> 20) % 8 != 0;
+        }
+        nc_shadow_grid_lit16(g, axis, off, x, y, z, want, got);
+        for (int i = 0; i < 16; i++) {
+            const struct nc_vec3 o = nc_v3(x[i], y[i], z[i]);
+            const int one = want[i] && nc_shadow_grid_lit_at(g, nc_v3_dot(o, axis[0]) - off[0],
+                                                             nc_v3_dot(o, axis[1]) - off[1], nc_v3_dot(o, axis[2]) - off[2]);
+            differ += (got[i] != 0) != one || (got[i] != 0 && got[i] != -1);
+            lit += one;
+            n++;
+        }
+    }
+    CHECK(differ == 0 && lit > n / 10 && lit < n - n / 10, "%s: 16-point query differs at %d of %d points (%d lit)", what,
+          differ, n, lit);
+}
+
 /* Every sunlit face's centroid and one random point, just off the surface
  * as the renderer starts its shadow rays: whatever the grid proves lit must
  * be unblocked, and most of the unblocked must be proven. The rays leave
@@ -104,6 +149,7 @@ static void check_proof(const struct nc_mesh *m, struct nc_vec3 sun, double tol_
      * renderer's tolerance, the least with the Sun at 2.6 deg over the
      * equator, where the crater walls make the most terminator. */
     CHECK(proven >= (tol_rad < 1e-3 ? 0.8 : 0.5) * unblocked, "%s: only %d of %d unshadowed points proven", what, proven, unblocked);
+    check_lit16(&g, R, what);
     nc_shadow_grid_free(&g);
 }
 
