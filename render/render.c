@@ -198,6 +198,7 @@ struct job {
     uint64_t path_seed;          /* the bounce directions' stream */
     int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
     int bins; /* camera rays through nc_rt_intersect_block (a pinhole at rest over meshes) */
+    int plain; /* meshes only, no albedo maps, the Sun at infinity: surface16's lanes without exceptions */
 };
 
 /* Whether any ray of the 4x4 pixel block at (px0, py0) can reach a body's
@@ -280,12 +281,41 @@ static inline void unit_lane(double x, double y, double z, double (*u)[NC_PACKET
 }
 
 /* The unit facet normals of a packet's hits (zero where a lane missed), in
- * AVX2 where the CPU has it (no FMA: the same bits as plain code). */
-__attribute__((target_clones("avx2", "default"))) static void unit_normals(const struct nc_hit16 *hit,
+ * AVX-512 or AVX2 where the CPU has it (this file is compiled without
+ * contraction: the same bits as plain code). */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void unit_normals(const struct nc_hit16 *hit,
                                                                              double (*un)[NC_PACKET])
 {
     for (int i = 0; i < NC_PACKET; i++)
         unit_lane(hit->nx[i], hit->ny[i], hit->nz[i], un, i);
+}
+
+/* surface16 where j->plain holds, in one branch-free loop (AVX-512 or AVX2
+ * where the CPU has it, without contraction: the same bits as the loop lane
+ * by lane). A missed lane gets body -1 and values never read. */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void plain_lanes(const struct job *j,
+                                                                          const struct nc_hit16 *hit,
+                                                                          const struct nc_vec3 *orig,
+                                                                          const struct nc_vec3 *dir,
+                                                                          const double (*un)[NC_PACKET], struct surf *s)
+{
+    for (int i = 0; i < NC_PACKET; i++) {
+        const struct nc_vec3 d = dir[i];
+        const double t = hit->t[i];
+        struct nc_vec3 nrm = nc_v3(un[0][i], un[1][i], un[2][i]);
+        const int outside = nc_v3_dot(nrm, d) <= 0;
+        const double flip = outside ? 1.0 : -1.0; /* as nc_v3_scale(nrm, -1.0) */
+        nrm = nc_v3(nrm.x * flip, nrm.y * flip, nrm.z * flip);
+        s->body[i] = hit->body[i];
+        s->outside[i] = outside;
+        s->t[i] = t;
+        s->p[i] = nc_v3_add(orig[i], nc_v3_scale(d, t));
+        s->n[i] = nrm;
+        s->d[i] = d;
+        s->sdir[i] = j->sun_dir;
+        s->irr[i] = j->sun_irr;
+        s->factor[i] = hit->albedo[i];
+    }
 }
 
 /* Fill s from a packet's hits, for rays from orig along the unit dir. */
@@ -295,6 +325,10 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
     const struct nc_scene *sc = j->s;
     double un[3][NC_PACKET];
     unit_normals(hit, un);
+    if (j->plain) {
+        plain_lanes(j, hit, orig, dir, (const double(*)[NC_PACKET])un, s);
+        return;
+    }
     for (int i = 0; i < NC_PACKET; i++) {
         s->body[i] = hit->body[i];
         if (hit->body[i] < 0)
@@ -386,6 +420,37 @@ static void unoccluded16(struct job *j, struct nc_ray16 *shadow, const int *from
  * path vertex (0: the camera ray's), which key the solar disk's points.
  * r_hard (NULL: not wanted): the same with the shadow ray aimed at the
  * Sun's centre (hard shadows), r itself when shadows are hard. */
+/* sunlight16's lanes for the camera rays' points with hard shadows, in one
+ * branch-free loop (AVX-512 or AVX2 where the CPU has it, without
+ * contraction: the same bits as the loop lane by lane): a lane with no point, or facing away from the Sun or
+ * the camera, gets lit 0 and an invalid ray (its other fields unused).
+ * Returns how many are lit. */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static int hard_lanes(const struct surf *s,
+                                                                         struct nc_photometry *geo,
+                                                                         struct nc_ray16 *shadow, int *from, int *lit)
+{
+    int any = 0;
+    for (int i = 0; i < NC_PACKET; i++) {
+        const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i], p = s->p[i];
+        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->t[i];
+        const int on = (s->body[i] >= 0) & (mu0 > 0) & (mu > 0);
+        geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, d), s->factor[i]};
+        shadow->ox[i] = (float)(p.x + eps * nrm.x);
+        shadow->oy[i] = (float)(p.y + eps * nrm.y);
+        shadow->oz[i] = (float)(p.z + eps * nrm.z);
+        shadow->dx[i] = (float)sdir.x;
+        shadow->dy[i] = (float)sdir.y;
+        shadow->dz[i] = (float)sdir.z;
+        shadow->tnear[i] = 0.0f;
+        shadow->tfar[i] = INFINITY;
+        shadow->valid[i] = on ? -1 : 0;
+        from[i] = on & s->outside[i] ? s->body[i] : -1; /* the ray leaves the outer side: n . s = mu0 > 0 */
+        lit[i] = on;
+        any += on;
+    }
+    return any;
+}
+
 static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, int sidx, int depth, double *r,
                        double *r_hard, struct tile_counts *cnt)
 {
@@ -396,59 +461,65 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
     const int twin = r_hard && j->sun_tan_radius > 0;
     const uint64_t disk_seed = depth ? mix64(j->disk_seed + (uint64_t)depth) : j->disk_seed;
     for (int i = 0; i < NC_PACKET; i++) {
-        shadow.valid[i] = lit[i] = 0;
-        from[i] = -1;
         r[i] = 0;
         if (r_hard)
             r_hard[i] = 0;
-        if (s->body[i] < 0)
-            continue;
-        struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i];
-        double mu = -nc_v3_dot(nrm, s->d[i]), mu0 = nc_v3_dot(nrm, sdir);
-        if (!(mu0 > 0 && mu > 0))
-            continue;
-        geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, s->d[i]), s->factor[i]};
-        /* Offset the origin off the surface by a few float ulps of the
-         * camera-relative coordinates (a bounce's t can be far shorter than
-         * the point's distance from the camera); tnear stays 0. */
-        double eps = 4e-6 * (depth ? fmax(s->t[i], nc_v3_norm(s->p[i])) : s->t[i]);
-        struct nc_vec3 p = s->p[i];
-        shadow.ox[i] = (float)(p.x + eps * nrm.x);
-        shadow.oy[i] = (float)(p.y + eps * nrm.y);
-        shadow.oz[i] = (float)(p.z + eps * nrm.z);
-        struct nc_vec3 sray = sdir;
-        if (twin) {
-            centre.ox[i] = shadow.ox[i];
-            centre.oy[i] = shadow.oy[i];
-            centre.oz[i] = shadow.oz[i];
-            centre.dx[i] = (float)sdir.x;
-            centre.dy[i] = (float)sdir.y;
-            centre.dz[i] = (float)sdir.z;
-            centre.tnear[i] = 0.0f;
-            centre.tfar[i] = INFINITY;
+    }
+    if (!depth && !(j->sun_tan_radius > 0)) {
+        any = hard_lanes(s, geo, &shadow, from, lit);
+    } else {
+        for (int i = 0; i < NC_PACKET; i++) {
+            shadow.valid[i] = lit[i] = 0;
+            from[i] = -1;
+            if (s->body[i] < 0)
+                continue;
+            struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i];
+            double mu = -nc_v3_dot(nrm, s->d[i]), mu0 = nc_v3_dot(nrm, sdir);
+            if (!(mu0 > 0 && mu > 0))
+                continue;
+            geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, s->d[i]), s->factor[i]};
+            /* Offset the origin off the surface by a few float ulps of the
+             * camera-relative coordinates (a bounce's t can be far shorter than
+             * the point's distance from the camera); tnear stays 0. */
+            double eps = 4e-6 * (depth ? fmax(s->t[i], nc_v3_norm(s->p[i])) : s->t[i]);
+            struct nc_vec3 p = s->p[i];
+            shadow.ox[i] = (float)(p.x + eps * nrm.x);
+            shadow.oy[i] = (float)(p.y + eps * nrm.y);
+            shadow.oz[i] = (float)(p.z + eps * nrm.z);
+            struct nc_vec3 sray = sdir;
+            if (twin) {
+                centre.ox[i] = shadow.ox[i];
+                centre.oy[i] = shadow.oy[i];
+                centre.oz[i] = shadow.oz[i];
+                centre.dx[i] = (float)sdir.x;
+                centre.dy[i] = (float)sdir.y;
+                centre.dz[i] = (float)sdir.z;
+                centre.tnear[i] = 0.0f;
+                centre.tfar[i] = INFINITY;
+            }
+            if (j->sun_tan_radius > 0) {
+                /* Soft shadows: toward a point of the solar disk, uniform
+                 * over it, from a stream of its own (pixel, sample, depth). */
+                int px = px0 + (i & 3), py = py0 + (i >> 2);
+                uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                double rr = j->sun_tan_radius * sqrt(hash01(disk_seed, pid, 2 * (uint64_t)sidx)),
+                       th = 2.0 * M_PI * hash01(disk_seed, pid, 2 * (uint64_t)sidx + 1);
+                struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
+                if (j->s->sun.has_position) /* the direction differs from point to point */
+                    nc_v3_basis(sdir, &e1, &e2);
+                sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)), nc_v3_scale(e2, rr * sin(th)))));
+            }
+            shadow.dx[i] = (float)sray.x;
+            shadow.dy[i] = (float)sray.y;
+            shadow.dz[i] = (float)sray.z;
+            shadow.tnear[i] = 0.0f;
+            shadow.tfar[i] = INFINITY;
+            shadow.valid[i] = -1;
+            /* the grid's proof needs a ray leaving the outer side */
+            from[i] = s->outside[i] && nc_v3_dot(nrm, sray) > 0 ? s->body[i] : -1;
+            lit[i] = 1;
+            any++;
         }
-        if (j->sun_tan_radius > 0) {
-            /* Soft shadows: toward a point of the solar disk, uniform
-             * over it, from a stream of its own (pixel, sample, depth). */
-            int px = px0 + (i & 3), py = py0 + (i >> 2);
-            uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-            double rr = j->sun_tan_radius * sqrt(hash01(disk_seed, pid, 2 * (uint64_t)sidx)),
-                   th = 2.0 * M_PI * hash01(disk_seed, pid, 2 * (uint64_t)sidx + 1);
-            struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
-            if (j->s->sun.has_position) /* the direction differs from point to point */
-                nc_v3_basis(sdir, &e1, &e2);
-            sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)), nc_v3_scale(e2, rr * sin(th)))));
-        }
-        shadow.dx[i] = (float)sray.x;
-        shadow.dy[i] = (float)sray.y;
-        shadow.dz[i] = (float)sray.z;
-        shadow.tnear[i] = 0.0f;
-        shadow.tfar[i] = INFINITY;
-        shadow.valid[i] = -1;
-        /* the grid's proof needs a ray leaving the outer side */
-        from[i] = s->outside[i] && nc_v3_dot(nrm, sray) > 0 ? s->body[i] : -1;
-        lit[i] = 1;
-        any++;
     }
     if (!any)
         return;
@@ -631,9 +702,10 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void 
 
 /* The unit directions d[i] of a packet's camera rays through the image
  * points ip (n strata a side; 0: the pixel centres). The pinhole case is
- * branch-free loops, vectorised (AVX2 where the CPU has it: no FMA, so the
- * same bits as plain scalar code, and as nc_v3_unit). */
-__attribute__((target_clones("avx2", "default"))) static void camera_dirs(const struct nc_camera *c,
+ * branch-free loops, vectorised (AVX-512 or AVX2 where the CPU has it,
+ * without contraction: the same bits as plain scalar code, and as
+ * nc_v3_unit). */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void camera_dirs(const struct nc_camera *c,
                                                                             const struct image_points *ip, int n,
                                                                             struct nc_vec3 *d)
 {
@@ -803,6 +875,7 @@ static void shade_tile(struct job *j, int tile)
     int g_lane[SLOT_GROUP][NC_PACKET];
     struct nc_hit16 hit[SLOT_GROUP];
     struct surf sf;
+    memset(&sf, 0, sizeof sf); /* hard_lanes reads every lane, hit or not */
     struct tile_counts cnt = {0, 0};
     double r[NC_PACKET];
 
@@ -1061,6 +1134,10 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
         return rc;
     }
     j.bins = rc > 0;
+    j.plain = !s->sun.has_position;
+    for (int b = 0; b < s->nbodies; b++)
+        j.plain &= (s->body[b].shape == NC_SHAPE_MESH || s->body[b].shape == NC_SHAPE_ASTEROID) &&
+                   !s->body[b].material.albedo_map;
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
     j.sun_tan_radius = s->render.soft_shadows ? tan(nc_scene_sun_radius_rad(s)) : 0.0;
     nc_v3_basis(j.sun_dir, &j.sun_e1, &j.sun_e2);

@@ -631,6 +631,22 @@ static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *
 /* Lane i of hit: instance inst's primitive prim (a body's own triangle, or a
  * rock of a tile) met at t, barycentric (u, v), geometric normal (x, y, z)
  * unnormalised in the instanced geometry's frame (the body's). */
+/* Lane i of hit: body bi's ground at ray parameter t, its body-frame
+ * normal (x, y, z) turned into the scene frame, albedo factor alb (put_hit
+ * then names the rock where one was hit). */
+static inline void put_surface(const struct rt_body *b, int bi, float t, float x, float y, float z, float alb,
+                              struct nc_hit16 *hit, int i)
+{
+    const float *R = b->rot;
+    hit->albedo[i] = alb;
+    hit->rock[i] = -1;
+    hit->body[i] = bi;
+    hit->t[i] = t;
+    hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;
+    hit->ny[i] = R[3] * x + R[4] * y + R[5] * z;
+    hit->nz[i] = R[6] * x + R[7] * y + R[8] * z;
+}
+
 static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float t, float u, float v, float x, float y,
                     float z, const struct nc_ray16 *ray, struct nc_hit16 *hit, int i)
 {
@@ -670,13 +686,8 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
         if (b->src->boulders.relief[0] > 0) /* u 1: a detailed surface's hit, the coarse relief in geometry */
             rock_relief(b, tl, prim, u != 0 ? NC_ROCK_MESH_OCTAVES : 0, t, ray, i, &x, &y, &z);
     }
-    hit->albedo[i] = alb;
+    put_surface(b, (int)rt->geom_to_body[inst], t, x, y, z, alb, hit, i);
     hit->rock[i] = rock;
-    hit->body[i] = (int)rt->geom_to_body[inst];
-    hit->t[i] = t;
-    hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;
-    hit->ny[i] = R[3] * x + R[4] * y + R[5] * z;
-    hit->nz[i] = R[6] * x + R[7] * y + R[8] * z;
 }
 
 static void put_miss(struct nc_hit16 *hit, int i)
@@ -825,13 +836,16 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
                 }
                 const struct nc__bins_tri *ct = &rt->bins.cand[slot[q][i]];
                 uint32_t prim = 0; /* put_hit reads it for vertex normals and albedos only */
-                const struct rt_body *b = &rt->body[nc__bins_which(&rt->bins, slot[q][i], NULL)];
-                float u = 0, v = 0;
-                if (b->vnormal || b->src->albedo_vertex) {
-                    const float d[3] = {ray[q0 + q].dx[i], ray[q0 + q].dy[i], ray[q0 + q].dz[i]};
-                    nc__bins_uv(ct, d, &u, &v);
-                    nc__bins_which(&rt->bins, slot[q][i], &prim);
+                const int bi = nc__bins_which(&rt->bins, slot[q][i], NULL);
+                const struct rt_body *b = &rt->body[bi];
+                if (!b->vnormal && !b->src->albedo_vertex) { /* put_hit's steps for a flat, uniform facet */
+                    put_surface(b, bi, t[q][i], ct->ng[0], ct->ng[1], ct->ng[2], 1.0f, h, i);
+                    continue;
                 }
+                float u = 0, v = 0;
+                const float d[3] = {ray[q0 + q].dx[i], ray[q0 + q].dy[i], ray[q0 + q].dz[i]};
+                nc__bins_uv(ct, d, &u, &v);
+                nc__bins_which(&rt->bins, slot[q][i], &prim);
                 put_hit(rt, b->inst_id, prim, t[q][i], u, v, ct->ng[0], ct->ng[1], ct->ng[2], &ray[q0 + q], h, i);
             }
         if (rt->rocks_on && rt->rock_binned)
