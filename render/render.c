@@ -283,8 +283,8 @@ static inline void unit_lane(double x, double y, double z, double (*u)[NC_PACKET
 /* The unit facet normals of a packet's hits (zero where a lane missed), in
  * AVX-512 or AVX2 where the CPU has it (this file is compiled without
  * contraction: the same bits as plain code). */
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void unit_normals(const struct nc_hit16 *hit,
-                                                                             double (*un)[NC_PACKET])
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void
+unit_normals(const struct nc_hit16 *hit, double (*un)[NC_PACKET])
 {
     for (int i = 0; i < NC_PACKET; i++)
         unit_lane(hit->nx[i], hit->ny[i], hit->nz[i], un, i);
@@ -293,11 +293,9 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void 
 /* surface16 where j->plain holds, in one branch-free loop (AVX-512 or AVX2
  * where the CPU has it, without contraction: the same bits as the loop lane
  * by lane). A missed lane gets body -1 and values never read. */
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void plain_lanes(const struct job *j,
-                                                                          const struct nc_hit16 *hit,
-                                                                          const struct nc_vec3 *orig,
-                                                                          const struct nc_vec3 *dir,
-                                                                          const double (*un)[NC_PACKET], struct surf *s)
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void
+plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec3 *orig, const struct nc_vec3 *dir,
+            const double (*un)[NC_PACKET], struct surf *s)
 {
     for (int i = 0; i < NC_PACKET; i++) {
         const struct nc_vec3 d = dir[i];
@@ -414,20 +412,14 @@ static void unoccluded16(struct job *j, struct nc_ray16 *shadow, const int *from
         lit[i] = lit[i] && !occluded[i] && !blocked[i];
 }
 
-/* Direct sunlight at the surface points of s seen along their rays: r[i]
- * (1/sr; radiance = r irr), 0 where the point is unlit, shadowed or missing.
- * (px0, py0) is the packet's pixel block, sidx the pixel sample and depth the
- * path vertex (0: the camera ray's), which key the solar disk's points.
- * r_hard (NULL: not wanted): the same with the shadow ray aimed at the
- * Sun's centre (hard shadows), r itself when shadows are hard. */
 /* sunlight16's lanes for the camera rays' points with hard shadows, in one
  * branch-free loop (AVX-512 or AVX2 where the CPU has it, without
- * contraction: the same bits as the loop lane by lane): a lane with no point, or facing away from the Sun or
- * the camera, gets lit 0 and an invalid ray (its other fields unused).
- * Returns how many are lit. */
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static int hard_lanes(const struct surf *s,
-                                                                         struct nc_photometry *geo,
-                                                                         struct nc_ray16 *shadow, int *from, int *lit)
+ * contraction: the same bits as the loop lane by lane): a lane with no
+ * point, or facing away from the Sun or the camera, gets lit 0 and an
+ * invalid ray (its other fields unused); a ray starts 4e-6 t off the
+ * surface, as in sunlight16. Returns how many are lit. */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static int
+hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *shadow, int *from, int *lit)
 {
     int any = 0;
     for (int i = 0; i < NC_PACKET; i++) {
@@ -451,6 +443,12 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static int h
     return any;
 }
 
+/* Direct sunlight at the surface points of s seen along their rays: r[i]
+ * (1/sr; radiance = r irr), 0 where the point is unlit, shadowed or missing.
+ * (px0, py0) is the packet's pixel block, sidx the pixel sample and depth the
+ * path vertex (0: the camera ray's), which key the solar disk's points.
+ * r_hard (NULL: not wanted): the same with the shadow ray aimed at the
+ * Sun's centre (hard shadows), r itself when shadows are hard. */
 static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, int sidx, int depth, double *r,
                        double *r_hard, struct tile_counts *cnt)
 {
@@ -507,7 +505,8 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
                 struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
                 if (j->s->sun.has_position) /* the direction differs from point to point */
                     nc_v3_basis(sdir, &e1, &e2);
-                sray = nc_v3_unit(nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)), nc_v3_scale(e2, rr * sin(th)))));
+                sray = nc_v3_unit(
+                    nc_v3_add(sdir, nc_v3_add(nc_v3_scale(e1, rr * cos(th)), nc_v3_scale(e2, rr * sin(th)))));
             }
             shadow.dx[i] = (float)sray.x;
             shadow.dy[i] = (float)sray.y;
@@ -691,8 +690,8 @@ struct image_points {
  * lanes at once (64-bit multiplies: AVX-512 or AVX2 where the CPU has it).
  * Integer arithmetic and an exact conversion to [0, 1) (hash01), so one
  * rounding (the sum's) on any path, contracted or not: the same bits. */
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void jitter16(uint64_t seed, const uint64_t *pid,
-                                                                            const int *g, struct image_points *ip)
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void
+jitter16(uint64_t seed, const uint64_t *pid, const int *g, struct image_points *ip)
 {
     for (int i = 0; i < NC_PACKET; i++) {
         ip->jx[i] += hash01(seed, pid[i], 2 * (uint64_t)g[i]);
@@ -705,9 +704,8 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void 
  * branch-free loops, vectorised (AVX-512 or AVX2 where the CPU has it,
  * without contraction: the same bits as plain scalar code, and as
  * nc_v3_unit). */
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void camera_dirs(const struct nc_camera *c,
-                                                                            const struct image_points *ip, int n,
-                                                                            struct nc_vec3 *d)
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void
+camera_dirs(const struct nc_camera *c, const struct image_points *ip, int n, struct nc_vec3 *d)
 {
     double fx[NC_PACKET], fy[NC_PACKET];
     for (int i = 0; i < NC_PACKET; i++) {

@@ -628,14 +628,11 @@ static void rock_relief(const struct rt_body *b, const struct nc__rt_rock_tile *
         *x = (float)n[0], *y = (float)n[1], *z = (float)n[2];
 }
 
-/* Lane i of hit: instance inst's primitive prim (a body's own triangle, or a
- * rock of a tile) met at t, barycentric (u, v), geometric normal (x, y, z)
- * unnormalised in the instanced geometry's frame (the body's). */
 /* Lane i of hit: body bi's ground at ray parameter t, its body-frame
  * normal (x, y, z) turned into the scene frame, albedo factor alb (put_hit
  * then names the rock where one was hit). */
 static inline void put_surface(const struct rt_body *b, int bi, float t, float x, float y, float z, float alb,
-                              struct nc_hit16 *hit, int i)
+                               struct nc_hit16 *hit, int i)
 {
     const float *R = b->rot;
     hit->albedo[i] = alb;
@@ -647,6 +644,9 @@ static inline void put_surface(const struct rt_body *b, int bi, float t, float x
     hit->nz[i] = R[6] * x + R[7] * y + R[8] * z;
 }
 
+/* Lane i of hit: instance inst's primitive prim (a body's own triangle, or a
+ * rock of a tile) met at t, barycentric (u, v), geometric normal (x, y, z)
+ * unnormalised in the instanced geometry's frame (the body's). */
 static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float t, float u, float v, float x, float y,
                     float z, const struct nc_ray16 *ray, struct nc_hit16 *hit, int i)
 {

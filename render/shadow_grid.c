@@ -198,7 +198,8 @@ void nc_shadow_grid_lit16(const struct nc_shadow_grid *g, const struct nc_vec3 a
                           const float *x, const float *y, const float *z, const int *want, int *lit)
 {
     if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")) {
-        const unsigned m = lit8_avx512(g, axis, off, x, y, z) | (unsigned)lit8_avx512(g, axis, off, x + 8, y + 8, z + 8) << 8;
+        const unsigned lo = lit8_avx512(g, axis, off, x, y, z), hi = lit8_avx512(g, axis, off, x + 8, y + 8, z + 8);
+        const unsigned m = lo | hi << 8;
         for (int i = 0; i < 16; i++)
             lit[i] = want[i] && (m >> i & 1) ? -1 : 0;
         return;

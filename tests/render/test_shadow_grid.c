@@ -96,15 +96,17 @@ static void check_lit16(const struct nc_shadow_grid *g, double R, const char *wh
         nc_shadow_grid_lit16(g, axis, off, x, y, z, want, got);
         for (int i = 0; i < 16; i++) {
             const struct nc_vec3 o = nc_v3(x[i], y[i], z[i]);
-            const int one = want[i] && nc_shadow_grid_lit_at(g, nc_v3_dot(o, axis[0]) - off[0],
-                                                             nc_v3_dot(o, axis[1]) - off[1], nc_v3_dot(o, axis[2]) - off[2]);
+            double c[3];
+            for (int k = 0; k < 3; k++)
+                c[k] = nc_v3_dot(o, axis[k]) - off[k];
+            const int one = want[i] && nc_shadow_grid_lit_at(g, c[0], c[1], c[2]);
             differ += (got[i] != 0) != one || (got[i] != 0 && got[i] != -1);
             lit += one;
             n++;
         }
     }
-    CHECK(differ == 0 && lit > n / 10 && lit < n - n / 10, "%s: 16-point query differs at %d of %d points (%d lit)", what,
-          differ, n, lit);
+    CHECK(differ == 0 && lit > n / 10 && lit < n - n / 10, "%s: 16-point query differs at %d of %d points (%d lit)",
+          what, differ, n, lit);
 }
 
 /* Every sunlit face's centroid and one random point, just off the surface
