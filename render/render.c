@@ -463,7 +463,7 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
         if (r_hard)
             r_hard[i] = 0;
     }
-    if (!depth && !(j->sun_tan_radius > 0)) {
+    if (!depth && !(j->sun_tan_radius > 0) && !j->r->lane_by_lane) {
         any = hard_lanes(s, geo, &shadow, from, lit);
     } else {
         for (int i = 0; i < NC_PACKET; i++) {
@@ -1132,7 +1132,7 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
         return rc;
     }
     j.bins = rc > 0;
-    j.plain = !s->sun.has_position;
+    j.plain = !s->sun.has_position && !r->lane_by_lane;
     for (int b = 0; b < s->nbodies; b++)
         j.plain &= (s->body[b].shape == NC_SHAPE_MESH || s->body[b].shape == NC_SHAPE_ASTEROID) &&
                    !s->body[b].material.albedo_map;

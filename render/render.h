@@ -86,6 +86,11 @@ struct nc_renderer {
      * pinhole at rest over meshes (nc_rt_bin_camera's binned triangles serve
      * them otherwise); tests compare the two. */
     int no_bins;
+    /* 1: set up the camera rays' surface points and hard-shadow rays lane by
+     * lane, in the general loops, instead of the branch-free loops that
+     * serve where they apply (render.c: plain_lanes, hard_lanes); tests
+     * compare the two (the frames are the same). */
+    int lane_by_lane;
     /* Per body, at the last frame: the roughness theta_bar (deg) its
      * material was rendered with after folding in the rocks not traced, or
      * -1 where nothing was folded (scene.h, render.boulder_fold). */

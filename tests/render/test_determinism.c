@@ -113,6 +113,28 @@ static void check_grouped(struct nc_scene *s, int spp, const struct nc_exposure 
     nc_renderer_free(&rb);
 }
 
+/* The branch-free lane loops (surface points, hard-shadow rays) and the
+ * general loops lane by lane give the same frame: the scene as set, and
+ * with rocks (their hits go through the same loops). */
+static void check_lanes(struct nc_scene *s, const char *what)
+{
+    struct nc_frame a, b;
+    struct nc_renderer ra, rb;
+    CHECK(nc_renderer_init(&ra, s, 2) == 0 && nc_renderer_init(&rb, s, 2) == 0, "%s: renderers", what);
+    rb.lane_by_lane = 1;
+    nc_frame_alloc(&a, s->camera.width_px, s->camera.height_px);
+    nc_frame_alloc(&b, s->camera.width_px, s->camera.height_px);
+    CHECK(nc_render_frame(&ra, s, &a) == 0 && nc_render_frame(&rb, s, &b) == 0, "%s: render", what);
+    double sum = 0;
+    for (int i = 0; i < a.width_px * a.height_px; i++)
+        sum += a.radiance[i];
+    CHECK(sum > 0 && same(&a, &b), "%s: the branch-free lane loops changed the frame", what);
+    nc_frame_free(&a);
+    nc_frame_free(&b);
+    nc_renderer_free(&ra);
+    nc_renderer_free(&rb);
+}
+
 int main(void)
 {
     /* The built-in default scene (procedural mesh, 4 jittered samples) at a
@@ -127,6 +149,15 @@ int main(void)
     for (int i = 0; i < ref.width_px * ref.height_px; i++)
         sum += ref.radiance[i];
     CHECK(sum > 0, "the reference frame is black");
+    check_lanes(&s, "default scene");
+    {
+        const char *rs[] = {"camera.width_px=160", "camera.height_px=120", "camera.position_m=[0,-1500,0]",
+                            "bodies.0.boulders={preset: bennu, min_diameter_m: 2}"};
+        struct nc_scene rocky;
+        nc_test_scene(nc_default_scene_yaml, rs, 4, &rocky);
+        check_lanes(&rocky, "rocks from 2 m at 1.5 km");
+        nc_scene_free(&rocky);
+    }
     const int threads[] = {2, 3, 8};
     for (int k = 0; k < 3; k++) {
         struct nc_frame f;
