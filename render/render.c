@@ -883,37 +883,45 @@ static void shade_tile(struct job *j, int tile)
             for (int bx = 0; bx < TILE; bx += 4) {
                 if (!live[by / 4][bx / 4])
                     continue;
-                /* Camera rays for a 4x4 pixel block, ns samples each. */
+                /* Camera rays for a 4x4 pixel block, ns samples each: what
+                 * the samples share (pixels, rows, origins) once a block. */
+                struct image_points ip;
+                uint64_t pid[NC_PACKET];
+                int valid[NC_PACKET];
+                float o32[3][NC_PACKET];
+                for (int i = 0; i < NC_PACKET; i++) {
+                    const int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
+                    valid[i] = (px < W && py < H) ? -1 : 0;
+                    pid[i] = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                    ip.px[i] = px;
+                    ip.py[i] = py;
+                    ip.rc[i] = &j->row[py < H ? py : H - 1];
+                    o32[0][i] = (float)ip.rc[i]->o.x;
+                    o32[1][i] = (float)ip.rc[i]->o.y;
+                    o32[2][i] = (float)ip.rc[i]->o.z;
+                }
                 for (int q = 0; q < ns; q++) {
                     const int slot = slot0 + q, vary = ps->K > 1 && (S > 1 || one); /* g differs from lane to lane */
                     /* Sample g lies in stratum g mod S = (sx, sy), jittered within it by the hashes. */
                     const int sx_slot = slot % S % n, sy_slot = slot % S / n;
-                    struct image_points ip;
-                    uint64_t pid[NC_PACKET];
                     for (int i = 0; i < NC_PACKET; i++) {
-                        const int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
-                        ray[q].valid[i] = (px < W && py < H) ? -1 : 0;
-                        pid[i] = (uint64_t)py * (uint64_t)W + (uint64_t)px;
-                        int g = vary ? sample_of(s->render.seed, pid[i], ps->k + slot * ps->K, ps->N) : slot;
+                        const int g = vary ? sample_of(s->render.seed, pid[i], ps->k + slot * ps->K, ps->N) : slot;
                         g_lane[q][i] = g;
-                        ip.px[i] = px;
-                        ip.py[i] = py;
                         if (S > 1) {
                             ip.jx[i] = vary ? g % S % n : sx_slot;
                             ip.jy[i] = vary ? g % S / n : sy_slot;
                         }
-                        ip.rc[i] = &j->row[py < H ? py : H - 1];
                     }
                     if (S > 1)
                         jitter16(s->render.seed, pid, g_lane[q], &ip);
                     camera_dirs(c, &ip, S > 1 ? n : 0, dir[q]);
-                    const struct row_cam *const *rc = ip.rc;
                     for (int i = 0; i < NC_PACKET; i++) {
                         const struct nc_vec3 d = dir[q][i];
-                        orig[q][i] = rc[i]->o;
-                        ray[q].ox[i] = (float)rc[i]->o.x;
-                        ray[q].oy[i] = (float)rc[i]->o.y;
-                        ray[q].oz[i] = (float)rc[i]->o.z;
+                        orig[q][i] = ip.rc[i]->o;
+                        ray[q].valid[i] = valid[i];
+                        ray[q].ox[i] = o32[0][i];
+                        ray[q].oy[i] = o32[1][i];
+                        ray[q].oz[i] = o32[2][i];
                         ray[q].dx[i] = (float)d.x;
                         ray[q].dy[i] = (float)d.y;
                         ray[q].dz[i] = (float)d.z;
