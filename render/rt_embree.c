@@ -902,10 +902,7 @@ static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct
     if (!b->analytic) {
         if (!dir_ok)
             return 0;
-        double c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = nc_v3_dot(o, b->grid_axis[k]) - b->grid_off[k];
-        if (!nc_shadow_grid_lit_at(b->grid, c[0], c[1], c[2]))
+        if (!nc_shadow_grid_lit_in(b->grid, b->grid_axis, b->grid_off, o))
             return 0;
     }
     for (int k = 0; k < rt->nbodies; k++)

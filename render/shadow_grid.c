@@ -152,19 +152,17 @@ int nc_shadow_grid_lit(const struct nc_shadow_grid *g, struct nc_vec3 p, struct 
            nc_shadow_grid_lit_at(g, nc_v3_dot(p, g->u), nc_v3_dot(p, g->v), nc_v3_dot(p, g->sun));
 }
 
-/* Point i of nc_shadow_grid_lit16. */
-static inline int lit_one(const struct nc_shadow_grid *g, const struct nc_vec3 axis[3], const double off[3], double px,
-                          double py, double pz)
+int nc_shadow_grid_lit_in(const struct nc_shadow_grid *g, const struct nc_vec3 axis[3], const double off[3],
+                          struct nc_vec3 p)
 {
-    const double pu = px * axis[0].x + py * axis[0].y + pz * axis[0].z - off[0];
-    const double pv = px * axis[1].x + py * axis[1].y + pz * axis[1].z - off[1];
-    const double ph = px * axis[2].x + py * axis[2].y + pz * axis[2].z - off[2];
-    return nc_shadow_grid_lit_at(g, pu, pv, ph);
+    return nc_shadow_grid_lit_at(g, nc_v3_dot(p, axis[0]) - off[0], nc_v3_dot(p, axis[1]) - off[1],
+                                 nc_v3_dot(p, axis[2]) - off[2]);
 }
 
 /* Eight points of nc_shadow_grid_lit16 in AVX-512 registers, their cells
  * read by one gather (the scalar reads wait on memory one after another):
- * the same operations in the same order, so the same answers. */
+ * the same operations in the same order, so the same answers. Cell indices
+ * in 32 bits: the build caps the grid at 2048 x 2048. */
 __attribute__((target("avx512f,avx512vl"))) static __mmask8 lit8_avx512(const struct nc_shadow_grid *g,
                                                                 const struct nc_vec3 axis[3], const double off[3],
                                                                 const float *x, const float *y, const float *z)
@@ -205,7 +203,7 @@ void nc_shadow_grid_lit16(const struct nc_shadow_grid *g, const struct nc_vec3 a
         return;
     }
     for (int i = 0; i < 16; i++)
-        lit[i] = want[i] && lit_one(g, axis, off, x[i], y[i], z[i]) ? -1 : 0;
+        lit[i] = want[i] && nc_shadow_grid_lit_in(g, axis, off, nc_v3(x[i], y[i], z[i])) ? -1 : 0;
 }
 
 void nc_shadow_grid_free(struct nc_shadow_grid *g)

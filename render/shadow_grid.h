@@ -49,11 +49,13 @@ int nc_shadow_grid_lit(const struct nc_shadow_grid *g, struct nc_vec3 p, struct 
  * and sun. */
 int nc_shadow_grid_dir_ok(const struct nc_shadow_grid *g, struct nc_vec3 d);
 int nc_shadow_grid_lit_at(const struct nc_shadow_grid *g, double pu, double pv, double ph);
-/* nc_shadow_grid_lit_at for 16 points of another frame at once: point i,
- * (x[i], y[i], z[i]), has the coordinates c_k = (x, y, z) . axis[k] - off[k]
- * along u, v and sun. lit[i] = -1 where want[i] and the point is proven
- * lit, else 0. The same operations in the same order as the two steps one
- * point at a time, so the same answers. */
+/* nc_shadow_grid_lit_at for point p of another frame, whose coordinates
+ * along u, v and sun are c_k = p . axis[k] - off[k]. */
+int nc_shadow_grid_lit_in(const struct nc_shadow_grid *g, const struct nc_vec3 axis[3], const double off[3],
+                          struct nc_vec3 p);
+/* nc_shadow_grid_lit_in for 16 float points at once, (x[i], y[i], z[i]):
+ * lit[i] = -1 where want[i] and the point is proven lit, else 0. The same
+ * operations in the same order, so the same answers. */
 void nc_shadow_grid_lit16(const struct nc_shadow_grid *g, const struct nc_vec3 axis[3], const double off[3],
                           const float *x, const float *y, const float *z, const int *want, int *lit);
 void nc_shadow_grid_free(struct nc_shadow_grid *g);
