@@ -237,15 +237,15 @@ static double dh_albedo(const struct nc_material *m, double i_deg)
     double mu0 = cos(i_deg * M_PI / 180), si = sqrt(1 - mu0 * mu0), sum = 0;
     for (int a = 0; a < N; a++) {
         double mu = 0.5 * (x[a] + 1), se = sqrt(1 - mu * mu); /* mu in (0, 1) */
+        struct nc_photometry geo[2 * N];
+        double r[2 * N];
         for (int b = 0; b < 2 * N; b++) {
             double psi = 0.5 * M_PI * (xa[b] + 1); /* psi in (0, pi) */
-            double cg = mu0 * mu + si * se * cos(psi);
-            struct nc_photometry geo = {mu0, mu, cg, 1.0};
-            double r;
-            nc_material_eval(m, 1, &geo, &r);
-            /* BRDF mu d(mu) d(psi), both halves of the azimuth */
-            sum += (r / mu0) * mu * (0.5 * w[a]) * (0.5 * M_PI * wa[b]) * 2;
+            geo[b] = (struct nc_photometry){mu0, mu, mu0 * mu + si * se * cos(psi), 1.0};
         }
+        nc_material_eval(m, 2 * N, geo, r); /* one call for the azimuths: the model's vector path */
+        for (int b = 0; b < 2 * N; b++) /* BRDF mu d(mu) d(psi), both halves of the azimuth */
+            sum += (r[b] / mu0) * mu * (0.5 * w[a]) * (0.5 * M_PI * wa[b]) * 2;
     }
     return sum;
 }
