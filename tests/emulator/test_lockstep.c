@@ -32,8 +32,8 @@ static double now_s(void)
 
 /* navcam serve in lock-step on a free port: a small frame with 16 samples
  * per pixel (slower than back-to-back requests), null output. Under the
- * sanitizers 4 samples are slower still: the same load in a quarter of
- * the test's time. */
+ * sanitizers a frame of 4 samples is still far slower than the requests:
+ * the same load in a quarter of the time. */
 #ifdef __SANITIZE_ADDRESS__
 #define SPP "render.samples_per_pixel=4"
 #else
