@@ -131,7 +131,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     /* How each mesh is shaded: name=flat or name=smooth, comma-separated. */
     char normals[NC_MAX_BODIES * 72] = "";
     for (int i = 0, o = 0; i < scene->nbodies; i++)
-        if (scene->body[i].shape == NC_SHAPE_MESH || scene->body[i].shape == NC_SHAPE_ASTEROID)
+        if (nc_body_is_mesh(&scene->body[i]))
             o += snprintf(normals + o, sizeof normals - (size_t)o, "%s%s=%s", o ? "," : "", scene->body[i].name,
                           scene->body[i].smooth_normals ? "smooth" : "flat");
     /* The roughness each body's rocks not traced were folded into. */

@@ -1142,7 +1142,7 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
     j.bins = rc > 0;
     j.plain = !s->sun.has_position && !r->lane_by_lane;
     for (int b = 0; b < s->nbodies; b++)
-        j.plain &= (s->body[b].shape == NC_SHAPE_MESH || s->body[b].shape == NC_SHAPE_ASTEROID) &&
+        j.plain &= nc_body_is_mesh(&s->body[b]) &&
                    !s->body[b].material.albedo_map;
     nc_scene_sun_at(s, s->body[0].position_m, &j.sun_dir, &j.sun_irr);
     j.sun_tan_radius = s->render.soft_shadows ? tan(nc_scene_sun_radius_rad(s)) : 0.0;

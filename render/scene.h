@@ -47,6 +47,13 @@ struct nc_body {
     struct nc_vec3 angular_velocity_rad_s; /* body-fixed frame */
 };
 
+/* Whether body b is a triangle mesh (a loaded shape model, a DEM or the
+ * procedural asteroid), not an analytic sphere or ellipsoid. */
+static inline int nc_body_is_mesh(const struct nc_body *b)
+{
+    return b->shape == NC_SHAPE_MESH || b->shape == NC_SHAPE_ASTEROID;
+}
+
 struct nc_sun {
     int has_position;
     struct nc_vec3 direction;   /* unit, toward the Sun, bodies[0] frame (when !has_position) */

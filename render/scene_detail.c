@@ -15,7 +15,6 @@
 #include "render/craters.h"
 
 /* Detail needs a triangle mesh: a loaded one or the asteroid's. */
-static int has_mesh(const struct nc_body *b) { return b->shape == NC_SHAPE_MESH || b->shape == NC_SHAPE_ASTEROID; }
 
 int nc__scene_error_at(const struct nc_cfg_node *n)
 {
@@ -32,7 +31,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const 
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
     if (!node && b->shape != NC_SHAPE_ASTEROID)
         return 0;
-    if (node && !has_mesh(b))
+    if (node && !nc_body_is_mesh(b))
         return nc_cfg_error(node, "craters need a mesh or asteroid shape");
     struct nc_crater_params p;
     nc_crater_params_default(&b->mesh, &p);
@@ -108,7 +107,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
     int rc, has_c, has_slope;
     if ((rc = nc_cfg_map(item, "boulders", &map)) <= 0)
         return rc;
-    if (!has_mesh(b))
+    if (!nc_body_is_mesh(b))
         return nc_cfg_error(nc_cfg_get(item, "boulders"), "boulders need a mesh or asteroid shape");
     struct nc_boulder_params p = {.d_min_m = 1, .d_max_m = 64, .burial_min = 0.1, .burial_max = 0.5, .shapes = 48,
                                   .seed = 1};
@@ -165,7 +164,7 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double 
     int rc;
     if ((rc = nc_cfg_map(sh, "relief", &map)) <= 0)
         return rc;
-    if (!has_mesh(b))
+    if (!nc_body_is_mesh(b))
         return nc_cfg_error(nc_cfg_get(sh, "relief"), "relief needs a mesh or asteroid shape");
     struct nc_relief_params p = {.hurst = 0.8, .amplitude = 1, .seed = 1};
     if ((rc = nc_cfg_double(map, "edge_m", 1e-6, 1e7, &p.edge_m)) <= 0)
@@ -192,7 +191,7 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b)
     int rc;
     if ((rc = nc_cfg_map(item, "albedo_variation", &map)) <= 0)
         return rc;
-    if (!has_mesh(b))
+    if (!nc_body_is_mesh(b))
         return nc_cfg_error(nc_cfg_get(item, "albedo_variation"),
                             "albedo_variation needs a mesh or asteroid shape (an albedo map serves the others)");
     /* default largest wavelength: a tenth of the radius of the sphere of
@@ -222,7 +221,7 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
     int rc, smooth = 0;
     if ((rc = nc_cfg_enum(shape, "normals", normals, &smooth)) < 0)
         return rc;
-    if (rc && !has_mesh(b))
+    if (rc && !nc_body_is_mesh(b))
         return nc_cfg_error(nc_cfg_get(shape, "normals"), "normals apply to mesh and asteroid shapes");
     b->smooth_normals = smooth;
     /* Craters displace the relief along the surface under it, not along

@@ -95,11 +95,7 @@ static void check_lit16(const struct nc_shadow_grid *g, double R, const char *wh
         }
         nc_shadow_grid_lit16(g, axis, off, x, y, z, want, got);
         for (int i = 0; i < 16; i++) {
-            const struct nc_vec3 o = nc_v3(x[i], y[i], z[i]);
-            double c[3];
-            for (int k = 0; k < 3; k++)
-                c[k] = nc_v3_dot(o, axis[k]) - off[k];
-            const int one = want[i] && nc_shadow_grid_lit_at(g, c[0], c[1], c[2]);
+            const int one = want[i] && nc_shadow_grid_lit_in(g, axis, off, nc_v3(x[i], y[i], z[i]));
             differ += (got[i] != 0) != one || (got[i] != 0 && got[i] != -1);
             lit += one;
             n++;
