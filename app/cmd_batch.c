@@ -18,6 +18,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/traj.h"
+#include "render/image_io.h"
 
 static const char batch_help[] =
     "Usage: navcam batch TRAJ.csv -o DIR [--scene SCENE.yaml] [--set KEY=VALUE]... [options]\n"
@@ -323,6 +324,13 @@ int main(int argc, char **argv)
         free(sets);
         free(rows);
         return 1;
+    }
+    char probe[16];
+    snprintf(probe, sizeof probe, "f.%s", ext);
+    if (nc_image_prepare(probe) < 0) {
+        free(sets);
+        free(rows);
+        return nc_cli_fail();
     }
     struct nc_scene base;
     struct nc_camsys cs;

@@ -104,6 +104,10 @@ int main(int argc, char **argv)
                 !nc_image_is_fits(out) ? "applies to .fits output only" : nc_errmsg());
         goto out;
     }
+    if (nc_image_prepare(out) < 0) {
+        fprintf(stderr, "navcam expose: %s\n", nc_errmsg());
+        goto out;
+    }
     struct nc_camera geom;
     struct nc_camsys cs;
     rc = 1;

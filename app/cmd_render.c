@@ -165,6 +165,10 @@ int main(int argc, char **argv)
         free(sets);
         return 1;
     }
+    if (nc_image_prepare(out) < 0) {
+        free(sets);
+        return nc_cli_fail();
+    }
     struct nc_scene scene;
     struct nc_camsys cs;
     struct nc_sky sky;

@@ -54,6 +54,11 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     if (f->bottom_up && !nc_image_is_fits(probe))
         return nc_cfg_error(nc_cfg_get(opts, "fits_row_order"), "applies to .fits patterns only (the pattern writes %s)",
                             probe);
+    if (nc_image_prepare(probe) < 0) { /* now, not at the first frame */
+        char why[4096];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_cfg_error(nc_cfg_get(opts, "pattern"), "%s", why);
+    }
     snprintf(f->dir, sizeof f->dir, "%s", dir);
     snprintf(f->pattern, sizeof f->pattern, "%s", pattern);
     if (mkdir(f->dir, 0777) < 0 && errno != EEXIST)

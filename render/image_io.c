@@ -53,6 +53,12 @@ int nc_image_format_ok(const char *path, int *is_float)
     return f != FMT_NONE;
 }
 
+int nc_image_prepare(const char *path)
+{
+    enum fmt f = format_of(path);
+    return f == FMT_NONE || f == FMT_FITS ? 0 : nc__oiio_load();
+}
+
 /* {"name": "value", ...} with JSON string escapes. */
 static char *describe(const struct nc_image_attr *attrs, int nattrs)
 {

@@ -1,10 +1,10 @@
-/* image_io.h - image files through OpenImageIO, behind a C interface.
+/* image_io.h - image files through OpenImageIO and cfitsio, behind a C interface.
  *
  * The format follows the file extension: .exr, .tif/.tiff and .fits store
  * float32 values as given; .png stores a 16-bit linear preview scaled so that
  * the largest finite value maps to 65535, with that scale written into the
- * file's metadata. NaN and Inf are written as 0. This is the only file that
- * touches OpenImageIO (C++).
+ * file's metadata. NaN and Inf are written as 0. OpenImageIO (C++) is
+ * behind it, loaded on first use (image_io_impl.h).
  * FITS is written and read with cfitsio (OpenImageIO 2.4 writes headers
  * standard readers reject and cannot read float FITS). Its rows go top row
  * first unless the attribute navcam:fits_row_order is "bottom_up" (the
@@ -33,6 +33,12 @@ int nc_image_is_fits(const char *path);
 int nc_image_fits_row_order_ok(const char *word);
 /* 1 if the extension is a supported output format (and *is_float), else 0. */
 int nc_image_format_ok(const char *path, int *is_float);
+/* Load now what reading or writing path's format needs: EXR, TIFF and PNG
+ * go through OpenImageIO, a module loaded on first use (its libraries take
+ * about 0.5 s to load). A program that will write such files calls this at
+ * its start, so that a missing module fails before any work and the first
+ * frame does not wait. 0, or an error naming where the module was looked for. */
+int nc_image_prepare(const char *path);
 /* Write a single-channel image; *preview_scale (may be NULL) receives the
  * value that 65535 stands for in a 16-bit preview, 0 for float formats. */
 int nc_image_write(const char *path, const float *px, int width, int height, const struct nc_image_attr *attrs,

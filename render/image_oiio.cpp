@@ -1,21 +1,33 @@
-// image_oiio.cpp - the OpenImageIO back-end of image_io (EXR, TIFF, PNG).
-// The only file that touches OpenImageIO; no physics and no policy here.
+// image_oiio.cpp - the OpenImageIO back-end of image_io (EXR, TIFF, PNG):
+// the module navcam-oiio.so, loaded on first use (image_io_impl.h). The
+// only file that touches OpenImageIO; no physics and no policy here. It
+// links nothing of NavCam's: its errors go back as text.
 #include <OpenImageIO/imageio.h>
 
 #include <cerrno>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
-extern "C" {
-#include "core/error.h"
-}
+#include "core/error.h" // the codes only
 #include "render/image_io_impl.h"
 
 using namespace OIIO;
 
-extern "C" int nc__oiio_write(const char *path, const void *px, int w, int h, enum nc__pixel type,
-                              const struct nc_image_attr *attrs, int nattrs, const char *description)
+namespace {
+
+__attribute__((format(printf, 4, 5))) int fail(int code, char *err, size_t len, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(err, len, fmt, ap);
+    va_end(ap);
+    return code;
+}
+
+int write_image(const char *path, const void *px, int w, int h, enum nc__pixel type, const struct nc_image_attr *attrs,
+                int nattrs, const char *description, char *err, size_t elen)
 {
     TypeDesc td = type == NC__PX_FLOAT ? TypeDesc::FLOAT : type == NC__PX_U16 ? TypeDesc::UINT16 : TypeDesc::UINT8;
     ImageSpec spec(w, h, 1, td);
@@ -27,32 +39,32 @@ extern "C" int nc__oiio_write(const char *path, const void *px, int w, int h, en
         spec.attribute("ImageDescription", description);
     auto out = ImageOutput::create(path);
     if (!out)
-        return nc_error(NC_EIMAGE, "%s: %s", path, OIIO::geterror().c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: %s", path, OIIO::geterror().c_str());
     if (!out->open(path, spec))
-        return nc_error(NC_EIMAGE, "%s: open for writing: %s", path, out->geterror().c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: open for writing: %s", path, out->geterror().c_str());
     if (!out->write_image(td, px)) {
         std::string e = out->geterror();
         out->close();
-        return nc_error(NC_EIMAGE, "%s: write: %s", path, e.c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: write: %s", path, e.c_str());
     }
     if (!out->close())
-        return nc_error(NC_EIMAGE, "%s: close: %s", path, out->geterror().c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: close: %s", path, out->geterror().c_str());
     return 0;
 }
 
-extern "C" int nc__oiio_read(const char *path, float **px, int *w, int *h)
+int read_image(const char *path, float **px, int *w, int *h, char *err, size_t elen)
 {
     auto in = ImageInput::open(path);
     if (!in)
-        return nc_error(NC_EIMAGE, "%s: %s", path, OIIO::geterror().c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: %s", path, OIIO::geterror().c_str());
     const ImageSpec &spec = in->spec();
     size_t n = (size_t)spec.width * (size_t)spec.height;
     float *buf = (float *)std::malloc(n * sizeof(float));
     if (!buf)
-        return nc_error(-ENOMEM, "%s: out of memory", path);
+        return fail(-ENOMEM, err, elen, "%s: out of memory", path);
     if (!in->read_image(0, 0, 0, 1, TypeDesc::FLOAT, buf)) {
         std::free(buf);
-        return nc_error(NC_EIMAGE, "%s: read: %s", path, in->geterror().c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: read: %s", path, in->geterror().c_str());
     }
     *w = spec.width;
     *h = spec.height;
@@ -60,14 +72,20 @@ extern "C" int nc__oiio_read(const char *path, float **px, int *w, int *h)
     return 0;
 }
 
-extern "C" int nc__oiio_read_attr(const char *path, const char *name, char *buf, size_t len)
+int read_attr(const char *path, const char *name, char *buf, size_t len, char *err, size_t elen)
 {
     auto in = ImageInput::open(path);
     if (!in)
-        return nc_error(NC_EIMAGE, "%s: %s", path, OIIO::geterror().c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: %s", path, OIIO::geterror().c_str());
     const ParamValue *p = in->spec().find_attribute(name, TypeDesc::STRING);
     if (!p)
-        return nc_error(NC_EIMAGE, "%s: no attribute '%s'", path, name);
+        return fail(NC_EIMAGE, err, elen, "%s: no attribute '%s'", path, name);
     std::snprintf(buf, len, "%s", p->get_string().c_str());
     return 0;
 }
+
+const struct nc__oiio_api api = {NC__OIIO_ABI, write_image, read_image, read_attr};
+
+} // namespace
+
+extern "C" __attribute__((visibility("default"))) const struct nc__oiio_api *nc__oiio_module(void) { return &api; }

@@ -57,6 +57,18 @@ done
 for c in replay pose; do
   case "$(needed "$libexec/navcam-$c")" in *OpenImageIO*|*embree*|*yaml*) bad "navcam-$c links the renderer: $(needed "$libexec/navcam-$c")" ;; *) ok ;; esac
 done
+# OpenImageIO (and the 260 libraries it pulls in: 0.5 s to load) is the
+# module navcam-oiio.so, loaded only by a command that reads or writes EXR,
+# TIFF or PNG files.
+for c in render expose serve batch bench compare texture stars brdf scene; do
+  case "$(needed "$libexec/navcam-$c")" in *OpenImageIO*) bad "navcam-$c links OpenImageIO itself" ;; *) ok ;; esac
+done
+case "$(needed "$libexec/navcam-oiio.so")" in *OpenImageIO*) ok ;; *) bad "navcam-oiio.so does not link OpenImageIO" ;; esac
+loaded() { LD_DEBUG=files "$@" 2>&1 >/dev/null | grep -c 'file=.*\(OpenImageIO\|navcam-oiio\)' ; }
+[ "$(loaded "$navcam" render --help)" = 0 ] && ok || bad "navcam render --help loads OpenImageIO"
+[ "$(loaded "$navcam" render -o "$tmp/lazy.fits" "${small[@]}")" = 0 ] && ok || bad "a FITS render loads OpenImageIO"
+[ "$(loaded "$navcam" render -o "$tmp/lazy.png" "${small[@]}")" -ge 2 ] && ok || bad "a PNG render does not load OpenImageIO"
+expect 0 "wrote $tmp/lazy.png" -- "$navcam" render -o "$tmp/lazy.png" "${small[@]}"
 expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio, usb)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
 expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
