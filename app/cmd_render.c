@@ -172,6 +172,7 @@ int main(int argc, char **argv)
     struct nc_scene scene;
     struct nc_camsys cs;
     struct nc_sky sky;
+    const double tl = now_ms();
     int rc = nc_shot_setup(scene_path, sets, nsets, &scene, &cs, &sky);
     free(sets);
     if (rc < 0)
@@ -179,7 +180,7 @@ int main(int argc, char **argv)
     if (exposure < 0)
         exposure = cs.exposure_s;
     struct nc_renderer r;
-    double t0 = now_ms();
+    const double t0 = now_ms();
     if ((rc = nc_renderer_init(&r, &scene, threads)) < 0) {
         nc_scene_free(&scene);
         nc_sky_free(&sky);
@@ -195,10 +196,10 @@ int main(int argc, char **argv)
     const struct nc_sky_stats sst = info.stars;
     const struct nc_sun_view sv = info.sun;
     if (rc >= 0) {
-        printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene setup %.1f ms, "
-               "render %.1f ms\n",
+        printf("wrote %s: %dx%d %s [%s], %d samples/pixel, %d time sample%s, %d threads; scene built in %.1f ms, "
+               "renderer set up in %.1f ms, render %.1f ms\n",
                out, scene.camera.width_px, scene.camera.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
-               tsamples, tsamples == 1 ? "" : "s", r.threads, t1 - t0, t2 - t1);
+               tsamples, tsamples == 1 ? "" : "s", r.threads, t0 - tl, t1 - t0, t2 - t1);
         if (chosen[0])
             printf("  render.quality auto: %s\n", chosen);
         if (sunwarn[0])
