@@ -11,55 +11,83 @@
 
 #include "core/error.h"
 
+static int cmp_u32(const void *pa, const void *pb)
+{
+    const uint32_t a = *(const uint32_t *)pa, b = *(const uint32_t *)pb;
+    return (a > b) - (a < b);
+}
+
 int nc_shadow_grid_closed(const double *v, size_t nv, const uint32_t *tri, size_t nt)
 {
-    if (nt == 0)
-        return 0;
-    /* Undirected edges, each with (uses a->b) - (uses b->a); a closed surface
-     * has at most 1.5 nt of them (every edge at least twice). */
-    size_t cap = 1;
-    while (cap < 3 * nt)
-        cap <<= 1;
-    uint64_t *key = malloc(cap * sizeof *key);
-    int32_t *count = calloc(cap, sizeof *count);
-    if (!key || !count) {
-        free(key);
-        free(count);
-        return nc_error(-ENOMEM, "out of memory for %zu edges", cap);
+    /* Each edge goes into the bucket of its lower vertex as (the other
+     * vertex << 1 | direction): a counting sort, whose writes follow the
+     * mesh's own vertex order (a hash table of edges made every one a cache
+     * miss: 2.0 s for 5.2 million triangles). Closed: in every bucket, each
+     * other vertex comes as often with one direction as with the other. */
+    if (nt == 0 || nv == 0 || nv > (size_t)INT32_MAX || nt > (size_t)UINT32_MAX / 3)
+        return 0; /* not proven: such a mesh is traced without the grid */
+    uint32_t *start = calloc(nv + 1, sizeof *start), *at = malloc(nv * sizeof *at), *e = malloc(3 * nt * sizeof *e);
+    if (!start || !at || !e) {
+        free(start);
+        free(at);
+        free(e);
+        return nc_error(-ENOMEM, "out of memory for the edges of %zu triangles", nt);
     }
-    memset(key, 0xff, cap * sizeof *key); /* UINT64_MAX: empty */
-    size_t used = 0;
     int closed = 1;
     double vol = 0;
     for (size_t t = 0; t < nt && closed; t++) {
         const uint32_t *f = &tri[3 * t];
-        for (int e = 0; e < 3; e++) {
-            uint32_t a = f[e], b = f[(e + 1) % 3];
-            uint64_t k = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
-            size_t h = (size_t)((k * 0x9e3779b97f4a7c15ull) >> 20) & (cap - 1);
-            while (key[h] != k && key[h] != UINT64_MAX)
-                h = (h + 1) & (cap - 1);
-            if (key[h] == UINT64_MAX) {
-                if (++used > cap / 2) { /* more distinct edges than a closed surface has */
-                    closed = 0;
-                    break;
-                }
-                key[h] = k;
-            }
-            count[h] += a < b ? 1 : -1;
+        if (f[0] >= nv || f[1] >= nv || f[2] >= nv) {
+            closed = 0;
+            break;
+        }
+        for (int k = 0; k < 3; k++) {
+            const uint32_t a = f[k], b = f[(k + 1) % 3];
+            start[(a < b ? a : b) + 1]++;
         }
         const double *p = &v[3 * (size_t)f[0]], *q = &v[3 * (size_t)f[1]], *r = &v[3 * (size_t)f[2]];
-        if (f[0] >= nv || f[1] >= nv || f[2] >= nv)
-            closed = 0;
-        else /* 6 x the signed volume of the tetrahedron (0, p, q, r) */
-            vol += p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) +
-                   p[2] * (q[0] * r[1] - q[1] * r[0]);
+        /* 6 x the signed volume of the tetrahedron (0, p, q, r) */
+        vol += p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) +
+               p[2] * (q[0] * r[1] - q[1] * r[0]);
     }
-    for (size_t h = 0; h < cap && closed; h++)
-        if (key[h] != UINT64_MAX && count[h] != 0)
-            closed = 0;
-    free(key);
-    free(count);
+    for (size_t i = 0; i < nv && closed; i++) {
+        start[i + 1] += start[i];
+        at[i] = start[i];
+    }
+    for (size_t t = 0; t < nt && closed; t++)
+        for (int k = 0; k < 3; k++) {
+            const uint32_t a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3];
+            if (a < b)
+                e[at[a]++] = b << 1 | 1;
+            else
+                e[at[b]++] = a << 1;
+        }
+    for (size_t i = 0; i < nv && closed; i++) {
+        uint32_t *x = e + start[i];
+        const size_t n = start[i + 1] - start[i];
+        if (n > 16)
+            qsort(x, n, sizeof *x, cmp_u32);
+        else
+            for (size_t j = 1; j < n; j++) /* insertion sort: a vertex has about 6 */
+                for (size_t k = j; k > 0 && x[k - 1] > x[k]; k--) {
+                    const uint32_t tmp = x[k];
+                    x[k] = x[k - 1];
+                    x[k - 1] = tmp;
+                }
+        for (size_t j = 0; j < n && closed;) { /* a run of one other vertex: 0s, then as many 1s */
+            size_t k = j;
+            while (k < n && x[k] >> 1 == x[j] >> 1)
+                k++;
+            size_t ones = 0;
+            for (size_t q = j; q < k; q++)
+                ones += x[q] & 1;
+            closed = 2 * ones == k - j;
+            j = k;
+        }
+    }
+    free(start);
+    free(at);
+    free(e);
     return closed && vol > 0;
 }
 

@@ -60,6 +60,23 @@ static void check_closed(const struct nc_mesh *m)
     }
     CHECK(nc_shadow_grid_closed(m->v, m->nv, t, m->nt) == 0, "a surface wound inward is refused");
     free(t);
+    /* A cone of 40 sides: its apex (vertex 0) has 80 edges, past the
+     * small-bucket sort; closed, and not once a side is left out or one of
+     * the base's faces repeated in place of another. */
+    enum { N = 40 };
+    double cv[3 * (N + 2)] = {0, 0, 1};
+    uint32_t ct[3 * 2 * N];
+    for (int i = 0; i < N; i++) {
+        cv[3 * (i + 1)] = cos(2 * M_PI * i / N), cv[3 * (i + 1) + 1] = sin(2 * M_PI * i / N);
+        const uint32_t a = 1 + i, b = 1 + (i + 1) % N;
+        ct[3 * i] = 0, ct[3 * i + 1] = a, ct[3 * i + 2] = b;                    /* side, outward */
+        ct[3 * (N + i)] = N + 1, ct[3 * (N + i) + 1] = b, ct[3 * (N + i) + 2] = a; /* base, facing -z */
+    }
+    cv[3 * (N + 1) + 2] = -1;
+    CHECK(nc_shadow_grid_closed(cv, N + 2, ct, 2 * N) == 1, "a cone of %d sides is closed and outward", N);
+    CHECK(nc_shadow_grid_closed(cv, N + 2, ct + 3, 2 * N - 1) == 0, "a cone without a side is open");
+    memcpy(ct + 3 * N, ct + 3 * (N + 1), 3 * sizeof *ct);
+    CHECK(nc_shadow_grid_closed(cv, N + 2, ct, 2 * N) == 0, "a cone with a base face twice is not closed");
 }
 
 /* The grid's 16-point query (nc_shadow_grid_lit16; AVX-512 where the CPU
