@@ -62,60 +62,114 @@ void nc_mesh_vertex_normals(const struct nc_mesh *m, double *n)
     }
 }
 
-/* Edge -> midpoint vertex, open addressing. */
-struct edge_map {
-    uint64_t *key;
-    uint32_t *val;
-    size_t mask;
-};
+/* Each half-edge (3 f + corner) with the half-edges of the same edge: rep[h]
+ * is the first of them in face order. A counting sort by the lower end, then
+ * within each end's few half-edges a sort by (other end, half-edge): its
+ * writes follow the mesh's vertex order, where a hash table of edges made
+ * each one a cache miss. */
+static int cmp_u64(const void *pa, const void *pb)
+{
+    const uint64_t a = *(const uint64_t *)pa, b = *(const uint64_t *)pb;
+    return (a > b) - (a < b);
+}
+
+static int first_half_edges(const struct nc_mesh *m, uint32_t *rep)
+{
+    const size_t nv = m->nv, H = 3 * m->nt;
+    uint32_t *start = calloc(nv + 1, sizeof *start), *at = malloc((nv ? nv : 1) * sizeof *at);
+    uint64_t *e = malloc((H ? H : 1) * sizeof *e);
+    if (!start || !at || !e) {
+        free(start);
+        free(at);
+        free(e);
+        return nc_error(-ENOMEM, "out of memory for the edges of %zu triangles", m->nt);
+    }
+    for (size_t h = 0; h < H; h++) {
+        const uint32_t a = m->tri[h], b = m->tri[h - h % 3 + (h + 1) % 3];
+        if (a >= nv || b >= nv) {
+            free(start);
+            free(at);
+            free(e);
+            return nc_error(NC_EMESH, "triangle %zu names vertex %u of %zu", h / 3, a > b ? a : b, nv);
+        }
+        start[(a < b ? a : b) + 1]++;
+    }
+    for (size_t i = 0; i < nv; i++) {
+        start[i + 1] += start[i];
+        at[i] = start[i];
+    }
+    for (size_t h = 0; h < H; h++) {
+        const uint32_t a = m->tri[h], b = m->tri[h - h % 3 + (h + 1) % 3];
+        e[at[a < b ? a : b]++] = (uint64_t)(a < b ? b : a) << 32 | h;
+    }
+    for (size_t i = 0; i < nv; i++) {
+        uint64_t *x = e + start[i];
+        const size_t n = start[i + 1] - start[i];
+        if (n > 16) /* a fan's hub */
+            qsort(x, n, sizeof *x, cmp_u64);
+        else /* insertion sort: about 6 a vertex */
+            for (size_t j = 1; j < n; j++)
+                for (size_t k = j; k > 0 && x[k - 1] > x[k]; k--) {
+                    const uint64_t t = x[k];
+                    x[k] = x[k - 1];
+                    x[k - 1] = t;
+                }
+        for (size_t j = 0; j < n;) {
+            size_t k = j;
+            while (k < n && x[k] >> 32 == x[j] >> 32)
+                rep[(uint32_t)x[k++]] = (uint32_t)x[j];
+            j = k;
+        }
+    }
+    free(start);
+    free(at);
+    free(e);
+    return 0;
+}
 
 int nc_mesh_subdivide(struct nc_mesh *m, nc_mesh_midpoint_fn place, void *ctx)
 {
     const size_t nt = m->nt, cap_v = m->nv + 3 * nt; /* at most one new vertex per half-edge */
     if (cap_v > UINT32_MAX || 4 * nt > (SIZE_MAX / 3) / sizeof(uint32_t))
         return nc_error(NC_ERANGE, "subdividing %zu triangles: too many vertices", nt);
-    size_t cap = 64;
-    while (cap < 2 * 3 * nt)
-        cap *= 2;
-    struct edge_map em = {malloc(cap * sizeof *em.key), malloc(cap * sizeof *em.val), cap - 1};
+    uint32_t *rep = malloc((nt ? 3 * nt : 1) * sizeof *rep), *mid = malloc((nt ? 3 * nt : 1) * sizeof *mid);
     double *v = realloc(m->v, 3 * cap_v * sizeof *v);
     if (v)
         m->v = v;
     uint32_t *tri = malloc(3 * 4 * nt * sizeof *tri);
-    if (!em.key || !em.val || !v || !tri) {
-        free(em.key);
-        free(em.val);
+    int rc = !rep || !mid || !v || !tri ? nc_error(-ENOMEM, "out of memory subdividing %zu triangles", nt)
+                                        : first_half_edges(m, rep);
+    if (rc < 0) {
+        free(rep);
+        free(mid);
         free(tri);
-        return nc_error(-ENOMEM, "out of memory subdividing %zu triangles", nt);
+        return rc;
     }
-    memset(em.key, 0xff, cap * sizeof *em.key);
+    /* New vertices in order of their edges' first half-edges, as the faces
+     * are read: mid[h] is the midpoint of half-edge h's edge. */
     for (size_t f = 0; f < nt; f++) {
         const uint32_t *t = m->tri + 3 * f;
-        uint32_t mid[3];
         for (int e = 0; e < 3; e++) {
-            uint32_t a = t[e], b = t[(e + 1) % 3];
-            uint64_t k = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
-            size_t h = (size_t)((k * 0x9e3779b97f4a7c15ull) >> 20) & em.mask;
-            while (em.key[h] != UINT64_MAX && em.key[h] != k)
-                h = (h + 1) & em.mask;
-            if (em.key[h] == UINT64_MAX) {
+            const size_t h = 3 * f + (size_t)e;
+            if (rep[h] == h) {
+                const uint32_t a = t[e], b = t[(e + 1) % 3];
                 double *p = m->v + 3 * m->nv;
                 for (int i = 0; i < 3; i++)
                     p[i] = 0.5 * (m->v[3 * a + i] + m->v[3 * b + i]);
                 if (place)
                     place(ctx, m, a < b ? a : b, a < b ? b : a, (uint32_t)m->nv, p);
-                em.key[h] = k;
-                em.val[h] = (uint32_t)m->nv++;
-            }
-            mid[e] = em.val[h];
+                mid[h] = (uint32_t)m->nv++;
+            } else
+                mid[h] = mid[rep[h]];
         }
+        const uint32_t *md = mid + 3 * f;
         /* corners a, b, c; midpoints ab, bc, ca */
-        const uint32_t nf[4][3] = {{t[0], mid[0], mid[2]}, {t[1], mid[1], mid[0]}, {t[2], mid[2], mid[1]},
-                                   {mid[0], mid[1], mid[2]}};
+        const uint32_t nf[4][3] = {{t[0], md[0], md[2]}, {t[1], md[1], md[0]}, {t[2], md[2], md[1]},
+                                   {md[0], md[1], md[2]}};
         memcpy(tri + 12 * f, nf, sizeof nf);
     }
-    free(em.key);
-    free(em.val);
+    free(rep);
+    free(mid);
     free(m->tri);
     m->tri = tri;
     m->nt = 4 * nt;
