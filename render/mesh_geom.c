@@ -62,20 +62,23 @@ void nc_mesh_vertex_normals(const struct nc_mesh *m, double *n)
     }
 }
 
-/* Each half-edge (3 f + corner) with the half-edges of the same edge: rep[h]
- * is the first of them in face order. A counting sort by the lower end, then
- * within each end's few half-edges a sort by (other end, half-edge): its
- * writes follow the mesh's vertex order, where a hash table of edges made
- * each one a cache miss. */
 static int cmp_u64(const void *pa, const void *pb)
 {
     const uint64_t a = *(const uint64_t *)pa, b = *(const uint64_t *)pb;
     return (a > b) - (a < b);
 }
 
-static int first_half_edges(const struct nc_mesh *m, uint32_t *rep)
+/* For each half-edge h (of triangle h / 3, from its corner h % 3 to the
+ * next), rep[h] = the first half-edge, in triangle order, of the same edge
+ * in either direction. A counting sort of the half-edges by their lower
+ * end, then within each end's few half-edges a sort by (other end,
+ * half-edge): its writes follow the mesh's vertex order, where a hash table
+ * of edges made each one a cache miss. */
+static int edge_firsts(const struct nc_mesh *m, uint32_t *rep)
 {
     const size_t nv = m->nv, H = 3 * m->nt;
+    if (m->nt > UINT32_MAX / 3)
+        return nc_error(NC_ERANGE, "%zu triangles: too many half-edges for 32-bit indices", m->nt);
     uint32_t *start = calloc(nv + 1, sizeof *start), *at = malloc((nv ? nv : 1) * sizeof *at);
     uint64_t *e = malloc((H ? H : 1) * sizeof *e);
     if (!start || !at || !e) {
@@ -138,7 +141,7 @@ int nc_mesh_subdivide(struct nc_mesh *m, nc_mesh_midpoint_fn place, void *ctx)
         m->v = v;
     uint32_t *tri = malloc(3 * 4 * nt * sizeof *tri);
     int rc = !rep || !mid || !v || !tri ? nc_error(-ENOMEM, "out of memory subdividing %zu triangles", nt)
-                                        : first_half_edges(m, rep);
+                                        : edge_firsts(m, rep);
     if (rc < 0) {
         free(rep);
         free(mid);
