@@ -67,6 +67,8 @@ struct relief {
     double *lin;  /* the relief interpolated linearly from the model's vertices */
     double s, hurst, factor, wl_max_m, wl_min_m;
     uint64_t seed;
+    double amp[64]; /* per octave: s wl^H factor / NC_NOISE_RMS, as fbm() multiplies it out */
+    int noct;
 };
 
 /* The fBm height at body point p: octaves of wavelength wl_max_m down to
@@ -74,12 +76,19 @@ struct relief {
  * deviation fBm gives at that scale. */
 static double fbm(const struct relief *r, const double *p)
 {
-    double h = 0;
-    int k = 0;
-    for (double wl = r->wl_max_m; wl >= r->wl_min_m * 0.999; wl /= 2, k++)
-        h += r->s * pow(wl, r->hurst) * r->factor / NC_NOISE_RMS *
-             nc_noise3(r->seed + (uint64_t)k, p[0] / wl, p[1] / wl, p[2] / wl);
+    double h = 0, wl = r->wl_max_m;
+    for (int k = 0; k < r->noct; k++, wl /= 2)
+        h += r->amp[k] * nc_noise3(r->seed + (uint64_t)k, p[0] / wl, p[1] / wl, p[2] / wl);
     return h;
+}
+
+/* The octaves' amplitudes, once (a pow() per octave and vertex was about a
+ * twentieth of a relief scene's start). */
+static void octaves(struct relief *r)
+{
+    r->noct = 0;
+    for (double wl = r->wl_max_m; wl >= r->wl_min_m * 0.999 && r->noct < 64; wl /= 2)
+        r->amp[r->noct++] = r->s * pow(wl, r->hurst) * r->factor / NC_NOISE_RMS;
 }
 
 /* A new vertex: its base, normal and linear part from its edge's ends (the
@@ -137,6 +146,7 @@ int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t m
      * the final edge. */
     r.wl_max_m = 0.5 * info->model_edge_m;
     r.wl_min_m = info->model_edge_m / exp2(levels);
+    octaves(&r);
     size_t cap = nv + 3 * nt; /* generous: a closed mesh adds 3/2 vertex per face per level */
     r.base = malloc(3 * cap * sizeof *r.base);
     r.nrm = malloc(3 * cap * sizeof *r.nrm);
