@@ -20,6 +20,9 @@ static void node_free(struct nc_cfg_node *n)
     for (size_t i = 0; i < n->nchild; i++)
         node_free(n->child[i]);
     free(n->child);
+    for (size_t i = 0; i < n->nasked; i++)
+        free(n->asked[i]);
+    free(n->asked);
     free(n->key);
     free(n->value);
     free(n);

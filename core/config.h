@@ -23,6 +23,8 @@ struct nc_cfg_node {
     const char *origin; /* file name or "--set ..." (owned by struct nc_cfg) */
     int line;           /* 1-based; 0 when not from a file */
     int used;
+    char **asked; /* a map: the keys readers asked of it, for the unknown-key message */
+    size_t nasked;
     struct nc_cfg_node *parent;
     struct nc_cfg_node **child;
     size_t nchild;

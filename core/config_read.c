@@ -15,10 +15,27 @@
 
 /* ---- readers ---------------------------------------------------------- */
 
+/* key, remembered as one map's readers asked for it (once; a failure to
+ * allocate only leaves the unknown-key message shorter). */
+static void note_asked(struct nc_cfg_node *map, const char *key)
+{
+    for (size_t i = 0; i < map->nasked; i++)
+        if (!strcmp(map->asked[i], key))
+            return;
+    char **a = realloc(map->asked, (map->nasked + 1) * sizeof *a), *k = strdup(key);
+    if (a)
+        map->asked = a;
+    if (a && k)
+        a[map->nasked++] = k;
+    else
+        free(k);
+}
+
 struct nc_cfg_node *nc_cfg_get(struct nc_cfg_node *map, const char *key)
 {
     if (!map || map->kind != NC_CFG_MAP)
         return NULL;
+    note_asked(map, key);
     struct nc_cfg_node *n = nc__cfg_find(map, key);
     if (n)
         n->used = 1;
@@ -200,6 +217,43 @@ static struct nc_cfg_node *first_unused(struct nc_cfg_node *n)
     return NULL;
 }
 
+/* Levenshtein distance of two keys (a few dozen characters). */
+static size_t edits(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b), row[65];
+    if (la > 64 || lb > 64)
+        return 99;
+    for (size_t j = 0; j <= lb; j++)
+        row[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            const size_t up = row[j], sub = diag + (a[i - 1] != b[j - 1]);
+            row[j] = up + 1 < row[j - 1] + 1 ? up + 1 : row[j - 1] + 1;
+            if (sub < row[j])
+                row[j] = sub;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
+/* A map other than skip whose readers asked for key. */
+static const struct nc_cfg_node *asker(const struct nc_cfg_node *n, const char *key, const struct nc_cfg_node *skip)
+{
+    if (n != skip)
+        for (size_t i = 0; i < n->nasked; i++)
+            if (!strcmp(n->asked[i], key))
+                return n;
+    for (size_t i = 0; i < n->nchild; i++) {
+        const struct nc_cfg_node *w = asker(n->child[i], key, skip);
+        if (w)
+            return w;
+    }
+    return NULL;
+}
+
 int nc_cfg_check_unused(struct nc_cfg *cfg)
 {
     if (!cfg->root)
@@ -208,7 +262,40 @@ int nc_cfg_check_unused(struct nc_cfg *cfg)
     struct nc_cfg_node *u = first_unused(cfg->root);
     if (!u)
         return 0;
-    return nc_cfg_error(u, "unknown key (see docs/config.md for the keys this section takes)");
+    const struct nc_cfg_node *p = u->parent;
+    if (!u->key || !p || !p->nasked)
+        return nc_cfg_error(u, "unknown key (see docs/config.md for the keys this section takes)");
+    /* The nearest key this section takes (a typo), else where the key is read
+     * (a key in the wrong section), then every key this section takes. */
+    char hint[1536] = "", where[512];
+    const char *best = NULL;
+    size_t bd = strlen(u->key) / 3; /* a third of its letters: none for one- or two-letter keys */
+    for (size_t i = 0; i < p->nasked; i++) {
+        const size_t d = edits(u->key, p->asked[i]);
+        if (d <= bd && (!best || d < bd))
+            best = p->asked[i], bd = d;
+    }
+    for (size_t i = 0; i < p->nasked && !best; i++) { /* the key without its unit, or cut short */
+        const char *a = p->asked[i], *k = u->key;
+        const size_t la = strlen(a), lk = strlen(k);
+        if ((la > lk && !strncmp(a, k, lk) && a[lk] == '_') || (lk > la && !strncmp(a, k, la) && k[la] == '_'))
+            best = a;
+    }
+    const struct nc_cfg_node *w = best ? NULL : asker(cfg->root, u->key, p);
+    if (best)
+        snprintf(hint, sizeof hint, "; did you mean '%s'?", best);
+    else if (w) {
+        nc_cfg_path(w, where, sizeof where);
+        snprintf(hint, sizeof hint, "; '%s' is read %s%s", u->key, w->parent ? "in " : "at the top level",
+                 w->parent ? where : "");
+    }
+    size_t len = strlen(hint);
+    snprintf(hint + len, sizeof hint - len, " (%s takes:", p->parent ? "this section" : "the top level");
+    for (size_t i = 0; i < p->nasked && (len = strlen(hint)) < sizeof hint - 80; i++)
+        snprintf(hint + len, sizeof hint - len, "%s %s", i ? "," : "", p->asked[i]);
+    len = strlen(hint);
+    snprintf(hint + len, sizeof hint - len, "%s; docs/config.md)", len >= sizeof hint - 80 ? ", ..." : "");
+    return nc_cfg_error(u, "unknown key%s", hint);
 }
 
 void nc_cfg_mark_used(struct nc_cfg_node *n)

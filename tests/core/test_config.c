@@ -91,6 +91,19 @@ int main(void)
         const char *sets[] = {"camera.exposure_s=0.1"};
         expect_error("--set unknown key", NULL, NULL, sets, 1, "--set camera.exposure_s=0.1", "unknown key");
     }
+    { /* what the unknown-key message suggests: the nearest key, a key's place, the section's keys */
+        const char *sets[] = {"camera.widht_px=64"};
+        expect_error("typo", NULL, NULL, sets, 1, "camera.widht_px: unknown key; did you mean 'width_px'?",
+                     "(this section takes: ");
+        const char *cut[] = {"render.samples=4"};
+        expect_error("key without its unit", NULL, NULL, cut, 1, "did you mean 'samples_per_pixel'?", "docs/config.md");
+        const char *moved[] = {"bodies.0.radius_m=5"};
+        expect_error("key in another section", NULL, NULL, moved, 1, "bodies[0].radius_m: unknown key; 'radius_m' is "
+                     "read in bodies[0].shape", "(this section takes: name, shape,");
+        const char *top[] = {"lights=1"};
+        expect_error("unknown top-level key", NULL, NULL, top, 1, "lights: unknown key (the top level takes: bodies,",
+                     NULL);
+    }
     {
         const char *sets[] = {"camera.position_m=[0,0"};
         expect_error("--set bad YAML", NULL, NULL, sets, 1, "--set camera.position_m", "YAML syntax error");
