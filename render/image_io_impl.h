@@ -14,7 +14,7 @@ enum nc__pixel { NC__PX_FLOAT, NC__PX_U16, NC__PX_U8 };
 
 /* The OpenImageIO back-end is a module, navcam-oiio.so beside the commands,
  * loaded on first use: OpenImageIO and the 260 libraries it pulls in take
- * about 0.5 s to load here (4 to 6 s under qemu's emulation), which a
+ * about 0.4 s to load here (4 to 6 s under qemu's emulation), which a
  * command that reads and writes no EXR, TIFF or PNG file should not pay.
  * Its one entry point, nc__oiio_module(), returns this table; each function
  * returns 0 or an error code (error.h) with the message in err. attrs go

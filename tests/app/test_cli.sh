@@ -57,7 +57,7 @@ done
 for c in replay pose; do
   case "$(needed "$libexec/navcam-$c")" in *OpenImageIO*|*embree*|*yaml*) bad "navcam-$c links the renderer: $(needed "$libexec/navcam-$c")" ;; *) ok ;; esac
 done
-# OpenImageIO (and the 260 libraries it pulls in: 0.5 s to load) is the
+# OpenImageIO (and the 260 libraries it pulls in: about 0.4 s to load) is the
 # module navcam-oiio.so, loaded only by a command that reads or writes EXR,
 # TIFF or PNG files.
 for c in render expose serve batch bench compare texture stars brdf scene; do
