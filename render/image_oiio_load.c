@@ -6,7 +6,6 @@
  * build paths this library was configured with (a test program or tool
  * elsewhere in the build tree). */
 #include <dlfcn.h>
-#include <errno.h>
 #include <limits.h>
 #include <pthread.h>
 #include <stdio.h>
