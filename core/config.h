@@ -82,5 +82,7 @@ void nc_cfg_path(const struct nc_cfg_node *node, char *buf, size_t len);
 void nc_cfg_mark_used(struct nc_cfg_node *node);
 /* First node (depth-first, in file order) that no reader consumed: an error. */
 int nc_cfg_check_unused(struct nc_cfg *cfg);
+/* The same within node n (NULL: none), once its readers have run. */
+int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n);
 
 #endif

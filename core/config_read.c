@@ -259,7 +259,12 @@ int nc_cfg_check_unused(struct nc_cfg *cfg)
     if (!cfg->root)
         return 0;
     cfg->root->used = 1;
-    struct nc_cfg_node *u = first_unused(cfg->root);
+    return nc_cfg_check_unused_in(cfg, cfg->root);
+}
+
+int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
+{
+    struct nc_cfg_node *u = n ? first_unused(n) : NULL;
     if (!u)
         return 0;
     const struct nc_cfg_node *p = u->parent;

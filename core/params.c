@@ -134,6 +134,41 @@ int nc_param_map(struct nc_cfg_node *map, const struct nc_param *table, const ch
     return nc_cfg_map(map, key, out);
 }
 
+int nc_params_values(struct nc_cfg_node *map, const struct nc_param *const *tables, int ntables)
+{
+    if (!map || map->kind != NC_CFG_MAP)
+        return 0;
+    int rc = 0;
+    for (size_t i = 0; i < map->nchild && rc >= 0; i++) {
+        const char *key = map->child[i]->key;
+        const struct nc_param *t = NULL, *p = NULL;
+        for (int k = 0; k < ntables && !p; k++)
+            if ((p = find(tables[k], key)))
+                t = tables[k];
+        if (!p)
+            continue;
+        int b;
+        long l;
+        double d;
+        const char *str;
+        struct nc_cfg_node *sub;
+        switch (p->type) {
+        case NC_PARAM_BOOL: rc = nc_param_bool(map, t, key, &b); break;
+        case NC_PARAM_INT: rc = nc_param_int(map, t, key, &l); break;
+        case NC_PARAM_DOUBLE: rc = nc_param_double(map, t, key, &d); break;
+        case NC_PARAM_STRING: rc = nc_param_string(map, t, key, &str); break;
+        case NC_PARAM_ENUM: rc = nc_param_enum(map, t, key, &b); break;
+        case NC_PARAM_MAP: {
+            const struct nc_param *inner[1] = {p->sub};
+            if ((rc = nc_param_map(map, t, key, &sub)) >= 0)
+                rc = nc_params_values(sub, inner, 1);
+            break;
+        }
+        }
+    }
+    return rc < 0 ? rc : 0;
+}
+
 /* "[default] range unit" of an entry. */
 static void describe(const struct nc_param *p, char *buf, size_t len)
 {

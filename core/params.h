@@ -52,6 +52,12 @@ enum { NC_PARAM_EMPTY_OK = 1u << 0 }; /* STRING: an empty value is allowed (it m
  * (it takes: ...)". Reads nothing, marks nothing. */
 int nc_params_check(const struct nc_cfg_node *map, const struct nc_param *const *tables, int ntables, const char *what);
 
+/* Every configured key of map read through its table entry (type, range,
+ * names; recursing into MAP entries), as the part will read it: so a part's
+ * options can be checked whole before it is opened. Keys no table names are
+ * left to nc_params_check. */
+int nc_params_values(struct nc_cfg_node *map, const struct nc_param *const *tables, int ntables);
+
 /* Typed readers through a table entry: *out gets the table's default (when
  * it has one), then the configured value checked against the table's range.
  * map may be NULL (everything at its default). Return 1 when the key was

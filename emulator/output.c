@@ -13,14 +13,20 @@ static const struct nc_param common_params[] = {
     NC_P_END,
 };
 
-int nc_output_open(struct nc_output *o, const struct nc_output_driver *drv, struct nc_cfg_node *opts,
-                   const struct nc_output_ctx *ctx)
+int nc_output_check(const struct nc_output_driver *drv, struct nc_cfg_node *opts)
 {
-    memset(o, 0, sizeof *o);
     char what[96];
     snprintf(what, sizeof what, "output driver '%s'", drv->name);
     const struct nc_param *const tables[] = {common_params, drv->params};
     int rc = nc_params_check(opts, tables, 2, what);
+    return rc < 0 ? rc : nc_params_values(opts, tables, 2);
+}
+
+int nc_output_open(struct nc_output *o, const struct nc_output_driver *drv, struct nc_cfg_node *opts,
+                   const struct nc_output_ctx *ctx)
+{
+    memset(o, 0, sizeof *o);
+    int rc = nc_output_check(drv, opts);
     if (rc < 0)
         return rc;
     o->drv = drv;

@@ -104,8 +104,10 @@ struct nc_output {
     unsigned long submitted, failed;
 };
 
-/* Checks opts against the driver's table (unknown keys: file:line), then
- * opens it. */
+/* opts against the driver's table: every key known (unknown keys:
+ * file:line), every value of its type and range. Touches nothing. */
+int nc_output_check(const struct nc_output_driver *drv, struct nc_cfg_node *opts);
+/* nc_output_check, then opens it. */
 int nc_output_open(struct nc_output *o, const struct nc_output_driver *drv, struct nc_cfg_node *opts,
                    const struct nc_output_ctx *ctx);
 int nc_output_submit(struct nc_output *o, const struct nc_frame_record *r);

@@ -35,6 +35,8 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
         snprintf(dir, sizeof dir, "%s", dirname(dir));
     }
     int rc = nc_cfg_load_scene(&cfg, opt->scene_path, opt->sets, opt->nsets);
+    if (rc >= 0) /* the serve section, trigger and outputs checked before the scene is built */
+        rc = nc__serve_config(&cfg, e, dir, 1);
     if (rc >= 0 && (rc = nc_scene_read(&cfg, &e->scene)) >= 0)
         *have_scene = 1;
     if (rc >= 0 &&
@@ -43,7 +45,7 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
     if (rc >= 0)
         rc = nc_sky_from_config(cfg.root, &e->sky);
     if (rc >= 0)
-        rc = nc__serve_config(&cfg, e, dir);
+        rc = nc__serve_config(&cfg, e, dir, 0);
     if (rc >= 0)
         rc = nc_cfg_check_unused(&cfg);
     nc_cfg_free(&cfg);

@@ -16,8 +16,9 @@ const char *const nc__serve_mode_names[] = {"lockstep", "freerun", "trigger", NU
  * client's TriggerSoftware) takes only the common keys. */
 static const struct nc_param software_params[] = {NC_P_END};
 
-/* `serve.trigger`: a line driver, or the built-in software source. */
-static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr)
+/* `serve.trigger`: a line driver, or the built-in software source (check:
+ * its options only). */
+static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr, int check)
 {
     int rc, builtin = 0;
     const struct nc_trigger_driver *d = nc_registry_select_trigger(e->drivers, tr, "software", &builtin, &rc);
@@ -36,8 +37,8 @@ static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr)
         e->acq.trigger_delay_s = delay_s;
         return 0;
     }
-    if (!d)
-        return rc;
+    if (!d || check)
+        return d ? nc_trigger_check(d, tr) : rc;
     if ((rc = nc_trigger_open(&e->line, d, tr, nc__serve_on_line, e)) < 0)
         return rc;
     e->have_line = 1;
@@ -47,7 +48,7 @@ static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr)
     return 0;
 }
 
-static int open_outputs(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir)
+static int open_outputs(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir, int check)
 {
     struct nc_output_ctx ctx = {e->scene.camera.width_px, e->scene.camera.height_px, e->cs.sensor.adc_bits, config_dir,
                                 &e->control};
@@ -68,9 +69,14 @@ static int open_outputs(struct nc_cfg *cfg, struct nc__emu *e, const char *confi
         if (o->kind != NC_CFG_MAP)
             return nc_cfg_error(o, "expected a map with 'driver' and its options");
         const struct nc_output_driver *d = nc_registry_select_output(e->drivers, o, &rc);
-        if (!d || (rc = nc_output_open(&e->out[e->nout], d, o, &ctx)) < 0)
+        if (!d)
             return rc;
-        e->nout++;
+        if (check)
+            rc = nc_output_check(d, o);
+        else if ((rc = nc_output_open(&e->out[e->nout], d, o, &ctx)) >= 0)
+            e->nout++;
+        if (rc < 0)
+            return rc;
     }
     return 0;
 }
@@ -84,7 +90,7 @@ static int int_key(struct nc_cfg_node *map, const char *key, long min, long max,
     return rc;
 }
 
-int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir)
+int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir, int check)
 {
     struct nc_cfg_node *sv = NULL;
     int rc, m = NC__MODE_FREERUN;
@@ -132,6 +138,20 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
     e->mode = (enum nc__serve_mode)m;
     e->overlap = e->overlap && e->mode != NC__MODE_LOCKSTEP;
     e->pose_wait_ns = llround(pose_wait_s * 1e9);
+    struct nc_cfg_node *tr = NULL;
+    if (sv && (rc = nc_cfg_map(sv, "trigger", &tr)) < 0)
+        return rc;
+    if (tr && e->mode == NC__MODE_LOCKSTEP)
+        return nc_cfg_error(tr, "serve.trigger does not apply to lock-step mode (frames follow POSE messages with "
+                                "CAPTURE)");
+    if (check) {
+        if ((tr && (rc = open_trigger(e, tr, 1)) < 0) || (rc = open_outputs(cfg, e, config_dir, 1)) < 0)
+            return rc;
+        struct nc_cfg_node *outs = nc_cfg_get(cfg->root, "outputs");
+        if ((sv && (rc = nc_cfg_check_unused_in(cfg, sv)) < 0) || (rc = nc_cfg_check_unused_in(cfg, outs)) < 0)
+            return rc;
+        return 0;
+    }
     if ((rc = nc_timeline_init(&e->tl, 4096, (int64_t)llround(max_extrap * 1e9))) < 0)
         return rc;
     /* The initial acquisition settings; serve.trigger may change the source. */
@@ -143,13 +163,7 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
         .exposure_s = e->cs.exposure_s,
         .gain_db = e->cs.sensor.analog_gain_db,
     };
-    struct nc_cfg_node *tr = NULL;
-    if (sv && (rc = nc_cfg_map(sv, "trigger", &tr)) < 0)
-        return rc;
-    if (tr && e->mode == NC__MODE_LOCKSTEP)
-        return nc_cfg_error(tr, "serve.trigger does not apply to lock-step mode (frames follow POSE messages with "
-                                "CAPTURE)");
-    if (tr && (rc = open_trigger(e, tr)) < 0)
+    if (tr && (rc = open_trigger(e, tr, 0)) < 0)
         return rc;
     if (e->mode != NC__MODE_LOCKSTEP) {
         /* The camera's own clock for free-run: a timer at the frame rate,
@@ -163,5 +177,5 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
         e->have_freerun = 1;
     }
     nc__serve_enable_sources(e);
-    return open_outputs(cfg, e, config_dir);
+    return open_outputs(cfg, e, config_dir, 0);
 }

@@ -161,8 +161,11 @@ struct nc__emu {
     int64_t last_reject_log_ns;
 };
 
-/* serve_config.c */
-int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir);
+/* serve_config.c: the serve section, the trigger source and the outputs,
+ * read and opened; with check, before the scene is built, only read and
+ * checked against the drivers' tables (unknown keys, types, ranges), so that
+ * a mistake there is reported without waiting for the scene. */
+int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_dir, int check);
 
 /* serve_net.c */
 int nc__serve_open_sockets(struct nc__emu *e);

@@ -52,16 +52,22 @@ static void on_edge(void *sink, const struct nc_trigger_edge *edge)
     }
 }
 
+int nc_trigger_check(const struct nc_trigger_driver *drv, struct nc_cfg_node *opts)
+{
+    char what[96];
+    snprintf(what, sizeof what, "trigger driver '%s'", drv->name);
+    const struct nc_param *const tables[] = {nc_trigger_common_params, drv->params};
+    int rc = nc_params_check(opts, tables, 2, what);
+    return rc < 0 ? rc : nc_params_values(opts, tables, 2);
+}
+
 int nc_trigger_open(struct nc_trigger *t, const struct nc_trigger_driver *drv, struct nc_cfg_node *opts,
                     nc_trigger_sink_fn sink, void *arg)
 {
     memset(t, 0, sizeof *t);
-    char what[96];
-    snprintf(what, sizeof what, "trigger driver '%s'", drv->name);
-    const struct nc_param *const tables[] = {nc_trigger_common_params, drv->params};
     int rc, act = NC_TRIGGER_RISING;
     double delay_s = 0, debounce_s = 0;
-    if ((rc = nc_params_check(opts, tables, 2, what)) < 0 ||
+    if ((rc = nc_trigger_check(drv, opts)) < 0 ||
         (rc = nc_param_enum(opts, nc_trigger_common_params, "activation", &act)) < 0 ||
         (rc = nc_param_double(opts, nc_trigger_common_params, "delay_s", &delay_s)) < 0 ||
         (rc = nc_param_double(opts, nc_trigger_common_params, "debounce_s", &debounce_s)) < 0)

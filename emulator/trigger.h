@@ -106,9 +106,12 @@ struct nc_trigger {
     int enabled; /* 0: edges are ignored before the gate (and not counted) */
 };
 
-/* Opens drv with opts (`serve.trigger`, checked against the common keys and
- * the driver's table; NULL: every option at its default) and the gate
- * they configure. Accepted edges go to sink(arg, event). */
+/* opts (`serve.trigger`) against the common keys and the driver's table:
+ * every key known, every value of its type and range. Touches nothing. */
+int nc_trigger_check(const struct nc_trigger_driver *drv, struct nc_cfg_node *opts);
+/* Opens drv with opts (nc_trigger_check; NULL: every option at its
+ * default) and the gate they configure. Accepted edges go to sink(arg,
+ * event). */
 int nc_trigger_open(struct nc_trigger *t, const struct nc_trigger_driver *drv, struct nc_cfg_node *opts,
                     nc_trigger_sink_fn sink, void *arg);
 int nc_trigger_start(struct nc_trigger *t);

@@ -71,6 +71,14 @@ loaded() { LD_DEBUG=files "$@" 2>&1 >/dev/null | grep -c 'file=.*\(OpenImageIO\|
 expect 0 "wrote $tmp/lazy.png" -- "$navcam" render -o "$tmp/lazy.png" "${small[@]}"
 expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio, usb)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
+# The serve section, the trigger's and the outputs' keys and values are
+# checked before the scene is built: no scene line comes before the error.
+for s in "serve.frame_rate=5" "serve.trigger={driver: timer, rate_hz: 1e9}" "outputs=[{driver: file, directry: x}]"; do
+  out=$("$navcam" serve --set serve.mode=trigger --set "$s" 2>&1)
+  case "$out" in *"scene: body"*) bad "serve --set $s built the scene before its error: $out" ;; *unknown\ key*|*expected\ a\ number*) ok ;;
+    *) bad "serve --set $s: $out" ;; esac
+done
+expect 1 "serve.frame_rate: unknown key; did you mean 'frame_rate_hz'?" -- "$navcam" serve --set serve.frame_rate=5
 expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
 expect 1 "serve.trigger.activation" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: timer, activation: sideways}"
