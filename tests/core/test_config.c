@@ -100,6 +100,9 @@ int main(void)
         const char *moved[] = {"bodies.0.radius_m=5"};
         expect_error("key in another section", NULL, NULL, moved, 1, "bodies[0].radius_m: unknown key; 'radius_m' is "
                      "read in bodies[0].shape", "(this section takes: name, shape,");
+        /* the Sun's and render settings are read and checked before any body is built */
+        expect_error("render key before the bodies", "{type: sphere, radius_m: 500}",
+                     "{type: mesh, file: nowhere.obj, unit: km}", cut, 1, "render.samples: unknown key", NULL);
         const char *top[] = {"lights=1"};
         expect_error("unknown top-level key", NULL, NULL, top, 1, "lights: unknown key (the top level takes: bodies,",
                      NULL);

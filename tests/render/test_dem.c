@@ -164,7 +164,8 @@ static void check_globe(void)
     nc_scene_free(&s);
     /* errors name the key */
     const char *base = "bodies:\n  - shape: {type: dem, file: nowhere.fits}\n    material: {model: lambert, A: 0.1}\n"
-                       "sun: {direction: [1, 0, 0]}\ncamera: {width_px: 8, height_px: 8, fx_px: 8, fy_px: 8}\n";
+                       "sun: {direction: [1, 0, 0]}\ncamera: {width_px: 8, height_px: 8, fx_px: 8, fy_px: 8, "
+                       "position_m: [0, 0, -10], attitude_q: [1, 0, 0, 0]}\n";
     CHECK(nc_test_scene_rc(base, NULL, 0, &s) < 0 && nc_test_contains(nc_errmsg(), "pixel_m"), "no pixel_m: %s",
           nc_errmsg());
     const char *sets[] = {"bodies[0].shape.pixel_m=1"};
