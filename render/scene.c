@@ -292,14 +292,14 @@ int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s)
         return rc ? rc : nc_cfg_missing(root, "bodies", "a list of bodies");
     if (bodies->nchild == 0 || bodies->nchild > NC_MAX_BODIES)
         return nc_cfg_error(bodies, "expected 1 to %d bodies, got %zu", NC_MAX_BODIES, bodies->nchild);
-    /* The camera, Sun and render settings first, the latter two checked for
-     * unknown keys too (they have no other reader): a mistake there is
-     * reported before the bodies' meshes, craters and rocks are built. */
+    /* The camera, Sun and render settings first, each checked for unknown
+     * keys too (they have no other reader): a mistake there is reported
+     * before the bodies' meshes, craters and rocks are built. */
     if ((rc = nc_cfg_map(root, "camera", &cam)) <= 0) {
         rc = rc ? rc : nc_cfg_missing(root, "camera", "a map with pose and intrinsics");
         goto fail;
     }
-    if ((rc = nc_camera_from_config(cam, &s->camera)) < 0)
+    if ((rc = nc_camera_from_config(cam, &s->camera)) < 0 || (rc = nc_cfg_check_unused_in(cfg, cam)) < 0)
         goto fail;
     if ((rc = nc_cfg_map(root, "sun", &sun)) <= 0) {
         rc = rc ? rc : nc_cfg_missing(root, "sun", s->camera.from_sumfile ? "a map with distance_au (the SUM file "

@@ -103,6 +103,9 @@ int main(void)
         /* the Sun's and render settings are read and checked before any body is built */
         expect_error("render key before the bodies", "{type: sphere, radius_m: 500}",
                      "{type: mesh, file: nowhere.obj, unit: km}", cut, 1, "render.samples: unknown key", NULL);
+        const char *cam[] = {"camera.widht_px=64"};
+        expect_error("camera key before the bodies", "{type: sphere, radius_m: 500}",
+                     "{type: mesh, file: nowhere.obj, unit: km}", cam, 1, "camera.widht_px: unknown key", NULL);
         const char *top[] = {"lights=1"};
         expect_error("unknown top-level key", NULL, NULL, top, 1, "lights: unknown key (the top level takes: bodies,",
                      NULL);
