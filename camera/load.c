@@ -34,7 +34,7 @@ int nc_sky_load(const char *path, const char *const *sets, int nsets, struct nc_
     nc_cfg_init(&cfg);
     int rc = nc_cfg_load_scene(&cfg, path, sets, nsets);
     if (rc >= 0)
-        rc = nc_sky_from_config(cfg.root, sky);
+        rc = nc_sky_from_config(&cfg, sky);
     nc_cfg_free(&cfg);
     return rc;
 }

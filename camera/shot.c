@@ -17,12 +17,16 @@ static double now_ms(void) { return (double)nc_mono_ns() * 1e-6; }
 int nc_shot_setup(const char *path, const char *const *sets, int nsets, struct nc_scene *scene,
                   struct nc_camsys *cs, struct nc_sky *sky)
 {
-    int rc = nc_setup_load(path, sets, nsets, scene, cs);
+    /* The stars first: a mistake in their section comes before the scene is built. */
+    int rc = nc_sky_load(path, sets, nsets, sky);
     if (rc < 0)
         return rc;
-    if ((rc = nc_sky_load(path, sets, nsets, sky)) >= 0 && (rc = nc_sky_prepare(sky, cs, &scene->camera)) < 0)
+    if ((rc = nc_setup_load(path, sets, nsets, scene, cs)) < 0) {
         nc_sky_free(sky);
-    if (rc < 0) {
+        return rc;
+    }
+    if ((rc = nc_sky_prepare(sky, cs, &scene->camera)) < 0) {
+        nc_sky_free(sky);
         nc_scene_free(scene);
         nc_camsys_free(cs);
     }

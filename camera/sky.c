@@ -33,11 +33,11 @@ double nc_star_band_photons(const struct nc_optics *o, double v_mag, double b_v)
     return V0_PHOTONS_S_M2_M * pow(10.0, -0.4 * v_mag) * band_g(o, nc_star_teff_k(b_v));
 }
 
-int nc_sky_from_config(struct nc_cfg_node *root, struct nc_sky *sky)
+int nc_sky_from_config(struct nc_cfg *cfg, struct nc_sky *sky)
 {
     memset(sky, 0, sizeof *sky);
     struct nc_cfg_node *m;
-    int rc = nc_cfg_map(root, "stars", &m);
+    int rc = nc_cfg_map(cfg->root, "stars", &m);
     if (rc <= 0)
         return rc;
     struct nc_cfg_node *cat = nc_cfg_get(m, "catalogue");
@@ -60,6 +60,8 @@ int nc_sky_from_config(struct nc_cfg_node *root, struct nc_sky *sky)
         return rc;
     if (!(nc_v3_norm(sky->observer_velocity_m_s) < 0.01 * 299792458.0))
         return nc_cfg_error(nc_cfg_get(m, "observer_velocity_m_s"), "expected a speed below 1 %% of light's");
+    if ((rc = nc_cfg_check_unused_in(cfg, m)) < 0) /* its one reader: a typo is not a default */
+        return rc;
     if ((rc = nc_star_cat_load(sky->path, &sky->cat)) < 0) {
         char why[512];
         snprintf(why, sizeof why, "%s", nc_errmsg());

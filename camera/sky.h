@@ -45,8 +45,9 @@ struct nc_sky_stats {
     long considered, drawn, hidden;
 };
 
-/* The `stars` section of root (absent: sky->on = 0). Loads the index. */
-int nc_sky_from_config(struct nc_cfg_node *root, struct nc_sky *sky);
+/* The `stars` section of cfg (absent: sky->on = 0), its keys checked (an
+ * unknown one is an error, before the index is loaded). Loads the index. */
+int nc_sky_from_config(struct nc_cfg *cfg, struct nc_sky *sky);
 /* Photometry for this camera model and geometry (fx_px); call again when
  * either changes. */
 int nc_sky_prepare(struct nc_sky *sky, const struct nc_camsys *cs, const struct nc_camera *geom);

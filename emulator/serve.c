@@ -43,7 +43,7 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
         (rc = nc_camsys_from_config(cfg.root, &e->scene.camera, e->scene.camera.focal_length_m, &e->cs)) >= 0)
         *have_cs = 1;
     if (rc >= 0)
-        rc = nc_sky_from_config(cfg.root, &e->sky);
+        rc = nc_sky_from_config(&cfg, &e->sky);
     if (rc >= 0)
         rc = nc__serve_config(&cfg, e, dir, 0);
     if (rc >= 0)

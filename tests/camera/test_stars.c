@@ -128,6 +128,15 @@ int main(void)
           "index round trip: %s", nc_errmsg());
     CHECK(nc_star_cat_count_to(&d, 0.0) == 1 && nc_star_cat_count_to(&d, 9) == 3, "prefix to a magnitude");
     nc_star_cat_free(&d);
+    { /* a key the stars' reader does not take is an error, not a default */
+        char set[1200];
+        snprintf(set, sizeof set, "stars={catalogue: '%s', limit_magg: 5}", ix);
+        const char *sets[] = {set};
+        struct nc_sky sky;
+        CHECK(nc_sky_load(NULL, sets, 1, &sky) < 0 &&
+                  nc_test_contains(nc_errmsg(), "stars.limit_magg: unknown key; did you mean 'limit_mag'?"),
+              "an unknown key under stars: %s", nc_errmsg());
+    }
     nc_star_cat_free(&c);
     nc_test_write(dat, "064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\nnot a star\n");
     CHECK(nc_star_cat_read_kstars(dat, &c) < 0 && nc_test_contains(nc_errmsg(), "stars.dat:2"),
