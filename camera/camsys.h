@@ -93,6 +93,10 @@ struct nc_camsys {
  * the field angles for vignetting and, if the sensor gives none, the pitch. */
 int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom, double focal_length_m,
                           struct nc_camsys *cs);
+/* The sections nc_camsys_from_config read (optics, sensor, exposure) checked
+ * for unknown keys: they have no other reader, so a caller checks them
+ * before it builds a scene's bodies. */
+int nc_camsys_check_sections(struct nc_cfg *cfg);
 void nc_camsys_free(struct nc_camsys *cs);
 
 /* The camera the renderer draws with for this camera model: geom with the

@@ -441,3 +441,12 @@ void nc_camsys_render_camera(const struct nc_camsys *cs, const struct nc_camera 
     c.cy_px += cs->margin_px;
     *out = c;
 }
+
+int nc_camsys_check_sections(struct nc_cfg *cfg)
+{
+    static const char *const sections[] = {"optics", "sensor", "exposure"};
+    int rc = 0;
+    for (int i = 0; i < 3 && rc >= 0; i++)
+        rc = nc_cfg_check_unused_in(cfg, nc_cfg_get(cfg->root, sections[i]));
+    return rc;
+}

@@ -9,8 +9,8 @@ int nc_setup_load(const char *path, const char *const *sets, int nsets, struct n
 {
     struct nc_cfg cfg;
     nc_cfg_init(&cfg);
-    int rc = nc_cfg_load_scene(&cfg, path, sets, nsets);
-    if (rc >= 0 && (rc = nc_scene_read(&cfg, s)) >= 0) {
+    int rc = nc_cfg_load_scene(&cfg, path, sets, nsets), have_cs = 0;
+    if (rc >= 0 && (rc = nc_scene_read_view(&cfg, s)) >= 0) {
         /* The emulator's sections, and the stars (nc_sky_load reads them). */
         static const char *const serve_sections[] = {"serve", "outputs", "stars"};
         for (int i = 0; i < 3; i++) {
@@ -18,8 +18,16 @@ int nc_setup_load(const char *path, const char *const *sets, int nsets, struct n
             if (n)
                 nc_cfg_mark_used(n);
         }
-        rc = nc_camsys_from_config(cfg.root, &s->camera, s->camera.focal_length_m, cs);
-        if (rc >= 0 && (rc = nc_cfg_check_unused(&cfg)) < 0)
+        /* The camera model's sections, checked before the bodies are built. */
+        if ((rc = nc_camsys_from_config(cfg.root, &s->camera, s->camera.focal_length_m, cs)) >= 0) {
+            have_cs = 1;
+            rc = nc_camsys_check_sections(&cfg);
+        }
+        if (rc >= 0)
+            rc = nc_scene_read_bodies(&cfg, s);
+        if (rc >= 0)
+            rc = nc_cfg_check_unused(&cfg);
+        if (rc < 0 && have_cs)
             nc_camsys_free(cs);
         if (rc < 0)
             nc_scene_free(s);

@@ -37,13 +37,18 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
     int rc = nc_cfg_load_scene(&cfg, opt->scene_path, opt->sets, opt->nsets);
     if (rc >= 0) /* the serve section, trigger and outputs checked before the scene is built */
         rc = nc__serve_config(&cfg, e, dir, 1);
-    if (rc >= 0 && (rc = nc_scene_read(&cfg, &e->scene)) >= 0)
+    /* Then every section but the bodies, each checked, and the bodies last. */
+    if (rc >= 0 && (rc = nc_scene_read_view(&cfg, &e->scene)) >= 0)
         *have_scene = 1;
     if (rc >= 0 &&
         (rc = nc_camsys_from_config(cfg.root, &e->scene.camera, e->scene.camera.focal_length_m, &e->cs)) >= 0)
         *have_cs = 1;
     if (rc >= 0)
+        rc = nc_camsys_check_sections(&cfg);
+    if (rc >= 0)
         rc = nc_sky_from_config(&cfg, &e->sky);
+    if (rc >= 0)
+        rc = nc_scene_read_bodies(&cfg, &e->scene);
     if (rc >= 0)
         rc = nc__serve_config(&cfg, e, dir, 0);
     if (rc >= 0)

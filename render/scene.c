@@ -281,42 +281,45 @@ int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s)
     return rc;
 }
 
-int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s)
+int nc_scene_read_view(struct nc_cfg *cfg, struct nc_scene *s)
 {
     memset(s, 0, sizeof *s);
-    struct nc_cfg_node *root = cfg->root, *bodies, *sun, *cam, *rnd = NULL;
+    struct nc_cfg_node *root = cfg->root, *sun, *cam, *rnd = NULL;
     int rc;
     if (!root)
         return nc_error(NC_ECONFIG, "empty configuration");
-    if ((rc = nc_cfg_seq(root, "bodies", &bodies)) <= 0)
-        return rc ? rc : nc_cfg_missing(root, "bodies", "a list of bodies");
-    if (bodies->nchild == 0 || bodies->nchild > NC_MAX_BODIES)
-        return nc_cfg_error(bodies, "expected 1 to %d bodies, got %zu", NC_MAX_BODIES, bodies->nchild);
-    /* The camera, Sun and render settings first, each checked for unknown
-     * keys too (they have no other reader): a mistake there is reported
-     * before the bodies' meshes, craters and rocks are built. */
-    if ((rc = nc_cfg_map(root, "camera", &cam)) <= 0) {
-        rc = rc ? rc : nc_cfg_missing(root, "camera", "a map with pose and intrinsics");
-        goto fail;
-    }
+    if ((rc = nc_cfg_map(root, "camera", &cam)) <= 0)
+        return rc ? rc : nc_cfg_missing(root, "camera", "a map with pose and intrinsics");
     if ((rc = nc_camera_from_config(cam, &s->camera)) < 0 || (rc = nc_cfg_check_unused_in(cfg, cam)) < 0)
-        goto fail;
-    if ((rc = nc_cfg_map(root, "sun", &sun)) <= 0) {
-        rc = rc ? rc : nc_cfg_missing(root, "sun", s->camera.from_sumfile ? "a map with distance_au (the SUM file "
-                                                                            "gives the direction)"
-                                                                          : "a map with direction or position_m");
-        goto fail;
-    }
+        return rc;
+    if ((rc = nc_cfg_map(root, "sun", &sun)) <= 0)
+        return rc ? rc
+                  : nc_cfg_missing(root, "sun", s->camera.from_sumfile ? "a map with distance_au (the SUM file gives "
+                                                                         "the direction)"
+                                                                       : "a map with direction or position_m");
     if ((rc = sun_from_config(sun, &s->sun, s->camera.from_sumfile ? &s->camera.sumfile_sun : NULL)) < 0 ||
         (rc = nc_cfg_check_unused_in(cfg, sun)) < 0)
-        goto fail;
+        return rc;
     if ((rc = nc_cfg_map(root, "render", &rnd)) < 0 || (rc = render_from_config(rnd, &s->render)) < 0 ||
         (rc = nc_cfg_check_unused_in(cfg, rnd)) < 0)
-        goto fail;
+        return rc;
+    return 0;
+}
+
+int nc_scene_read_bodies(struct nc_cfg *cfg, struct nc_scene *s)
+{
+    struct nc_cfg_node *bodies;
+    int rc;
+    if ((rc = nc_cfg_seq(cfg->root, "bodies", &bodies)) <= 0)
+        return rc ? rc : nc_cfg_missing(cfg->root, "bodies", "a list of bodies");
+    if (bodies->nchild == 0 || bodies->nchild > NC_MAX_BODIES)
+        return nc_cfg_error(bodies, "expected 1 to %d bodies, got %zu", NC_MAX_BODIES, bodies->nchild);
     for (size_t i = 0; i < bodies->nchild; i++) {
         s->nbodies = (int)i + 1;
-        if ((rc = body_from_config(bodies->child[i], (int)i, &s->body[i])) < 0)
-            goto fail;
+        if ((rc = body_from_config(bodies->child[i], (int)i, &s->body[i])) < 0) {
+            nc_scene_free(s);
+            return rc;
+        }
     }
     if (s->camera.from_sumfile) { /* its pose is in bodies[0]'s body-fixed frame */
         const struct nc_body *b0 = &s->body[0];
@@ -324,9 +327,12 @@ int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s)
         s->camera.attitude_q = nc_quat_mul(b0->attitude_q, s->camera.attitude_q);
     }
     return 0;
-fail:
-    nc_scene_free(s);
-    return rc;
+}
+
+int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s)
+{
+    int rc = nc_scene_read_view(cfg, s);
+    return rc < 0 ? rc : nc_scene_read_bodies(cfg, s);
 }
 
 int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *sets, int nsets)

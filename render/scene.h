@@ -108,6 +108,13 @@ int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s);
 /* The same without the unknown-key check, for callers that read further
  * sections (optics, sensor, ...) and check afterwards. */
 int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s);
+/* nc_scene_read in its two steps: the camera, Sun and render sections, each
+ * checked for unknown keys (they have no other reader); then the bodies,
+ * built (meshes, craters, rocks: seconds for a large scene). A caller reads
+ * its own sections between the two, so that a mistake in any of them is
+ * reported before the build. Each frees s on failure. */
+int nc_scene_read_view(struct nc_cfg *cfg, struct nc_scene *s);
+int nc_scene_read_bodies(struct nc_cfg *cfg, struct nc_scene *s);
 /* Load file (NULL = built-in default scene) and apply overrides. */
 int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *sets, int nsets);
 /* Convenience: load file (NULL = built-in default), apply overrides, build. */

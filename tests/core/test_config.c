@@ -107,7 +107,7 @@ int main(void)
         expect_error("camera key before the bodies", "{type: sphere, radius_m: 500}",
                      "{type: mesh, file: nowhere.obj, unit: km}", cam, 1, "camera.widht_px: unknown key", NULL);
         const char *top[] = {"lights=1"};
-        expect_error("unknown top-level key", NULL, NULL, top, 1, "lights: unknown key (the top level takes: bodies,",
+        expect_error("unknown top-level key", NULL, NULL, top, 1, "lights: unknown key (the top level takes: camera, sun, render, bodies,",
                      NULL);
     }
     {
