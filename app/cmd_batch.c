@@ -325,13 +325,6 @@ int main(int argc, char **argv)
         free(rows);
         return 1;
     }
-    char probe[16];
-    snprintf(probe, sizeof probe, "f.%s", ext);
-    if (nc_image_prepare(probe) < 0) {
-        free(sets);
-        free(rows);
-        return nc_cli_fail();
-    }
     struct nc_scene base;
     struct nc_camsys cs;
     struct nc_sky sky;
@@ -355,6 +348,10 @@ int main(int argc, char **argv)
     int32_t *rock = geometry ? malloc(plane * sizeof *rock) : NULL;
     if (geometry && (!geom || !rock))
         rc = nc_error(-ENOMEM, "out of memory for the geometry planes");
+    char probe[16]; /* the image library now, not at the first frame; after the configuration */
+    snprintf(probe, sizeof probe, "f.%s", ext);
+    if (rc >= 0)
+        rc = nc_image_prepare(probe);
     long done = 0, skipped = 0, mine = 0;
     double t_all = now_s();
     for (long i = 0; i < nrows && rc >= 0; i++) {

@@ -104,15 +104,16 @@ int main(int argc, char **argv)
                 !nc_image_is_fits(out) ? "applies to .fits output only" : nc_errmsg());
         goto out;
     }
-    if (nc_image_prepare(out) < 0) {
-        fprintf(stderr, "navcam expose: %s\n", nc_errmsg());
-        goto out;
-    }
     struct nc_camera geom;
     struct nc_camsys cs;
     rc = 1;
     if (nc_camsys_load(cam_path, sets, nsets, &geom, &cs) < 0) {
         fprintf(stderr, "navcam expose: %s\n", nc_errmsg());
+        goto out;
+    }
+    if (nc_image_prepare(out) < 0) { /* the image library now, after the configuration */
+        fprintf(stderr, "navcam expose: %s\n", nc_errmsg());
+        nc_camsys_free(&cs);
         goto out;
     }
     if (T < 0)

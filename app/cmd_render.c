@@ -165,10 +165,6 @@ int main(int argc, char **argv)
         free(sets);
         return 1;
     }
-    if (nc_image_prepare(out) < 0) {
-        free(sets);
-        return nc_cli_fail();
-    }
     struct nc_scene scene;
     struct nc_camsys cs;
     struct nc_sky sky;
@@ -187,6 +183,14 @@ int main(int argc, char **argv)
         return nc_cli_fail();
     }
     double t1 = now_ms();
+    /* The image library now (OpenImageIO for EXR, TIFF, PNG), not after the
+     * render; after the configuration, whose mistakes need none of it. */
+    if ((rc = nc_image_prepare(out)) < 0) {
+        nc_renderer_free(&r);
+        nc_scene_free(&scene);
+        nc_sky_free(&sky);
+        return nc_cli_fail();
+    }
     struct nc_shot_info info;
     const struct nc_image_attr *extra = rows ? &row_attr : NULL;
     rc = nc_shot(&r, &scene, &cs, &sky, q, exposure, frame_no, out, extra, rows ? 1 : 0, &info);

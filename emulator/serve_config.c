@@ -16,8 +16,9 @@ const char *const nc__serve_mode_names[] = {"lockstep", "freerun", "trigger", NU
  * client's TriggerSoftware) takes only the common keys. */
 static const struct nc_param software_params[] = {NC_P_END};
 
-/* `serve.trigger`: a line driver, or the built-in software source (check:
- * its options only). */
+/* `serve.trigger`: a line driver, or the built-in software source. check:
+ * a line driver's options are checked, not opened (the software source
+ * opens nothing; its settings are set again by the real pass). */
 static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr, int check)
 {
     int rc, builtin = 0;

@@ -35,9 +35,10 @@ int nc_image_fits_row_order_ok(const char *word);
 int nc_image_format_ok(const char *path, int *is_float);
 /* Load now what reading or writing path's format needs: EXR, TIFF and PNG
  * go through OpenImageIO, a module loaded on first use (its libraries take
- * about 0.4 s to load). A program that will write such files calls this at
- * its start, so that a missing module fails before any work and the first
- * frame does not wait. 0, or an error naming where the module was looked for. */
+ * about 0.4 s to load). A program that will write such files calls this
+ * once its configuration is read, before it renders, so that a missing
+ * module fails before that work and the first frame does not wait. 0, or
+ * an error naming where the module was looked for. */
 int nc_image_prepare(const char *path);
 /* Write a single-channel image; *preview_scale (may be NULL) receives the
  * value that 65535 stands for in a 16-bit preview, 0 for float formats. */

@@ -82,8 +82,8 @@ static double fbm(const struct relief *r, const double *p)
     return h;
 }
 
-/* The octaves' amplitudes, once (a pow() per octave and vertex was about a
- * twentieth of a relief scene's start). */
+/* The octaves' amplitudes, once (a pow() per octave and vertex was 6 % of
+ * the samples of bennu_rubble.yaml's start, perf). */
 static void octaves(struct relief *r)
 {
     r->noct = 0;

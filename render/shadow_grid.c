@@ -23,7 +23,11 @@ int nc_shadow_grid_closed(const double *v, size_t nv, const uint32_t *tri, size_
      * vertex << 1 | direction): a counting sort, whose writes follow the
      * mesh's own vertex order (a hash table of edges made every one a cache
      * miss: 2.0 s for 5.2 million triangles). Closed: in every bucket, each
-     * other vertex comes as often with one direction as with the other. */
+     * other vertex comes as often with one direction as with the other.
+     * Subdivision sorts half-edges the same way (mesh_geom.c) but needs each
+     * one's index, in 64-bit entries; through that one function this check
+     * took 1.1-1.2 s against 0.52-0.59 s with its 32-bit entries (5.2
+     * million triangles, three runs each), so it keeps its own. */
     if (nt == 0 || nv == 0 || nv > (size_t)INT32_MAX || nt > (size_t)UINT32_MAX / 3)
         return 0; /* not proven: such a mesh is traced without the grid */
     uint32_t *start = calloc(nv + 1, sizeof *start), *at = malloc(nv * sizeof *at), *e = malloc(3 * nt * sizeof *e);

@@ -68,6 +68,8 @@ loaded() { LD_DEBUG=files "$@" 2>&1 >/dev/null | grep -c 'file=.*\(OpenImageIO\|
 [ "$(loaded "$navcam" render --help)" = 0 ] && ok || bad "navcam render --help loads OpenImageIO"
 [ "$(loaded "$navcam" render -o "$tmp/lazy.fits" "${small[@]}")" = 0 ] && ok || bad "a FITS render loads OpenImageIO"
 [ "$(loaded "$navcam" render -o "$tmp/lazy.png" "${small[@]}")" -ge 2 ] && ok || bad "a PNG render does not load OpenImageIO"
+[ "$(loaded "$navcam" render -o "$tmp/lazy.png" "${small[@]}" --set render.samples=4)" = 0 ] && ok ||
+  bad "a PNG render's configuration error loads OpenImageIO"
 expect 0 "wrote $tmp/lazy.png" -- "$navcam" render -o "$tmp/lazy.png" "${small[@]}"
 expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio, usb)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
