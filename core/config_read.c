@@ -217,23 +217,29 @@ static struct nc_cfg_node *first_unused(struct nc_cfg_node *n)
     return NULL;
 }
 
-/* Levenshtein distance of two keys (a few dozen characters). */
+/* Edit distance of two keys (a few dozen characters): insertions,
+ * deletions, substitutions and swaps of two neighbours (hurts: hurst)
+ * count one each, as optimal string alignment. */
 static size_t edits(const char *a, const char *b)
 {
-    size_t la = strlen(a), lb = strlen(b), row[65];
+    size_t la = strlen(a), lb = strlen(b), r0[65], r1[65], r2[65], *prev = r0, *row = r1, *back = r2;
     if (la > 64 || lb > 64)
         return 99;
     for (size_t j = 0; j <= lb; j++)
         row[j] = j;
     for (size_t i = 1; i <= la; i++) {
-        size_t diag = row[0];
+        size_t *t = back;
+        back = prev, prev = row, row = t; /* back: row i - 2, prev: row i - 1 */
         row[0] = i;
         for (size_t j = 1; j <= lb; j++) {
-            const size_t up = row[j], sub = diag + (a[i - 1] != b[j - 1]);
-            row[j] = up + 1 < row[j - 1] + 1 ? up + 1 : row[j - 1] + 1;
-            if (sub < row[j])
-                row[j] = sub;
-            diag = up;
+            size_t d = prev[j - 1] + (a[i - 1] != b[j - 1]);
+            if (prev[j] + 1 < d)
+                d = prev[j] + 1;
+            if (row[j - 1] + 1 < d)
+                d = row[j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && back[j - 2] + 1 < d)
+                d = back[j - 2] + 1;
+            row[j] = d;
         }
     }
     return row[lb];

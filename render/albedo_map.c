@@ -55,6 +55,8 @@ static int from_config(struct nc_cfg_node *map, int signed_values, struct nc_alb
         (rc = nc_cfg_enum(map, "lon_direction", dirs, &dir)) < 0 ||
         (rc = nc_cfg_double(map, "scale", signed_values ? -1e9 : 0, 1e9, &scale)) < 0)
         return rc;
+    if (!out) /* the keys alone */
+        return 0;
     const struct nc_cfg_node *fn = nc_cfg_get(map, "file");
     char path[4096];
     nc_cfg_resolve_path(fn, file, path, sizeof path);

@@ -27,7 +27,8 @@ int nc_albedo_map_load(const char *path, double lon_left_deg, int east, double s
  * east), scale (default 1). */
 int nc_albedo_map_from_config(struct nc_cfg_node *map, struct nc_albedo_map **out);
 /* The same map read as elevations (scene_dem.c): values of any sign, scale
- * in metres per image unit (default 1), sampled by nc_albedo_map_factor. */
+ * in metres per image unit (default 1), sampled by nc_albedo_map_factor.
+ * out NULL: its keys read and checked, no image loaded. */
 int nc_elevation_map_from_config(struct nc_cfg_node *map, struct nc_albedo_map **out);
 /* Albedo factor (or elevation) at body-fixed point p (any length, not the origin). */
 double nc_albedo_map_factor(const struct nc_albedo_map *m, struct nc_vec3 p);

@@ -67,13 +67,14 @@ const char nc_default_scene_yaml[] =
 
 static const char *const shape_names[] = {"sphere", "ellipsoid", "mesh", "asteroid", "dem", "globe", NULL};
 
-static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+/* dry: the keys read and checked, nothing loaded or built */
+static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
 {
     int type = 0, rc;
     if ((rc = nc_cfg_enum(sh, "type", shape_names, &type)) <= 0)
         return rc ? rc : nc_cfg_missing(sh, "type", "sphere, ellipsoid, mesh, asteroid, dem or globe");
     if (type >= 4) /* dem, globe: meshes from elevation data */
-        return nc__scene_dem_from_config(sh, type == 5, b);
+        return nc__scene_dem_from_config(sh, type == 5, b, dry);
     b->shape = (enum nc_shape_type)type;
     switch (b->shape) {
     case NC_SHAPE_SPHERE: {
@@ -106,8 +107,8 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
             ap.subdivisions = (int)v;
         if ((rc = nc_cfg_seed(sh, "seed", &ap.seed)) < 0)
             return rc;
-        if ((rc = nc_cfg_double(sh, "lump_amplitude", 0, 0.5, &ap.lump_amplitude)) < 0)
-            return rc;
+        if ((rc = nc_cfg_double(sh, "lump_amplitude", 0, 0.5, &ap.lump_amplitude)) < 0 || dry)
+            return rc < 0 ? rc : 0;
         if ((rc = nc_mesh_asteroid(&ap, &b->mesh)) < 0)
             return rc;
         b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
@@ -122,8 +123,8 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
             return rc ? rc : nc_cfg_missing(sh, "file", "path of an OBJ or PLY mesh");
         if ((rc = nc_cfg_enum(sh, "unit", units, &unit)) <= 0)
             return rc ? rc : nc_cfg_missing(sh, "unit", "the mesh's length unit: m or km");
-        if ((rc = nc_cfg_double(sh, "scale", 1e-9, 1e9, &scale)) < 0)
-            return rc;
+        if ((rc = nc_cfg_double(sh, "scale", 1e-9, 1e9, &scale)) < 0 || dry)
+            return rc < 0 ? rc : 0;
         char path[4096];
         nc_cfg_resolve_path(nc_cfg_get(sh, "file"), file, path, sizeof path);
         if ((rc = nc_mesh_load(path, scale * (unit ? 1000.0 : 1.0), &b->mesh)) < 0)
@@ -135,7 +136,11 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     return 0;
 }
 
-static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body *b)
+/* A body's name, material and pose, and every key of its shape and surface
+ * detail read and checked with nothing built (a dry pass on a copy): then
+ * a mistake anywhere in it, an unknown key included, is reported before
+ * the seconds its build can take. */
+static int body_read(struct nc_cfg *cfg, struct nc_cfg_node *item, int index, struct nc_body *b)
 {
     int rc;
     item->used = 1;
@@ -150,9 +155,8 @@ static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body 
     struct nc_cfg_node *sh, *mat;
     if ((rc = nc_cfg_map(item, "shape", &sh)) <= 0)
         return rc ? rc : nc_cfg_missing(item, "shape", "a map with 'type'");
-    if ((rc = shape_from_config(sh, b)) < 0)
-        return rc;
-    if ((rc = nc__scene_detail_from_config(item, sh, b)) < 0)
+    struct nc_body dry = *b;
+    if ((rc = shape_from_config(sh, &dry, 1)) < 0 || (rc = nc__scene_detail_from_config(item, sh, &dry, 1)) < 0)
         return rc;
     if ((rc = nc_cfg_map(item, "material", &mat)) <= 0)
         return rc ? rc : nc_cfg_missing(item, "material", "a map with model (or preset) and parameters");
@@ -165,7 +169,15 @@ static int body_from_config(struct nc_cfg_node *item, int index, struct nc_body 
         (rc = nc_cfg_vec3(item, "velocity_m_s", &b->velocity_m_s)) < 0 ||
         (rc = nc_cfg_vec3(item, "angular_velocity_rad_s", &b->angular_velocity_rad_s)) < 0)
         return rc;
-    return 0;
+    return nc_cfg_check_unused_in(cfg, item);
+}
+
+/* The body's shape and surface detail, built (body_read first). */
+static int body_build(struct nc_cfg_node *item, struct nc_body *b)
+{
+    struct nc_cfg_node *sh = nc_cfg_get(item, "shape");
+    int rc = shape_from_config(sh, b, 0);
+    return rc < 0 ? rc : nc__scene_detail_from_config(item, sh, b, 0);
 }
 
 /* sum_dir: the camera's SUM file gives the direction (NULL: it does not). */
@@ -316,11 +328,16 @@ int nc_scene_read_bodies(struct nc_cfg *cfg, struct nc_scene *s)
         return nc_cfg_error(bodies, "expected 1 to %d bodies, got %zu", NC_MAX_BODIES, bodies->nchild);
     for (size_t i = 0; i < bodies->nchild; i++) {
         s->nbodies = (int)i + 1;
-        if ((rc = body_from_config(bodies->child[i], (int)i, &s->body[i])) < 0) {
+        if ((rc = body_read(cfg, bodies->child[i], (int)i, &s->body[i])) < 0) {
             nc_scene_free(s);
             return rc;
         }
     }
+    for (size_t i = 0; i < bodies->nchild; i++)
+        if ((rc = body_build(bodies->child[i], &s->body[i])) < 0) {
+            nc_scene_free(s);
+            return rc;
+        }
     if (s->camera.from_sumfile) { /* its pose is in bodies[0]'s body-fixed frame */
         const struct nc_body *b0 = &s->body[0];
         s->camera.position_m = nc_v3_add(b0->position_m, nc_quat_rotate(b0->attitude_q, s->camera.position_m));

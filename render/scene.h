@@ -109,9 +109,10 @@ int nc_scene_from_config(struct nc_cfg *cfg, struct nc_scene *s);
  * sections (optics, sensor, ...) and check afterwards. */
 int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s);
 /* nc_scene_read in its two steps: the camera, Sun and render sections, each
- * checked for unknown keys (they have no other reader); then the bodies,
- * built (meshes, craters, rocks: seconds for a large scene). A caller reads
- * its own sections between the two, so that a mistake in any of them is
+ * checked for unknown keys (they have no other reader); then the bodies:
+ * every body's keys read and checked (nothing built), then each built
+ * (meshes, craters, rocks: seconds for a large scene). A caller reads its
+ * own sections between the two, so that a mistake in any of them is
  * reported before the build. Each frees s on failure. */
 int nc_scene_read_view(struct nc_cfg *cfg, struct nc_scene *s);
 int nc_scene_read_bodies(struct nc_cfg *cfg, struct nc_scene *s);
@@ -121,13 +122,15 @@ int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *s
 int nc_scene_load(const char *path, const char *const *sets, int nsets, struct nc_scene *s);
 void nc_scene_free(struct nc_scene *s);
 /* A body's craters and boulders from its config item and shape node, after
- * its shape is built (scene_detail.c; internal to scene*.c). */
-int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b);
+ * its shape is built (scene_detail.c; internal to scene*.c). dry: every key
+ * read and checked, nothing built (the shape was read dry too). */
+int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b, int dry);
 /* The error just set (by a loader or generator) restated at config node n,
  * with its file and line (scene_detail.c). */
 int nc__scene_error_at(const struct nc_cfg_node *n);
-/* Shapes `dem` and `globe` as meshes (scene_dem.c; internal to scene*.c). */
-int nc__scene_dem_from_config(struct nc_cfg_node *shape, int globe, struct nc_body *b);
+/* Shapes `dem` and `globe` as meshes (scene_dem.c; internal to scene*.c);
+ * dry: their keys alone, no image read. */
+int nc__scene_dem_from_config(struct nc_cfg_node *shape, int globe, struct nc_body *b, int dry);
 
 /* The Sun's angular radius seen from bodies[0], radians. */
 double nc_scene_sun_radius_rad(const struct nc_scene *s);

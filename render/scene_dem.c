@@ -15,7 +15,7 @@
 #include "render/albedo_map.h"
 #include "render/image_io.h"
 
-static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
 {
     const char *file;
     int rc;
@@ -47,6 +47,8 @@ static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b)
         if ((rc = nc_cfg_double(sph, "lon_deg", -360, 360, &p.lon_deg)) <= 0)
             return rc ? rc : nc_cfg_missing(sph, "lon_deg", "east longitude of the tile's centre");
     }
+    if (dry)
+        return 0;
     char path[4096];
     nc_cfg_resolve_path(nc_cfg_get(sh, "file"), file, path, sizeof path);
     float *h;
@@ -63,7 +65,7 @@ static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     return 0;
 }
 
-static int globe_from_config(struct nc_cfg_node *sh, struct nc_body *b)
+static int globe_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
 {
     double r;
     long sub = 7;
@@ -76,8 +78,8 @@ static int globe_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     if ((rc = nc_cfg_map(sh, "elevation_map", &em)) <= 0)
         return rc ? rc : nc_cfg_missing(sh, "elevation_map", "an equirectangular elevation image (file, scale: m per unit)");
     struct nc_albedo_map *map;
-    if ((rc = nc_elevation_map_from_config(em, &map)) < 0)
-        return rc;
+    if ((rc = nc_elevation_map_from_config(em, dry ? NULL : &map)) < 0 || dry)
+        return rc < 0 ? rc : 0;
     rc = nc_mesh_globe(r, (int)sub, map, &b->mesh);
     nc_albedo_map_free(map);
     if (rc < 0)
@@ -88,8 +90,8 @@ static int globe_from_config(struct nc_cfg_node *sh, struct nc_body *b)
     return 0;
 }
 
-int nc__scene_dem_from_config(struct nc_cfg_node *sh, int globe, struct nc_body *b)
+int nc__scene_dem_from_config(struct nc_cfg_node *sh, int globe, struct nc_body *b, int dry)
 {
     b->shape = NC_SHAPE_MESH;
-    return globe ? globe_from_config(sh, b) : dem_from_config(sh, b);
+    return globe ? globe_from_config(sh, b, dry) : dem_from_config(sh, b, dry);
 }

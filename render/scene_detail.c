@@ -26,7 +26,7 @@ int nc__scene_error_at(const struct nc_cfg_node *n)
 /* `shape.craters` of a mesh or asteroid: a mean count of the default
  * population (a number), or a map of its parameters. An asteroid without
  * the key gets 100. */
-static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir)
+static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir, int dry)
 {
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
     if (!node && b->shape != NC_SHAPE_ASTEROID)
@@ -68,14 +68,17 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const 
             (rc = nc_cfg_double(map, "max_diameter_m", 1e-6, 2e7, &p.d_max_m)) < 0 ||
             (rc = nc_cfg_double(map, "depth_ratio", 0, 1, &p.depth_ratio)) < 0 ||
             (rc = nc_cfg_double(map, "rim_ratio", 0, 1, &p.rim_ratio)) < 0 ||
-            (rc = nc_cfg_double(map, "degradation", 0, 1, &p.degradation)) < 0)
+            (rc = nc_cfg_double(map, "degradation", 0, 1, &p.degradation)) < 0 ||
+            (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
             return rc;
+        if (dry) /* the diameters' defaults come from the mesh */
+            return 0;
         if (!(p.d_max_m > p.d_min_m))
             return nc_cfg_error(nc_cfg_get(map, "max_diameter_m") ? nc_cfg_get(map, "max_diameter_m") : map,
                                 "max_diameter_m (%g) must exceed min_diameter_m (%g)", p.d_max_m, p.d_min_m);
-        if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
-            return rc;
     }
+    if (dry)
+        return 0;
     if (count >= 0)
         p.c_per_km2 = nc_craters_density_for(&p, area_km2, count);
     struct nc_crater_field f;
@@ -101,7 +104,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const 
 
 /* `boulders:` of a body (docs/terrain.md): a preset or C and slope, the
  * diameter range, burial, shapes, the faces' roughness, seed. */
-static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
+static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b, int dry)
 {
     struct nc_cfg_node *map;
     int rc, has_c, has_slope;
@@ -143,7 +146,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
         p.shapes = (int)v;
     if ((rc = nc_cfg_double(map, "roughness_deg", 0, 45, &p.roughness_deg)) < 0)
         return rc;
-    if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
+    if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0 || dry)
         return rc;
     if ((rc = nc_boulders_generate(&b->mesh, &p, MAX_BOULDERS, &b->boulders)) < 0) {
         return nc__scene_error_at(map);
@@ -157,7 +160,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b)
 
 /* `shape.relief` of a mesh or asteroid: fBm relief below its resolution;
  * *base_normals the normals under it (nc_mesh_relief), NULL without relief. */
-static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double **base_normals)
+static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double **base_normals, int dry)
 {
     *base_normals = NULL;
     struct nc_cfg_node *map;
@@ -171,7 +174,7 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double 
         return rc ? rc : nc_cfg_missing(map, "edge_m", "the mean edge length to subdivide down to, metres");
     if ((rc = nc_cfg_double(map, "hurst", 0.01, 0.99, &p.hurst)) < 0 ||
         (rc = nc_cfg_double(map, "amplitude", 0, 100, &p.amplitude)) < 0 ||
-        (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
+        (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0 || dry)
         return rc;
     struct nc_relief_info info;
     if ((rc = nc_mesh_relief(&b->mesh, &p, NC_RELIEF_MAX_TRIANGLES, &info, base_normals)) < 0) {
@@ -185,7 +188,7 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double 
 }
 
 /* `albedo_variation:` of a body with a mesh (docs/terrain.md). */
-static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b)
+static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b, int dry)
 {
     struct nc_cfg_node *map;
     int rc;
@@ -201,7 +204,8 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b)
     if ((rc = nc_cfg_double(map, "rms", 0, 2, &p.rms)) < 0 ||
         (rc = nc_cfg_double(map, "largest_m", 1e-6, 1e9, &p.largest_m)) < 0 ||
         (rc = nc_cfg_double(map, "hurst", 0, 1, &p.hurst)) < 0 ||
-        (rc = nc_cfg_double(map, "rocks_rms", 0, 2, &p.rocks_rms)) < 0 || (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0)
+        (rc = nc_cfg_double(map, "rocks_rms", 0, 2, &p.rocks_rms)) < 0 || (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0 ||
+        dry)
         return rc;
     if (p.rocks_rms < 0)
         p.rocks_rms = p.rms;
@@ -215,7 +219,7 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b)
     return 0;
 }
 
-int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b)
+int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b, int dry)
 {
     static const char *const normals[] = {"flat", "smooth", NULL};
     int rc, smooth = 0;
@@ -227,13 +231,13 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
     /* Craters displace the relief along the surface under it, not along
      * its own rough normals (craters.h). */
     double *under = NULL;
-    rc = relief_from_config(shape, b, &under);
+    rc = relief_from_config(shape, b, &under, dry);
     if (rc >= 0)
-        rc = craters_from_config(shape, b, under);
+        rc = craters_from_config(shape, b, under, dry);
     free(under);
     if (rc < 0)
         return rc;
-    if ((rc = boulders_from_config(item, b)) < 0)
+    if ((rc = boulders_from_config(item, b, dry)) < 0)
         return rc;
-    return albedo_var_from_config(item, b);
+    return albedo_var_from_config(item, b, dry);
 }

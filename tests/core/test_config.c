@@ -106,6 +106,27 @@ int main(void)
         const char *cam[] = {"camera.widht_px=64"};
         expect_error("camera key before the bodies", "{type: sphere, radius_m: 500}",
                      "{type: mesh, file: nowhere.obj, unit: km}", cam, 1, "camera.widht_px: unknown key", NULL);
+        /* and every body's keys before any body is built: a mistake in its
+         * detail or material comes before its mesh is even opened */
+        const char *rocks[] = {"bodies.0.boulders={preset: bennu, min_diameterm: 1}"};
+        expect_error("boulder key before the mesh", "{type: sphere, radius_m: 500}",
+                     "{type: mesh, file: nowhere.obj, unit: km}", rocks, 1,
+                     "bodies[0].boulders.min_diameterm: unknown key; did you mean 'min_diameter_m'?", NULL);
+        const char *swap[] = {"bodies.0.shape.relief={edge_m: 1, hurts: 0.5}"};
+        expect_error("two letters swapped", "{type: sphere, radius_m: 500}",
+                     "{type: mesh, file: nowhere.obj, unit: km}", swap, 1,
+                     "bodies[0].shape.relief.hurts: unknown key; did you mean 'hurst'?", NULL);
+        const char *mat[] = {"bodies.0.material.A=2"};
+        expect_error("material before the mesh", "{type: sphere, radius_m: 500}",
+                     "{type: mesh, file: nowhere.obj, unit: km}", mat, 1, "bodies[0].material.A", "[0, 1]");
+        const char *second[] = {"bodies.1={shape: {type: sphere, radius_m: 5}, material: {model: lambert, A: 0.1}, "
+                                "position_m: [0, 0, 900], colour: red}"};
+        expect_error("second body before the first is built", "{type: sphere, radius_m: 500}",
+                     "{type: mesh, file: nowhere.obj, unit: km}", second, 1, "bodies[1].colour: unknown key", NULL);
+        const char *globe[] = {"bodies.0.shape={type: globe, radius_m: 1000, elevation_map: {file: nowhere.tif, "
+                               "scael: 1}}"};
+        expect_error("elevation map key before its image", NULL, NULL, globe, 1,
+                     "bodies[0].shape.elevation_map.scael: unknown key; did you mean 'scale'?", NULL);
         const char *top[] = {"lights=1"};
         expect_error("unknown top-level key", NULL, NULL, top, 1, "lights: unknown key (the top level takes: camera, sun, render, bodies,",
                      NULL);
