@@ -24,6 +24,8 @@ int nc_setup_load(const char *path, const char *const *sets, int nsets, struct n
             rc = nc_camsys_check_sections(&cfg);
         }
         if (rc >= 0)
+            rc = nc_scene_check_sections(&cfg);
+        if (rc >= 0)
             rc = nc_scene_read_bodies(&cfg, s);
         if (rc >= 0)
             rc = nc_cfg_check_unused(&cfg);

@@ -98,6 +98,17 @@ void nc_cfg_path(const struct nc_cfg_node *node, char *buf, size_t len)
         snprintf(buf, len, "(top level)");
 }
 
+void nc_cfg_where(const struct nc_cfg_node *node, char *buf, size_t len)
+{
+    char path[256];
+    nc_cfg_path(node, path, sizeof path);
+    const char *origin = node->origin ? node->origin : "config";
+    if (node->line > 0)
+        snprintf(buf, len, "%s:%d: %s", origin, node->line, path);
+    else
+        snprintf(buf, len, "%s: %s", origin, path);
+}
+
 static int vcfg_error(const struct nc_cfg_node *node, const char *key, const char *fmt, va_list ap)
 {
     char path[256], msg[512];

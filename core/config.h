@@ -77,6 +77,9 @@ int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...) __attribu
 int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected);
 /* Dotted path of a node, e.g. "bodies[0].shape.radius_m". */
 void nc_cfg_path(const struct nc_cfg_node *node, char *buf, size_t len);
+/* Where node came from and its path, as errors name it: "FILE:LINE: path",
+ * or "--set ARG: path" for a value set on the command line (no line). */
+void nc_cfg_where(const struct nc_cfg_node *node, char *buf, size_t len);
 /* Mark a node and everything below it as consumed (sections a reader
  * deliberately ignores). */
 void nc_cfg_mark_used(struct nc_cfg_node *node);
@@ -84,5 +87,8 @@ void nc_cfg_mark_used(struct nc_cfg_node *node);
 int nc_cfg_check_unused(struct nc_cfg *cfg);
 /* The same within node n (NULL: none), once its readers have run. */
 int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n);
+/* The same for map's own keys alone, not what lies below them: a section no
+ * reader takes, before the readers of the others have run. */
+int nc_cfg_check_unused_keys(struct nc_cfg *cfg, struct nc_cfg_node *map);
 
 #endif

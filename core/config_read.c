@@ -245,19 +245,22 @@ static size_t edits(const char *a, const char *b)
     return row[lb];
 }
 
-/* A map other than skip whose readers asked for key. */
-static const struct nc_cfg_node *asker(const struct nc_cfg_node *n, const char *key, const struct nc_cfg_node *skip)
+/* How many maps other than skip had their readers ask for key; *first the
+ * first of them in file order. */
+static int askers(const struct nc_cfg_node *n, const char *key, const struct nc_cfg_node *skip,
+                  const struct nc_cfg_node **first)
 {
+    int k = 0;
     if (n != skip)
         for (size_t i = 0; i < n->nasked; i++)
-            if (!strcmp(n->asked[i], key))
-                return n;
-    for (size_t i = 0; i < n->nchild; i++) {
-        const struct nc_cfg_node *w = asker(n->child[i], key, skip);
-        if (w)
-            return w;
-    }
-    return NULL;
+            if (!strcmp(n->asked[i], key)) {
+                if (!k++ && !*first)
+                    *first = n;
+                break;
+            }
+    for (size_t i = 0; i < n->nchild; i++)
+        k += askers(n->child[i], key, skip, first);
+    return k;
 }
 
 int nc_cfg_check_unused(struct nc_cfg *cfg)
@@ -266,6 +269,14 @@ int nc_cfg_check_unused(struct nc_cfg *cfg)
         return 0;
     cfg->root->used = 1;
     return nc_cfg_check_unused_in(cfg, cfg->root);
+}
+
+int nc_cfg_check_unused_keys(struct nc_cfg *cfg, struct nc_cfg_node *map)
+{
+    for (size_t i = 0; map && map->kind == NC_CFG_MAP && i < map->nchild; i++)
+        if (!map->child[i]->used)
+            return nc_cfg_check_unused_in(cfg, map->child[i]);
+    return 0;
 }
 
 int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
@@ -292,7 +303,10 @@ int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
         if ((la > lk && !strncmp(a, k, lk) && a[lk] == '_') || (lk > la && !strncmp(a, k, la) && k[la] == '_'))
             best = a;
     }
-    const struct nc_cfg_node *w = best ? NULL : asker(cfg->root, u->key, p);
+    /* a key that several sections read (a seed) names none of them */
+    const struct nc_cfg_node *w = NULL;
+    if (!best && askers(cfg->root, u->key, p, &w) != 1)
+        w = NULL;
     if (best)
         snprintf(hint, sizeof hint, "; did you mean '%s'?", best);
     else if (w) {

@@ -48,6 +48,8 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
     if (rc >= 0)
         rc = nc_sky_from_config(&cfg, &e->sky);
     if (rc >= 0)
+        rc = nc_scene_check_sections(&cfg);
+    if (rc >= 0)
         rc = nc_scene_read_bodies(&cfg, &e->scene);
     if (rc >= 0)
         rc = nc__serve_config(&cfg, e, dir, 0);

@@ -84,6 +84,7 @@ struct nc__client {
     unsigned gen;
     uint8_t buf[4 + NC_PROTO_MAX_BYTES]; /* requests not yet taken (lock-step back-pressure keeps them here) */
     size_t have;
+    uint32_t skip; /* bytes of a refused message still to come, to be passed over */
     uint8_t out[NC_SERVE_CLIENT_OUT_BYTES]; /* answers not yet sent (the client reads slowly) */
     size_t out_len;
 };

@@ -115,26 +115,52 @@ static void close_client(struct nc__emu *e, int i)
     e->clients[i].fd = -1;
     e->clients[i].gen++;
     e->clients[i].have = 0;
+    e->clients[i].skip = 0;
     e->clients[i].out_len = 0;
     pthread_mutex_unlock(&e->client_lock);
 }
 
+/* Pass over what is left of a refused message in a client's buffer: 0
+ * when it is all gone. */
+static uint32_t skip_refused(struct nc__client *c)
+{
+    const size_t k = c->skip < c->have ? c->skip : c->have;
+    memmove(c->buf, c->buf + k, c->have - k);
+    c->have -= k;
+    c->skip -= (uint32_t)k;
+    return c->skip;
+}
+
+/* A length prefix beyond this cannot have framed a NavCam message: the
+ * stream is not NavCam's, or lost its place. */
+#define SKIP_MAX_BYTES 65536u
+
 /* Take one whole length-prefixed message from a client's buffer: 1 when one
- * was taken, 0 when none is complete or lock-step has no room for it (the
- * request waits in the buffer: back-pressure), -1 when the client was
- * disconnected. */
+ * was taken (or a refused one begun to be passed over), 0 when none is
+ * complete or lock-step has no room for it (the request waits in the
+ * buffer: back-pressure), -1 when the client was disconnected. */
 static int client_take(struct nc__emu *e, int i)
 {
     struct nc__client *c = &e->clients[i];
+    if (c->skip && skip_refused(c))
+        return 0;
     if (c->have < 4)
         return 0;
     uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 | (uint32_t)c->buf[3] << 24;
     if (len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) {
-        /* The stream cannot be resynchronised: count and disconnect. */
+        /* Too long or too short to be a message, but the prefix still says
+         * where the next one starts: counted, and its bytes passed over. */
         log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
         atomic_fetch_add(&e->received, 1);
-        close_client(e, i);
-        return -1;
+        if (len > SKIP_MAX_BYTES) {
+            nc_log_warn("emulator", "a TCP client's length prefix says %u bytes (at most %d): not a NavCam stream; "
+                        "disconnected", len, NC_PROTO_MAX_BYTES);
+            close_client(e, i);
+            return -1;
+        }
+        c->skip = 4 + len;
+        skip_refused(c);
+        return 1;
     }
     if (c->have < 4 + len || (e->mode == NC__MODE_LOCKSTEP && nc__serve_queue_full(e)))
         return 0;
@@ -219,6 +245,7 @@ static void accept_client(struct nc__emu *e)
     pthread_mutex_lock(&e->client_lock);
     e->clients[slot].fd = fd;
     e->clients[slot].have = 0;
+    e->clients[slot].skip = 0;
     e->clients[slot].out_len = 0;
     pthread_mutex_unlock(&e->client_lock);
 }
@@ -281,9 +308,13 @@ void nc__serve_answer_unread(struct nc__emu *e)
     for (int i = 0; i < e->max_clients; i++) {
         struct nc__client *c = &e->clients[i];
         while (c->fd >= 0) {
-            while (c->have >= 4) {
+            while (!(c->skip && skip_refused(c)) && c->have >= 4) {
                 uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
                                (uint32_t)c->buf[3] << 24;
+                if ((len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) && len <= SKIP_MAX_BYTES) {
+                    c->skip = 4 + len; /* refused, passed over (client_take) */
+                    continue;
+                }
                 if (len > NC_PROTO_MAX_BYTES || c->have < 4 + len)
                     break;
                 struct nc_pose_msg m;

@@ -3,6 +3,7 @@
  * counters; changes nothing. */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 #include <stdlib.h>
 
 #include "core/log.h"
@@ -79,15 +80,17 @@ void nc__serve_stats_line(struct nc__emu *e, double elapsed_s)
     for (int i = 0; i < NC__DROP_COUNT; i++)
         drp += atomic_load(&e->dropped[i]);
     unsigned long delivered = atomic_load(&e->delivered);
+    char why[320] = ""; /* every reason, by its name in the summary JSON */
+    for (int i = 0; i < NC__DROP_COUNT; i++) {
+        const size_t n = strlen(why);
+        snprintf(why + n, sizeof why - n, "%s%s %lu", i ? ", " : "", nc__serve_drop_names[i],
+                 atomic_load(&e->dropped[i]));
+    }
     nc_log_info("emulator",
-                "%.1f s: frames %lu (%.2f fps), dropped %lu (overrun %lu, queue %lu, stale %lu, no pose %lu, "
-                "output %lu), messages %lu, rejected %lu, latency p50 %.2f ms p99 %.2f ms (render+camera p50 %.2f "
-                "ms, waiting p99 %.2f ms)",
-                elapsed_s, delivered, elapsed_s > 0 ? delivered / elapsed_s : 0.0, drp,
-                atomic_load(&e->dropped[NC__DROP_OVERRUN]), atomic_load(&e->dropped[NC__DROP_QUEUE_FULL]),
-                atomic_load(&e->dropped[NC__DROP_STALE_POSE]), atomic_load(&e->dropped[NC__DROP_NO_POSE]),
-                atomic_load(&e->dropped[NC__DROP_OUTPUT_BUSY]), atomic_load(&e->received), rej, p.p50[Q_LAT],
-                p.p99[Q_LAT], p.p50[Q_REN], p.p99[Q_WAIT]);
+                "%.1f s: frames %lu (%.2f fps), dropped %lu (%s), messages %lu, rejected %lu, latency p50 %.2f ms "
+                "p99 %.2f ms (render+camera p50 %.2f ms, waiting p99 %.2f ms)",
+                elapsed_s, delivered, elapsed_s > 0 ? delivered / elapsed_s : 0.0, drp, why,
+                atomic_load(&e->received), rej, p.p50[Q_LAT], p.p99[Q_LAT], p.p50[Q_REN], p.p99[Q_WAIT]);
 }
 
 void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f)

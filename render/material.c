@@ -175,13 +175,13 @@ int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
     }
     if (!strcmp(m->model->name, "lommel_seeliger") && m->p[0] < NC_LS_W_SUSPECT) {
         const struct nc_cfg_node *w = nc_cfg_get(map, "w");
-        char path[256];
-        nc_cfg_path(w ? w : map, path, sizeof path);
+        char where[512];
+        nc_cfg_where(w ? w : map, where, sizeof where);
         nc_log_warn("scene",
-                    "%s:%d: %s = %g (lommel_seeliger) gives a geometric albedo of %.4f, darker than any measured "
+                    "%s = %g (lommel_seeliger) gives a geometric albedo of %.4f, darker than any measured "
                     "small body: Lommel-Seeliger's w is not a single-scattering albedo. For a body of geometric "
                     "albedo p use w = 8 p (Bennu, p = 0.044: w = 0.35), or Hapke with its w (docs/reflectance.md)",
-                    (w ? w : map)->origin, (w ? w : map)->line, path, m->p[0], m->p[0] / 8);
+                    where, m->p[0], m->p[0] / 8);
     }
     return 0;
 }

@@ -346,6 +346,12 @@ int nc_scene_read_bodies(struct nc_cfg *cfg, struct nc_scene *s)
     return 0;
 }
 
+int nc_scene_check_sections(struct nc_cfg *cfg)
+{
+    nc_cfg_get(cfg->root, "bodies"); /* read next */
+    return nc_cfg_check_unused_keys(cfg, cfg->root);
+}
+
 int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s)
 {
     int rc = nc_scene_read_view(cfg, s);
@@ -371,8 +377,13 @@ int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *s
             nc_cfg_free(&def);
         }
     }
-    for (int i = 0; rc >= 0 && i < nsets; i++)
+    for (int i = 0; rc >= 0 && i < nsets; i++) {
+        if (!strncmp(sets[i], "base=", 5) || !strncmp(sets[i], "base.", 5)) /* too late: the file is laid already */
+            return nc_error(NC_EUSAGE, "--set %s: base is a scene file's key (base: builtin:default lays the file "
+                                       "over the built-in default scene; docs/config.md), not a --set one",
+                            sets[i]);
         rc = nc_cfg_set(cfg, sets[i]);
+    }
     return rc;
 }
 

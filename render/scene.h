@@ -116,6 +116,10 @@ int nc_scene_read(struct nc_cfg *cfg, struct nc_scene *s);
  * reported before the build. Each frees s on failure. */
 int nc_scene_read_view(struct nc_cfg *cfg, struct nc_scene *s);
 int nc_scene_read_bodies(struct nc_cfg *cfg, struct nc_scene *s);
+/* Between the two, once the caller has read its own sections: a top-level
+ * key that no reader takes (a misspelt section) is an error then, before
+ * the bodies are built. */
+int nc_scene_check_sections(struct nc_cfg *cfg);
 /* Load file (NULL = built-in default scene) and apply overrides. */
 int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *sets, int nsets);
 /* Convenience: load file (NULL = built-in default), apply overrides, build. */

@@ -29,8 +29,12 @@ int nc__scene_error_at(const struct nc_cfg_node *n)
 static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir, int dry)
 {
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
-    if (!node && b->shape != NC_SHAPE_ASTEROID)
-        return 0;
+    if (!node && b->shape != NC_SHAPE_ASTEROID) {
+        const struct nc_cfg_node *seed = nc_body_is_mesh(b) ? nc_cfg_get(sh, "seed") : NULL;
+        return seed ? nc_cfg_error(seed, "a mesh's seed is its craters' (docs/config.md): give shape.craters too, "
+                                         "or remove the seed")
+                    : 0;
+    }
     if (node && !nc_body_is_mesh(b))
         return nc_cfg_error(node, "craters need a mesh or asteroid shape");
     struct nc_crater_params p;

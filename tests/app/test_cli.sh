@@ -81,14 +81,17 @@ for s in "serve.frame_rate=5" "serve.trigger={driver: timer, rate_hz: 1e9}" "out
     *) bad "serve --set $s: $out" ;; esac
 done
 expect 1 "serve.frame_rate: unknown key; did you mean 'frame_rate_hz'?" -- "$navcam" serve --set serve.frame_rate=5
-# Every section but the bodies is read and checked before the bodies are built.
-for s in "camera.widht_px=64" "render.samples=4" "optics.f_numbr=4" "sensor.read_noise=5" "exposure.time=1"; do
+# Every section, a misspelt one and the bodies' keys included, is read and
+# checked before the bodies are built.
+for s in "camera.widht_px=64" "render.samples=4" "optics.f_numbr=4" "sensor.read_noise=5" "exposure.time=1" \
+         "rendr.seed=1" "bodies.0.shape.craters.sloep=2" "bodies.0.material.theta_bra=20"; do
   for c in "render -o $tmp/early.fits" serve; do
     out=$("$navcam" $c --set "$s" 2>&1)
     case "$out" in *"scene: body"*) bad "$c --set $s built the scene before its error: $out" ;; *"unknown key; did you mean"*) ok ;;
       *) bad "$c --set $s: $out" ;; esac
   done
 done
+expect 1 "base is a scene file's key" -- "$navcam" render -o "$tmp/early.fits" --set base=builtin:default
 expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
 expect 1 "serve.trigger.activation" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: timer, activation: sideways}"

@@ -91,14 +91,36 @@ s.sendto(good, ("127.0.0.1", port))
 s.sendto(pc.encode(pc.POSE, 4, 0, 5 * 10**8, (0, -6000, 0)), ("127.0.0.1", port))  # time went backwards
 PY
 sleep 0.5
+# Over TCP the length prefix frames each message: a message too short or too
+# long is counted and passed over, and the connection goes on; a prefix past
+# 64 KiB is no NavCam stream, and the connection is closed.
+python3 - "$src/examples" "$tcp" <<'PY' && ok || bad "TCP: a refused message's bytes not passed over"
+import socket, struct, sys
+sys.path.insert(0, sys.argv[1])
+import python_client as pc
+s = socket.create_connection(("127.0.0.1", int(sys.argv[2])))
+s.settimeout(60)
+cap = pc.encode(pc.POSE, 7, pc.CAPTURE, 3 * 10**9, (0, -6000, 0), (0.7071067811865476, -0.7071067811865476, 0, 0))
+short, long_ = bytes(20), bytes(1104)
+s.sendall(struct.pack("<I", len(short)) + short + struct.pack("<I", len(long_)) + long_ + struct.pack("<I", len(cap)) + cap)
+seq, frame, status = pc.read_frame_answer(s)
+assert (seq, status) == (7, 0), (seq, frame, status)
+s.sendall(struct.pack("<I", 100000) + bytes(64))
+assert s.recv(1) == b"", "still connected after a 100000-byte prefix"
+print("TCP: truncated and oversized messages passed over, the capture after them answered; a 100000-byte prefix disconnects")
+PY
 "$navcam" pose send --tcp --port "$tcp" --capture --time 2 --position 0,-6000,0 --attitude 1,0,0,0 \
   > "$tmp/reject/pose.out" 2>&1 && grep -q "delivered" "$tmp/reject/pose.out" && ok \
   || bad "no frame after the rejections: $(cat "$tmp/reject/pose.out")"
 stop
-for r in "truncated" "oversized" "bad magic" "unsupported version" "unknown message type" "bad CRC" \
+for r in "bad magic" "unsupported version" "unknown message type" "bad CRC" \
          "NaN or infinite value" "quaternion not of unit length" "simulation time went backwards"; do
   [ "$(json "$tmp/reject/stats.json" "d['rejected']['$r']")" = 1 ] && ok || bad "rejection '$r' not counted once"
 done
+# truncated: one datagram, one TCP message; oversized: those and the 100000-byte prefix
+[ "$(json "$tmp/reject/stats.json" "d['rejected']['truncated']")" = 2 ] && ok || bad "truncated not counted twice"
+[ "$(json "$tmp/reject/stats.json" "d['rejected']['oversized']")" = 3 ] && ok || bad "oversized not counted 3 times"
+grep -q "not a NavCam stream; disconnected" "$tmp/reject/serve.log" && ok || bad "the disconnect not logged"
 grep -q "rejected a message from UDP" "$tmp/reject/serve.log" && ok || bad "rejections not logged"
 [ "$(grep -c "rejected a message" "$tmp/reject/serve.log")" -le 2 ] && ok || bad "rejection log not rate-limited"
 
