@@ -91,8 +91,14 @@ struct gige {
     int running, sending;
     double poll_hz;
     struct nc_acquisition applied; /* what the registers said last time */
+    uint32_t held[6];                /* the image registers' last values that held (held_reg) */
     unsigned long rejected_settings;
 };
+
+/* The image registers a client writes: their values are checked together. */
+static const uint32_t held_reg[6] = {ARV_FAKE_CAMERA_REGISTER_WIDTH,    ARV_FAKE_CAMERA_REGISTER_HEIGHT,
+                                     ARV_FAKE_CAMERA_REGISTER_X_OFFSET, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET,
+                                     ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, REG_PACKET_SIZE};
 
 static uint32_t reg_get(struct gige *g, uint32_t a)
 {
@@ -162,20 +168,71 @@ static int same(const struct nc_acquisition *a, const struct nc_acquisition *b)
            a->trigger_delay_s == b->trigger_delay_s;
 }
 
-/* Client-written settings to the emulator, when they changed. */
+static void refused(struct gige *g, const char *what)
+{
+    if (g->rejected_settings++ == 0)
+        nc_log_warn("output/gige", "a client's setting was refused (the registers show what holds): %s", what);
+}
+
+/* Aravis's device stores whatever a client writes (GenICam's ranges are
+ * the client's to check, and Aravis leaves them unchecked by default): the
+ * device checks them here, as a camera's firmware would. The read-only
+ * registers get their values back; an image setting outside the XML's
+ * ranges (the region beyond the sensor, a packet size outside 576..65000
+ * or off its step of 4, a pixel format or trigger enumeration that is no
+ * entry) gets the last one that held. */
+static void check_registers(struct gige *g)
+{
+    /* and AcquisitionMode, whose one entry is Continuous (1) */
+    const uint32_t ro[4] = {ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT,
+                            REG_META_ROWS, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE};
+    const uint32_t ro_value[4] = {(uint32_t)g->W, (uint32_t)g->H, (uint32_t)g->meta_rows, 1};
+    for (int i = 0; i < 4; i++)
+        if (reg_get(g, ro[i]) != ro_value[i]) {
+            reg_set(g, ro[i], ro_value[i]);
+            refused(g, "a write to SensorWidth, SensorHeight, MetadataRows (read only) or AcquisitionMode");
+        }
+    uint32_t v[6];
+    for (int i = 0; i < 6; i++)
+        v[i] = reg_get(g, held_reg[i]);
+    const uint32_t W = (uint32_t)g->W, H = (uint32_t)(g->H + g->meta_rows), min_w = W < 16 ? W : 16,
+                   packet = v[5] & 0xffff;
+    const int ok = v[0] >= min_w && v[0] <= W && v[2] <= W - v[0] && v[1] >= 1 && v[1] <= H && v[3] <= H - v[1] &&
+                   (v[4] == PF_MONO8 || v[4] == PF_MONO12 || v[4] == PF_MONO16) && packet >= 576 &&
+                   packet <= 65000 && packet % 4 == 0;
+    if (ok) {
+        memcpy(g->held, v, sizeof v);
+    } else if (memcmp(g->held, v, sizeof v)) {
+        for (int i = 0; i < 6; i++)
+            reg_set(g, held_reg[i], g->held[i]);
+        refused(g, "Width, Height, OffsetX, OffsetY, PixelFormat or GevSCPSPacketSize outside its range");
+    }
+    if (reg_get(g, REG_TRIGGER_MODE) > 1 || reg_get(g, REG_TRIGGER_SOURCE) > 1 || reg_get(g, REG_TRIGGER_ACT) > 2) {
+        publish(g, &g->applied);
+        refused(g, "TriggerMode, TriggerSource or TriggerActivation not one of its entries");
+    }
+}
+
+/* Client-written settings to the emulator, when they changed: within the
+ * XML's ranges (ExposureTime 1 us to 10 s, Gain 0 to 48 dB,
+ * AcquisitionFrameRate 0.01 to 1000 Hz, TriggerDelay 0 to 10 s: the last
+ * two the emulator checks). */
 static void apply_settings(struct gige *g)
 {
     struct nc_acquisition want;
     read_settings(g, &want);
     if (same(&want, &g->applied) || !g->ctl)
         return;
-    if (g->ctl->set(g->ctl->emu, &want) >= 0) {
+    if (!(want.exposure_s >= 1e-6 && want.exposure_s <= 10.0) || !(want.gain_db >= 0 && want.gain_db <= 48) ||
+        !(want.frame_rate_hz >= 0.01))
+        nc_error(NC_ERANGE, "ExposureTime %g us, Gain %g dB or AcquisitionFrameRate %g Hz beyond the device's range",
+                 want.exposure_s * 1e6, want.gain_db, want.frame_rate_hz);
+    else if (g->ctl->set(g->ctl->emu, &want) >= 0) {
         g->applied = want; /* the registers already say so */
         return;
     }
     /* Refused (lock-step, out of range): show the client what holds. */
-    if (g->rejected_settings++ == 0)
-        nc_log_warn("output/gige", "a client's setting was refused: %s", nc_errmsg());
+    refused(g, nc_errmsg());
     g->ctl->get(g->ctl->emu, &want);
     publish(g, &want);
 }
@@ -187,21 +244,25 @@ static void *poll_thread(void *arg)
     int64_t next_rate_ns = 0;
     while (!atomic_load(&g->stop)) {
         nanosleep(&(struct timespec){0, period_ns}, NULL);
-        if (reg_get(g, REG_TRIGGER_SW) == 1) {
-            reg_set(g, REG_TRIGGER_SW, 0);
-            if (g->ctl)
-                g->ctl->software_trigger(g->ctl->emu);
-        }
-        /* Acquisition: read after the settings a client wrote before its
-         * AcquisitionStart, so those are applied before the stream opens to
-         * exposures starting from now. */
+        /* What a client wrote within one period is taken in the order a
+         * GenICam client writes it: settings, then AcquisitionStart, then
+         * TriggerSoftware. So the settings are applied before the stream
+         * opens to exposures starting from now, and a trigger right after
+         * the start or a setting makes a frame that is sent, with that
+         * setting. */
         int acquiring = arv_fake_camera_get_acquisition_status(g->fc) != 0 &&
                         arv_fake_camera_get_control_channel_privilege(g->fc) != 0;
+        check_registers(g);
         apply_settings(g);
         if (acquiring && !atomic_load(&g->acq_start_ns))
             atomic_store(&g->acq_start_ns, nc_mono_ns());
         else if (!acquiring)
             atomic_store(&g->acq_start_ns, 0);
+        if (reg_get(g, REG_TRIGGER_SW) == 1) {
+            reg_set(g, REG_TRIGGER_SW, 0);
+            if (g->ctl)
+                g->ctl->software_trigger(g->ctl->emu);
+        }
         int64_t now = nc_mono_ns();
         if (g->ctl && g->ctl->resulting_rate_hz && now >= next_rate_ns) {
             reg_set_double(g, REG_RESULTING_RATE, g->ctl->resulting_rate_hz(g->ctl->emu));
@@ -422,6 +483,8 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_MODE, 1);
     reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOURCE, 1);
     arv_fake_camera_set_trigger_frequency(g->fc, 10);
+    for (int i = 0; i < 6; i++)
+        g->held[i] = reg_get(g, held_reg[i]);
     struct nc_acquisition a = {.frame_rate_hz = 10, .exposure_s = 1e-3};
     if (g->ctl)
         g->ctl->get(g->ctl->emu, &a);

@@ -6,7 +6,9 @@
  * bias, gain scales as 10^(dB/20)); after AcquisitionStop, ExposureTime,
  * AcquisitionStart every frame has the new setting (none exposed before the
  * start arrives); TriggerMode On + Software: one frame per
- * TriggerSoftware and none without; TriggerSource Line0 follows the line of
+ * TriggerSoftware and none without; settings, AcquisitionStart and
+ * TriggerSoftware written at once act in that order; out-of-range writes and
+ * writes to read-only registers read back what holds; TriggerSource Line0 follows the line of
  * serve.trigger; AcquisitionFrameRate within 2% (exposure starts on the
  * rate's grid; a tick skipped under load, an overrun, is allowed at most
  * once in five frames); a client
@@ -305,6 +307,59 @@ static void test_trigger_and_rate(void)
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
 }
 
+/* What a client writes within one poll period acts in its order: settings,
+ * AcquisitionStart, TriggerSoftware (ExposureTime=X; AcquisitionStart;
+ * TriggerSoftware at once: that frame, with X). And the device checks
+ * writes as a camera's firmware would: a region beyond the sensor, a gain
+ * beyond the XML's Max, a trigger mode that is no entry, a read-only
+ * register: each reads back what holds. */
+static void test_write_order(void)
+{
+    char dir[4096];
+    pid_t pid;
+    ArvCamera *c = begin("order", "outputs=[{driver: gige, pixel_format: Mono12, metadata_row: 1}]", NULL, &pid, dir,
+                         sizeof dir);
+    if (!c)
+        return;
+    uint8_t *img = malloc((size_t)W * (H + 1) * 2);
+    GError *err = NULL;
+    arv_camera_set_trigger(c, "Software", &err);
+    g_clear_error(&err);
+    struct stream st = {0};
+    CHECK(start(c, &st) == 0, "stream");
+    static const double xs[] = {700, 1900, 1100, 2600, 1500};
+    int good = 0;
+    for (int k = 0; k < 5; k++) {
+        arv_camera_stop_acquisition(c, NULL);
+        while (next_frame(&st, 0.15, img, NULL) == 0)
+            ;
+        arv_camera_set_exposure_time(c, xs[k], NULL);
+        arv_camera_start_acquisition(c, NULL);
+        arv_camera_software_trigger(c, NULL);
+        uint64_t frame;
+        double ex = 0, gain;
+        good += next_frame(&st, 3, img, NULL) == 0 && meta(img, &frame, &ex, &gain) == 0 &&
+                fabs(ex - xs[k] * 1e-6) < 1e-9;
+    }
+    printf("ExposureTime, AcquisitionStart, TriggerSoftware at once: %d of 5 frames sent, with that exposure\n", good);
+    CHECK(good == 5, "settings, start and trigger written at once: %d of 5 frames with their exposure", good);
+    finish(c, &st);
+    ArvDevice *d = arv_camera_get_device(c);
+    static const uint32_t reg[4] = {0x100 /* Width */, 0x110 /* Gain, 0.01 dB */, 0x1010 /* TriggerMode */,
+                                    0x11c /* SensorWidth */},
+                          bad[4] = {W + 10, 6000, 7, 99}, want[4] = {W, 0, 1, W};
+    for (int i = 0; i < 4; i++) {
+        guint32 v = 0;
+        arv_device_write_register(d, reg[i], bad[i], NULL);
+        usleep(50000);
+        arv_device_read_register(d, reg[i], &v, NULL);
+        CHECK(v == want[i], "register 0x%x written %u: reads %u, want %u (what holds)", reg[i], bad[i], v, want[i]);
+    }
+    free(img);
+    g_object_unref(c);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+}
+
 /* TriggerSource Line0: the line of serve.trigger (an 8 Hz timer here)
  * makes the frames, not the 20 Hz free-run. */
 static void test_line0(void)
@@ -444,6 +499,7 @@ int main(int argc, char **argv)
     test_exposure_gain();
     test_next_exposure();
     test_trigger_and_rate();
+    test_write_order();
     test_line0();
     test_client_killed();
     test_errors();
