@@ -22,7 +22,8 @@ static const char bench_help[] =
     "and the error against the reference: relative radiance over the body's pixels\n"
     "and DN after the scene's camera model (noise-free, exposed so that the\n"
     "reference's 99th percentile sits at 70 % of the full well), RMS and 95th\n"
-    "percentile. Writes DIR/accuracy.csv, DIR/accuracy.gp and, through gnuplot,\n"
+    "percentile. Writes DIR/accuracy.csv, DIR/accuracy_front.csv (each scene's\n"
+    "Pareto front: scene, time_ms, rel_rms), DIR/accuracy.gp and, through gnuplot,\n"
     "DIR/accuracy.png: error against time per scene with its Pareto front.\n"
     "\n"
     "Scenes: sphere (analytic Hapke sphere), bennu (a real shape model), rubble\n"
@@ -183,7 +184,14 @@ int main(int argc, char **argv)
                 only[nonly++] = optarg;
             break;
         case 'z': bad = parse_int("size", optarg, 16, 4096, &o.size_px); break;
-        case 'r': bad = parse_int("ref-spp", optarg, 1, 4096, &o.ref_spp); break;
+        case 'r':
+            bad = parse_int("ref-spp", optarg, 1, 4096, &o.ref_spp);
+            if (!bad && (int)lround(sqrt(o.ref_spp)) * (int)lround(sqrt(o.ref_spp)) != o.ref_spp) {
+                fprintf(stderr, "navcam bench: --ref-spp expects a square number of samples (1, 4, 9, ... 4096), "
+                                "got '%s'\n", optarg);
+                bad = 1;
+            }
+            break;
         case 'b': bad = parse_int("ref-bounces", optarg, 0, 64, &o.ref_bounces); break;
         case 'd': o.shapes_dir = optarg; break;
         case 'Q': o.quick = 1; break;
@@ -283,9 +291,13 @@ int main(int argc, char **argv)
         return nc_cli_fail();
     char cmd[4200];
     snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot accuracy.gp", dir);
-    if (nplots && system(cmd) != 0)
+    if (!nplots) {
+        fprintf(stderr, "navcam bench: every scene asked for was skipped: nothing measured, no chart\n");
+        return 1;
+    }
+    if (system(cmd) != 0)
         printf("no chart: gnuplot failed or is missing (Debian: gnuplot-nox); %s/accuracy.gp draws it\n", dir);
-    else if (nplots)
+    else
         printf("wrote %s/accuracy.csv, %s/accuracy.png\n", dir, dir);
     return 0;
 }

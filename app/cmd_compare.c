@@ -45,7 +45,7 @@ static const char compare_help[] =
     "                       float32, 0 off the foreground), DIR/relative_error.png\n"
     "                       (the map), DIR/error_histogram.png and .csv (gnuplot)\n"
     "  -f, --fit F          scale, histogram or none (default scale)\n"
-    "  -r, --register R     search shifts within R px (default 0: no registration)\n"
+    "  -r, --register R     search shifts within R px, 0 to 256 (default 0: no registration)\n"
     "  -F, --flip-real AXES mirror REAL before anything else: y top to bottom (an\n"
     "                       image stored bottom row first), x left to right, xy\n"
     "                       both (turned by 180 degrees); default none\n"
@@ -174,6 +174,11 @@ int main(int argc, char **argv)
     if (w != w2 || h != h2) {
         rc = nc_error(NC_ERANGE, "%s is %dx%d but %s is %dx%d: the images must have the same size", real_path, w, h,
                       render_path, w2, h2);
+        goto done;
+    }
+    if (w < 7 || h < 7) { /* the texture's FAST circle needs 7x7 */
+        rc = nc_error(NC_ERANGE, "%s and %s are %dx%d: too small to compare (at least 7x7 pixels)", real_path,
+                      render_path, w, h);
         goto done;
     }
     nc_image_flip(real, sizeof *real, w, h, flip & 2, flip & 1);

@@ -19,7 +19,7 @@
 #include "render/image_io.h"
 
 static const char expose_help[] =
-    "Usage: navcam expose CAMERA.yaml --radiance L --exposure T [--frames N] [--dark] -o OUT\n"
+    "Usage: navcam expose CAMERA.yaml --radiance L [--exposure T] [--frames N] [--dark] -o OUT\n"
     "\n"
     "Apply the camera model (optics, PSF, detector, ADC) to a uniform radiance field\n"
     "and write N digitised frames: how a camera engineer checks a configuration and\n"

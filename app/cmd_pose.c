@@ -15,19 +15,21 @@
 #include "navcam/client.h"
 
 static const char pose_help[] =
-    "Usage: navcam pose send --position X,Y,Z --attitude W,X,Y,Z --sun X,Y,Z [options]\n"
+    "Usage: navcam pose send --position X,Y,Z [--attitude W,X,Y,Z] [--sun X,Y,Z] [options]\n"
     "\n"
     "Send one POSE (or, with --trigger, one software TRIGGER) to `navcam serve`.\n"
     "  -P, --position X,Y,Z   camera position, m, scene frame\n"
-    "  -A, --attitude W,X,Y,Z camera -> scene quaternion (default 1,0,0,0)\n"
-    "  -S, --sun X,Y,Z        Sun direction, body frame (default 1,0,0)\n"
+    "  -A, --attitude W,X,Y,Z camera -> scene quaternion, of unit length within 1e-6 (default 1,0,0,0)\n"
+    "  -S, --sun X,Y,Z        Sun direction, body frame, not zero (default 1,0,0)\n"
     "  -t, --time S           simulation time, s (default 0)\n"
     "  -c, --capture          ask for a frame (lock-step or trigger mode)\n"
     "      --trigger          send a TRIGGER instead of a POSE\n"
-    "  -e, --exposure S       exposure for the requested frame, s\n"
-    "  -g, --gain DB          analog gain for the requested frame, dB\n"
+    "  -e, --exposure S       exposure for the requested frame, s, 0 to 3600\n"
+    "  -g, --gain DB          analog gain for the requested frame, dB, -60 to 60\n"
     "      --tcp              over TCP, waiting for the FRAME answer when capturing\n"
-    "  -H, --host ADDR        default 127.0.0.1;  -p, --port N  default 5750 (UDP) / 5751 (TCP)\n";
+    "  -H, --host ADDR        numeric IPv4 address (default 127.0.0.1)\n"
+    "  -p, --port N           1 to 65535 (default 5750 for UDP, 5751 for TCP)\n"
+    "Values the protocol refuses (docs/protocol.md) are refused here, naming the option.\n";
 
 static int parse_vec(const char *s, double *v, int n)
 {
@@ -63,22 +65,45 @@ int main(int argc, char **argv)
     int tcp = 0, port = 0, c, have_pos = 0;
     const char *host = "127.0.0.1";
     optind = 1;
+    const char *why = NULL; /* what is wrong with the option's value */
     while ((c = getopt_long(argc - 1, argv + 1, "P:A:S:t:ce:g:H:p:h", opts, NULL)) != -1) {
         switch (c) {
         case 'P': have_pos = parse_vec(optarg, pos, 3) == 0; if (!have_pos) goto bad; break;
-        case 'A': if (parse_vec(optarg, att, 4) < 0) goto bad; break;
-        case 'S': if (parse_vec(optarg, sun, 3) < 0) goto bad; break;
-        case 't': if (parse_vec(optarg, &t, 1) < 0) goto bad; break;
+        case 'A':
+            if (parse_vec(optarg, att, 4) < 0)
+                goto bad;
+            why = "not a unit quaternion within 1e-6";
+            if (fabs(sqrt(att[0] * att[0] + att[1] * att[1] + att[2] * att[2] + att[3] * att[3]) - 1) > 1e-6)
+                goto bad;
+            break;
+        case 'S':
+            if (parse_vec(optarg, sun, 3) < 0 || (why = "a zero vector", !(sun[0] || sun[1] || sun[2])))
+                goto bad;
+            break;
+        case 't': if (parse_vec(optarg, &t, 1) < 0 || (why = "beyond +-9.2e9 s", !(fabs(t) < 9.2e9))) goto bad; break;
         case 'c': m.flags |= NC_MSG_CAPTURE; break;
         case 'R': m.type = NC_MSG_TRIGGER; m.flags |= NC_MSG_CAPTURE; break;
-        case 'e': if (parse_vec(optarg, &v, 1) < 0) goto bad; m.exposure_s = v; m.flags |= NC_MSG_EXPOSURE; break;
-        case 'g': if (parse_vec(optarg, &v, 1) < 0) goto bad; m.gain_db = v; m.flags |= NC_MSG_GAIN; break;
+        case 'e':
+            if (parse_vec(optarg, &v, 1) < 0 || (why = "not within 0 to 3600 s", !(v >= 0 && v <= 3600)))
+                goto bad;
+            m.exposure_s = v, m.flags |= NC_MSG_EXPOSURE;
+            break;
+        case 'g':
+            if (parse_vec(optarg, &v, 1) < 0 || (why = "not within -60 to 60 dB", !(v >= -60 && v <= 60)))
+                goto bad;
+            m.gain_db = v, m.flags |= NC_MSG_GAIN;
+            break;
         case 'C': tcp = 1; break;
         case 'H': host = optarg; break;
-        case 'p': port = atoi(optarg); break;
+        case 'p':
+            if (parse_vec(optarg, &v, 1) < 0 || (why = "not a port, 1 to 65535", !(v >= 1 && v <= 65535 && v == floor(v))))
+                goto bad;
+            port = (int)v;
+            break;
         case 'h': fputs(pose_help, stdout); return 0;
         default: fputs("Try 'navcam pose send --help'.\n", stderr); return 2;
         }
+        why = NULL;
     }
     if (m.type == NC_MSG_POSE && !have_pos) {
         fprintf(stderr, "navcam pose send: --position X,Y,Z is required\n");
@@ -107,6 +132,10 @@ int main(int argc, char **argv)
     nc_client_close(cl);
     return rc;
 bad:
-    fprintf(stderr, "navcam pose send: bad value '%s' for --%s\n", optarg, opts[0].name);
+    for (int i = 0; opts[i].name; i++)
+        if (opts[i].val == c)
+            fprintf(stderr, "navcam pose send: --%s %s: %s\n", opts[i].name, optarg,
+                    why ? why : c == 'A' ? "expected 4 numbers W,X,Y,Z" : strchr("PS", c) ? "expected 3 numbers X,Y,Z"
+                                                                                      : "expected a number");
     return 2;
 }

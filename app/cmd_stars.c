@@ -22,7 +22,7 @@ static const char stars_help[] =
     "       (Debian package kstars-data: /usr/share/kstars/stars.dat;\n"
     "       scripts/install-deps.sh --stars extracts it without installing KStars).\n"
     "  -o, --output INDEX   the index to write\n"
-    "      --max-mag V      keep stars brighter than V only\n"
+    "      --max-mag V      keep only stars of magnitude V or brighter (V included)\n"
     "info   count the stars of an index by magnitude, and time its loading.\n"
     "\n"
     "Use the index in a scene: stars: {catalogue: INDEX} (docs/stars.md).\n";
@@ -92,7 +92,7 @@ int main(int argc, char **argv)
     size_t all = c.n;
     c.n = nc_star_cat_count_to(&c, max_mag);
     if (c.n == 0) {
-        fprintf(stderr, "navcam stars: no star brighter than V %g in %s\n", max_mag, argv[optind]);
+        fprintf(stderr, "navcam stars: no star of V %g or brighter in %s\n", max_mag, argv[optind]);
         nc_star_cat_free(&c);
         return 1;
     }

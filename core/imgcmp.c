@@ -196,11 +196,9 @@ int nc_imgcmp(const float *real, const float *render, int w, int h, enum nc_imgc
 {
     const size_t n = (size_t)w * (size_t)h;
     memset(out, 0, sizeof *out);
-    out->threshold_real = nc_otsu_threshold(real, n);
-    out->threshold_render = nc_otsu_threshold(render, n);
     out->scale = 1;
     unsigned char *fg = calloc(n, 1);
-    float *fit_px = malloc(n * sizeof *fit_px);
+    float *fit_px = calloc(n ? n : 1, sizeof *fit_px);
     struct ranked *ra = NULL, *rb = NULL;
     double *err = NULL;
     int rc = 0;
@@ -208,11 +206,21 @@ int nc_imgcmp(const float *real, const float *render, int w, int h, enum nc_imgc
         rc = nc_error(-ENOMEM, "out of memory");
         goto done;
     }
+    /* Each image's threshold over the pixels both have (a pixel missing in
+     * either is missing everywhere). */
+    for (int k = 0; k < 2; k++) {
+        const float *a = k ? render : real, *b = k ? real : render;
+        for (size_t i = 0; i < n; i++)
+            fit_px[i] = isfinite(b[i]) ? a[i] : NAN;
+        *(k ? &out->threshold_render : &out->threshold_real) = nc_otsu_threshold(fit_px, n);
+    }
     size_t inter = 0, uni = 0, m = 0;
     double srs = 0, sss = 0;
     for (size_t i = 0; i < n; i++) {
-        int a = isfinite(real[i]) && real[i] > out->threshold_real;
-        int b = isfinite(render[i]) && render[i] > out->threshold_render;
+        /* a pixel missing in either image is missing from both silhouettes */
+        const int both = isfinite(real[i]) && isfinite(render[i]);
+        int a = both && real[i] > out->threshold_real;
+        int b = both && render[i] > out->threshold_render;
         inter += a && b;
         uni += a || b;
         fg[i] = a && real[i] > 0 && isfinite(render[i]);

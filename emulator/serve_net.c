@@ -38,6 +38,11 @@ static void handle_message(struct nc__emu *e, const uint8_t *buf, size_t len, in
         r = NC_REJECT_BAD_TYPE; /* FRAME goes the other way */
     if (r != NC_REJECT_NONE) {
         log_reject(e, r, from);
+        /* A value refused (its header and CRC sound): a CAPTURE it carried
+         * is still answered, exactly once, so that no client waits for it. */
+        if ((r == NC_REJECT_NOT_FINITE || r == NC_REJECT_BAD_QUATERNION || r == NC_REJECT_BAD_VALUE) &&
+            (m.flags & NC_MSG_CAPTURE))
+            nc__serve_refused_capture(e, &m, client, gen);
         return;
     }
     if (m.type == NC_MSG_POSE) {

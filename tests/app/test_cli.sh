@@ -111,6 +111,12 @@ expect 1 "GREY holds 8 bits; the camera's ADC has 12" -- "$navcam" serve --set "
 expect 1 "v4l2 output: /dev/nonexistent-video: No such file or directory" -- "$navcam" serve \
   --set "outputs=[{driver: v4l2, device: /dev/nonexistent-video}]"
 expect 2 "missing -o OUT" -- "$navcam" render
+# pose send refuses what the protocol refuses, naming the option (nothing is sent)
+expect 2 "--gain abc: expected a number" -- "$navcam" pose send -P 0,-6000,0 -g abc
+expect 2 "--attitude 0,0,0,0: not a unit quaternion" -- "$navcam" pose send -P 0,-6000,0 -A 0,0,0,0
+expect 2 "--sun 0,0,0: a zero vector" -- "$navcam" pose send -P 0,-6000,0 -S 0,0,0
+expect 2 "--exposure -1: not within 0 to 3600 s" -- "$navcam" pose send -P 0,-6000,0 -e -1
+expect 2 "--port 99999: not a port" -- "$navcam" pose send -P 0,-6000,0 -p 99999
 expect 2 "unsupported output format" -- "$navcam" render -o "$tmp/x.bmp"
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
 expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 0

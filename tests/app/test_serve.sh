@@ -105,16 +105,26 @@ short, long_ = bytes(20), bytes(1104)
 s.sendall(struct.pack("<I", len(short)) + short + struct.pack("<I", len(long_)) + long_ + struct.pack("<I", len(cap)) + cap)
 seq, frame, status = pc.read_frame_answer(s)
 assert (seq, status) == (7, 0), (seq, frame, status)
+# a CAPTURE refused for a value (a quaternion not of unit length) is answered: dropped
+bad = pc.encode(pc.POSE, 8, pc.CAPTURE, 4 * 10**9, (0, -6000, 0), (0.9, 0, 0, 0))
+s.sendall(struct.pack("<I", len(bad)) + bad)
+seq, frame, status = pc.read_frame_answer(s)
+assert (seq, status) == (8, 1), (seq, frame, status)
 s.sendall(struct.pack("<I", 100000) + bytes(64))
 assert s.recv(1) == b"", "still connected after a 100000-byte prefix"
-print("TCP: truncated and oversized messages passed over, the capture after them answered; a 100000-byte prefix disconnects")
+print("TCP: truncated and oversized messages passed over, the capture after them answered, a refused capture "
+      "answered dropped; a 100000-byte prefix disconnects")
 PY
 "$navcam" pose send --tcp --port "$tcp" --capture --time 2 --position 0,-6000,0 --attitude 1,0,0,0 \
   > "$tmp/reject/pose.out" 2>&1 && grep -q "delivered" "$tmp/reject/pose.out" && ok \
   || bad "no frame after the rejections: $(cat "$tmp/reject/pose.out")"
 stop
+[ "$(json "$tmp/reject/stats.json" "d['rejected']['quaternion not of unit length']")" = 2 ] && ok \
+  || bad "quaternion rejection not counted twice"
+[ "$(json "$tmp/reject/stats.json" "d['dropped']['rejected_request']")" = 1 ] && ok \
+  || bad "the refused capture not counted as rejected_request"
 for r in "bad magic" "unsupported version" "unknown message type" "bad CRC" \
-         "NaN or infinite value" "quaternion not of unit length" "simulation time went backwards"; do
+         "NaN or infinite value" "simulation time went backwards"; do
   [ "$(json "$tmp/reject/stats.json" "d['rejected']['$r']")" = 1 ] && ok || bad "rejection '$r' not counted once"
 done
 # truncated: one datagram, one TCP message; oversized: those and the 100000-byte prefix

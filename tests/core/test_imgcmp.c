@@ -55,6 +55,16 @@ int main(void)
           "Otsu keeps %zu of the %zu lit pixels (not the dimmest, at the terminator)",
           r.foreground_px, lit);
 
+    /* Itself with every 7th pixel missing (NaN, or Inf in the render):
+     * missing in both silhouettes, so they still coincide. */
+    for (int k = 0; k < 2; k++) {
+        for (int i = 0; i < N; i++)
+            other[i] = i % 7 ? real[i] : k ? INFINITY : NAN;
+        CHECK(nc_imgcmp(k ? real : other, k ? other : real, W, H, NC_FIT_SCALE, &r, rel) == 0, "compare");
+        CHECK(r.limb_iou == 1 && r.rel_p95 == 0, "itself with %s pixels: iou %g p95 %g", k ? "Inf" : "NaN",
+              r.limb_iou, r.rel_p95);
+    }
+
     /* A copy 0.37 times as bright: the scale fit finds 1/0.37. */
     for (int i = 0; i < N; i++)
         other[i] = 0.37f * real[i];
