@@ -20,9 +20,10 @@
  *   so they act on the next exposure; at AcquisitionStart it applies the
  *   settings first, then opens the stream to exposures from then on.
  *   TriggerSoftware fires the emulator's software trigger;
- *   AcquisitionResultingFrameRate is kept up to date.
- * Registers are plain memory shared with the device thread (no locking in
- * Aravis 0.8): 32-bit accesses are single loads and stores.
+ *   AcquisitionResultingFrameRate is kept up to date. Within one poll it
+ *   takes writes in a GenICam client's order (settings, AcquisitionStart,
+ *   TriggerSoftware) and first undoes those a camera's firmware refuses
+ *   (gige_regs.h: the registers, their checks).
  */
 #include <arpa/inet.h>
 #include <arv.h>
@@ -43,27 +44,12 @@
 #include "core/log.h"
 #include "drivers/gige/gige_check.h"
 #include "drivers/gige/gige_image.h"
+#include "drivers/gige/gige_regs.h"
 #include "drivers/gige/gvsp.h"
 #include "drivers/navcam_genicam_xml.h"
 #include "emulator/output.h"
 #include "core/version.h"
 
-/* NavCam's application registers (see the XML's header comment). */
-enum {
-    REG_FRAME_RATE = 0x1000,     /* double, Hz */
-    REG_TRIGGER_MODE = 0x1010,   /* 0 Off, 1 On */
-    REG_TRIGGER_SOURCE = 0x1014, /* 0 Line0, 1 Software */
-    REG_TRIGGER_ACT = 0x1018,    /* 0 rising, 1 falling, 2 any */
-    REG_TRIGGER_SW = 0x101c,     /* latch: a client writes 1 */
-    REG_TRIGGER_DELAY = 0x1020,  /* double, us */
-    REG_RESULTING_RATE = 0x1028, /* double, Hz, read-only */
-    REG_META_ROWS = 0x1030,      /* 0 or 1 */
-    REG_PACKET_SIZE = 0xd04,     /* stream channel 0: packet size in the low 16 bits */
-    REG_VENDOR = 0x48,
-    REG_MODEL = 0x68,
-    REG_VERSION = 0x88,
-    REG_INFO = 0xa8,
-};
 
 struct gige {
     ArvGvFakeCamera *gv;
@@ -91,81 +77,15 @@ struct gige {
     int running, sending;
     double poll_hz;
     struct nc_acquisition applied; /* what the registers said last time */
-    uint32_t held[6];                /* the image registers' last values that held (held_reg) */
+    uint32_t held[NC_GIGE_HELD];     /* the image registers' last values that held */
     unsigned long rejected_settings;
 };
-
-/* The image registers a client writes: their values are checked together. */
-static const uint32_t held_reg[6] = {ARV_FAKE_CAMERA_REGISTER_WIDTH,    ARV_FAKE_CAMERA_REGISTER_HEIGHT,
-                                     ARV_FAKE_CAMERA_REGISTER_X_OFFSET, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET,
-                                     ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, REG_PACKET_SIZE};
-
-static uint32_t reg_get(struct gige *g, uint32_t a)
-{
-    guint32 v = 0;
-    arv_fake_camera_read_register(g->fc, a, &v);
-    return v;
-}
-
-static void reg_set(struct gige *g, uint32_t a, uint32_t v) { arv_fake_camera_write_register(g->fc, a, v); }
-
-static double reg_get_double(struct gige *g, uint32_t a)
-{
-    uint64_t be = 0, u;
-    double d;
-    arv_fake_camera_read_memory(g->fc, a, 8, &be);
-    u = GUINT64_FROM_BE(be);
-    memcpy(&d, &u, sizeof d);
-    return d;
-}
-
-static void reg_set_double(struct gige *g, uint32_t a, double d)
-{
-    uint64_t u;
-    memcpy(&u, &d, sizeof u);
-    u = GUINT64_TO_BE(u);
-    arv_fake_camera_write_memory(g->fc, a, 8, &u);
-}
-
-static void reg_set_string(struct gige *g, uint32_t a, size_t len, const char *s)
-{
-    char buf[64] = {0};
-    snprintf(buf, sizeof buf < len ? sizeof buf : len, "%s", s);
-    arv_fake_camera_write_memory(g->fc, a, (guint32)len, buf);
-}
 
 /* The registers a client sees, from the emulator's settings. */
 static void publish(struct gige *g, const struct nc_acquisition *a)
 {
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US, (uint32_t)llround(a->exposure_s * 1e6));
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW, (uint32_t)llround(fmax(a->gain_db, 0) * 100));
-    reg_set_double(g, REG_FRAME_RATE, a->frame_rate_hz);
-    reg_set(g, REG_TRIGGER_MODE, (uint32_t)a->triggered);
-    reg_set(g, REG_TRIGGER_SOURCE, a->source == NC_SOURCE_SOFTWARE ? 1 : 0);
-    reg_set(g, REG_TRIGGER_ACT, (uint32_t)a->activation);
-    reg_set_double(g, REG_TRIGGER_DELAY, a->trigger_delay_s * 1e6);
+    nc__gige_publish(g->fc, a);
     g->applied = *a;
-}
-
-/* The settings the registers hold now. */
-static void read_settings(struct gige *g, struct nc_acquisition *a)
-{
-    *a = g->applied;
-    a->exposure_s = reg_get(g, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US) * 1e-6;
-    a->gain_db = reg_get(g, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW) * 0.01;
-    a->frame_rate_hz = reg_get_double(g, REG_FRAME_RATE);
-    a->triggered = reg_get(g, REG_TRIGGER_MODE) != 0;
-    a->source = reg_get(g, REG_TRIGGER_SOURCE) == 1 ? NC_SOURCE_SOFTWARE : NC_SOURCE_LINE;
-    uint32_t act = reg_get(g, REG_TRIGGER_ACT);
-    a->activation = act <= 2 ? (enum nc_trigger_activation)act : NC_TRIGGER_RISING;
-    a->trigger_delay_s = reg_get_double(g, REG_TRIGGER_DELAY) * 1e-6;
-}
-
-static int same(const struct nc_acquisition *a, const struct nc_acquisition *b)
-{
-    return a->triggered == b->triggered && a->source == b->source && a->activation == b->activation &&
-           a->frame_rate_hz == b->frame_rate_hz && a->exposure_s == b->exposure_s && a->gain_db == b->gain_db &&
-           a->trigger_delay_s == b->trigger_delay_s;
 }
 
 static void refused(struct gige *g, const char *what)
@@ -174,43 +94,12 @@ static void refused(struct gige *g, const char *what)
         nc_log_warn("output/gige", "a client's setting was refused (the registers show what holds): %s", what);
 }
 
-/* Aravis's device stores whatever a client writes (GenICam's ranges are
- * the client's to check, and Aravis leaves them unchecked by default): the
- * device checks them here, as a camera's firmware would. The read-only
- * registers get their values back; an image setting outside the XML's
- * ranges (the region beyond the sensor, a packet size outside 576..65000
- * or off its step of 4, a pixel format or trigger enumeration that is no
- * entry) gets the last one that held. */
+/* The checks a camera's firmware makes on what clients write (gige_regs.h). */
 static void check_registers(struct gige *g)
 {
-    /* and AcquisitionMode, whose one entry is Continuous (1) */
-    const uint32_t ro[4] = {ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT,
-                            REG_META_ROWS, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE};
-    const uint32_t ro_value[4] = {(uint32_t)g->W, (uint32_t)g->H, (uint32_t)g->meta_rows, 1};
-    for (int i = 0; i < 4; i++)
-        if (reg_get(g, ro[i]) != ro_value[i]) {
-            reg_set(g, ro[i], ro_value[i]);
-            refused(g, "a write to SensorWidth, SensorHeight, MetadataRows (read only) or AcquisitionMode");
-        }
-    uint32_t v[6];
-    for (int i = 0; i < 6; i++)
-        v[i] = reg_get(g, held_reg[i]);
-    const uint32_t W = (uint32_t)g->W, H = (uint32_t)(g->H + g->meta_rows), min_w = W < 16 ? W : 16,
-                   packet = v[5] & 0xffff;
-    const int ok = v[0] >= min_w && v[0] <= W && v[2] <= W - v[0] && v[1] >= 1 && v[1] <= H && v[3] <= H - v[1] &&
-                   (v[4] == PF_MONO8 || v[4] == PF_MONO12 || v[4] == PF_MONO16) && packet >= 576 &&
-                   packet <= 65000 && packet % 4 == 0;
-    if (ok) {
-        memcpy(g->held, v, sizeof v);
-    } else if (memcmp(g->held, v, sizeof v)) {
-        for (int i = 0; i < 6; i++)
-            reg_set(g, held_reg[i], g->held[i]);
-        refused(g, "Width, Height, OffsetX, OffsetY, PixelFormat or GevSCPSPacketSize outside its range");
-    }
-    if (reg_get(g, REG_TRIGGER_MODE) > 1 || reg_get(g, REG_TRIGGER_SOURCE) > 1 || reg_get(g, REG_TRIGGER_ACT) > 2) {
-        publish(g, &g->applied);
-        refused(g, "TriggerMode, TriggerSource or TriggerActivation not one of its entries");
-    }
+    const char *why = NULL;
+    for (int n = nc__gige_check_registers(g->fc, g->W, g->H, g->meta_rows, g->held, &g->applied, &why); n > 0; n--)
+        refused(g, why);
 }
 
 /* Client-written settings to the emulator, when they changed: within the
@@ -220,8 +109,8 @@ static void check_registers(struct gige *g)
 static void apply_settings(struct gige *g)
 {
     struct nc_acquisition want;
-    read_settings(g, &want);
-    if (same(&want, &g->applied) || !g->ctl)
+    nc__gige_read_settings(g->fc, &g->applied, &want);
+    if (nc__gige_same(&want, &g->applied) || !g->ctl)
         return;
     if (!(want.exposure_s >= 1e-6 && want.exposure_s <= 10.0) || !(want.gain_db >= 0 && want.gain_db <= 48) ||
         !(want.frame_rate_hz >= 0.01))
@@ -258,14 +147,14 @@ static void *poll_thread(void *arg)
             atomic_store(&g->acq_start_ns, nc_mono_ns());
         else if (!acquiring)
             atomic_store(&g->acq_start_ns, 0);
-        if (reg_get(g, REG_TRIGGER_SW) == 1) {
-            reg_set(g, REG_TRIGGER_SW, 0);
+        if (nc__gige_reg(g->fc, REG_TRIGGER_SW) == 1) {
+            nc__gige_reg_set(g->fc, REG_TRIGGER_SW, 0);
             if (g->ctl)
                 g->ctl->software_trigger(g->ctl->emu);
         }
         int64_t now = nc_mono_ns();
         if (g->ctl && g->ctl->resulting_rate_hz && now >= next_rate_ns) {
-            reg_set_double(g, REG_RESULTING_RATE, g->ctl->resulting_rate_hz(g->ctl->emu));
+            nc__gige_reg_set_double(g->fc, REG_RESULTING_RATE, g->ctl->resulting_rate_hz(g->ctl->emu));
             next_rate_ns = now + 100000000;
         }
     }
@@ -282,10 +171,10 @@ static int layout(struct gige *g, const struct nc_frame_record *r)
 {
     /* Clients may write anything into these registers (GenICam range checks
      * are the client's): offsets are clamped to the sensor. */
-    const uint32_t w = reg_get(g, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = reg_get(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
-    const uint32_t rox = reg_get(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET);
-    const uint32_t roy = reg_get(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
-    const uint32_t pf = reg_get(g, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT);
+    const uint32_t w = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
+    const uint32_t rox = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_X_OFFSET);
+    const uint32_t roy = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
+    const uint32_t pf = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT);
     const int ox = rox < (uint32_t)g->W ? (int)rox : g->W, oy = roy < (uint32_t)g->H ? (int)roy : g->H;
     if ((pf != PF_MONO8 && pf != PF_MONO12 && pf != PF_MONO16) || w == 0 || h == 0 ||
         (size_t)w * h > (size_t)g->W * (g->H + 1))
@@ -344,7 +233,7 @@ static void *sender_thread(void *arg)
             g->before_start++; /* the client asked for frames exposed from AcquisitionStart on */
             continue;
         }
-        uint32_t packet = reg_get(g, REG_PACKET_SIZE) & 0xffff;
+        uint32_t packet = nc__gige_reg(g->fc, REG_PACKET_SIZE) & 0xffff;
         pthread_mutex_unlock(&g->lock); /* submit() may pack and hand over the next frame meanwhile */
         int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &g->im[k]);
         pthread_mutex_lock(&g->lock);
@@ -462,29 +351,28 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         return nc_error(NC_ECONFIG, "gige: the GigE Vision device did not start on %s", g->iface);
     }
     g->fc = arv_gv_fake_camera_get_fake_camera(g->gv);
-    reg_set_string(g, REG_VENDOR, 32, "NavCam");
-    reg_set_string(g, REG_MODEL, 32, model);
-    reg_set_string(g, REG_VERSION, 32, NC_VERSION_STRING);
-    reg_set_string(g, REG_INFO, 48, "navcam serve: a rendered camera");
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, (uint32_t)g->W);
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT, (uint32_t)g->H);
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_WIDTH, (uint32_t)g->W);
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_HEIGHT, (uint32_t)(g->H + g->meta_rows));
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_X_OFFSET, 0);
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET, 0);
-    reg_set(g, REG_META_ROWS, (uint32_t)g->meta_rows);
+    nc__gige_reg_set_string(g->fc, REG_VENDOR, 32, "NavCam");
+    nc__gige_reg_set_string(g->fc, REG_MODEL, 32, model);
+    nc__gige_reg_set_string(g->fc, REG_VERSION, 32, NC_VERSION_STRING);
+    nc__gige_reg_set_string(g->fc, REG_INFO, 48, "navcam serve: a rendered camera");
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, (uint32_t)g->W);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT, (uint32_t)g->H);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_WIDTH, (uint32_t)g->W);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_HEIGHT, (uint32_t)(g->H + g->meta_rows));
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_X_OFFSET, 0);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET, 0);
+    nc__gige_reg_set(g->fc, REG_META_ROWS, (uint32_t)g->meta_rows);
     static const uint32_t pfs[] = {PF_MONO8, PF_MONO12, PF_MONO16};
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, pfs[fmt]);
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE, 1);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, pfs[fmt]);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE, 1);
     /* Loopback carries big packets; real links start at the safe 1400. */
-    reg_set(g, REG_PACKET_SIZE, (uint32_t)(packet > 0 ? packet : !strcmp(g->iface, "lo") ? 8192 : 1400));
+    nc__gige_reg_set(g->fc, REG_PACKET_SIZE, (uint32_t)(packet > 0 ? packet : !strcmp(g->iface, "lo") ? 8192 : 1400));
     /* Internal: the device itself never streams (its software trigger is
      * never raised; it looks for it 10 times a second); the sender does. */
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_MODE, 1);
-    reg_set(g, ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOURCE, 1);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_TRIGGER_MODE, 1);
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOURCE, 1);
     arv_fake_camera_set_trigger_frequency(g->fc, 10);
-    for (int i = 0; i < 6; i++)
-        g->held[i] = reg_get(g, held_reg[i]);
+    nc__gige_hold(g->fc, g->held);
     struct nc_acquisition a = {.frame_rate_hz = 10, .exposure_s = 1e-3};
     if (g->ctl)
         g->ctl->get(g->ctl->emu, &a);

@@ -1,0 +1,61 @@
+/* gige_regs.h - the GigE Vision device's registers (output_gige.c): NavCam's
+ * own addresses, typed access to the register memory of Aravis's device,
+ * the emulator's acquisition settings as registers, and the checks a
+ * camera's firmware makes on what clients write. Registers are plain
+ * memory shared with the device thread (no locking in Aravis 0.8): 32-bit
+ * accesses are single loads and stores. Internal to the gige driver. */
+#ifndef NC_GIGE_REGS_H
+#define NC_GIGE_REGS_H
+
+#include <arv.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "emulator/output.h"
+
+/* NavCam's application registers (see the XML's header comment). */
+enum {
+    REG_FRAME_RATE = 0x1000,     /* double, Hz */
+    REG_TRIGGER_MODE = 0x1010,   /* 0 Off, 1 On */
+    REG_TRIGGER_SOURCE = 0x1014, /* 0 Line0, 1 Software */
+    REG_TRIGGER_ACT = 0x1018,    /* 0 rising, 1 falling, 2 any */
+    REG_TRIGGER_SW = 0x101c,     /* latch: a client writes 1 */
+    REG_TRIGGER_DELAY = 0x1020,  /* double, us */
+    REG_RESULTING_RATE = 0x1028, /* double, Hz, read-only */
+    REG_META_ROWS = 0x1030,      /* 0 or 1 */
+    REG_PACKET_SIZE = 0xd04,     /* stream channel 0: packet size in the low 16 bits */
+    REG_VENDOR = 0x48,
+    REG_MODEL = 0x68,
+    REG_VERSION = 0x88,
+    REG_INFO = 0xa8,
+};
+
+uint32_t nc__gige_reg(ArvFakeCamera *fc, uint32_t a);
+void nc__gige_reg_set(ArvFakeCamera *fc, uint32_t a, uint32_t v);
+double nc__gige_reg_double(ArvFakeCamera *fc, uint32_t a);
+void nc__gige_reg_set_double(ArvFakeCamera *fc, uint32_t a, double d);
+void nc__gige_reg_set_string(ArvFakeCamera *fc, uint32_t a, size_t len, const char *s);
+
+/* The registers a client sees, from the emulator's settings a. */
+void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a);
+/* The settings the registers hold now (those they do not hold from base). */
+void nc__gige_read_settings(ArvFakeCamera *fc, const struct nc_acquisition *base, struct nc_acquisition *a);
+int nc__gige_same(const struct nc_acquisition *a, const struct nc_acquisition *b);
+
+/* The image registers a client writes, checked together: Width, Height,
+ * OffsetX, OffsetY, PixelFormat, GevSCPSPacketSize. */
+#define NC_GIGE_HELD 6
+void nc__gige_hold(ArvFakeCamera *fc, uint32_t held[NC_GIGE_HELD]);
+/* Aravis's device stores whatever a client writes (GenICam's ranges are
+ * the client's to check, and Aravis leaves them unchecked by default): the
+ * checks a camera's firmware makes, for a sensor of w x h pixels with
+ * meta_rows metadata rows. The read-only registers get their values back;
+ * image registers outside the XML's ranges (the region beyond the sensor,
+ * a packet size outside 576..65000 or off its step of 4, a pixel format
+ * that is no entry) the last values that held (held, updated when they
+ * hold); a trigger enumeration that is no entry, the settings applied.
+ * Returns how many kinds of write were undone, *why the last. */
+int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uint32_t held[NC_GIGE_HELD],
+                             const struct nc_acquisition *applied, const char **why);
+
+#endif
