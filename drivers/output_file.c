@@ -22,7 +22,7 @@ struct file_out {
 static const char *const fits_orders[] = {"top_down", "bottom_up", NULL};
 
 static const struct nc_param file_params[] = {
-    NC_P_STRING("directory", "out", "where the files go (made if missing)"),
+    NC_P_STRING("directory", "out", "where the files go (made if missing, with its parents)"),
     NC_P_STRING("pattern", "frame_%06llu.png", "file name with one %llu-style conversion for the frame number; the extension picks the format "
      "(.png, .tif, .fits, .exr)"),
     NC_P_ENUM("fits_row_order", "top_down", fits_orders,
@@ -61,8 +61,24 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     }
     snprintf(f->dir, sizeof f->dir, "%s", dir);
     snprintf(f->pattern, sizeof f->pattern, "%s", pattern);
-    if (mkdir(f->dir, 0777) < 0 && errno != EEXIST)
-        return nc_error(-errno, "file output: mkdir %s: %s", f->dir, strerror(errno));
+    /* made with every missing parent, as mkdir -p */
+    for (char *p = f->dir + 1;; p++) {
+        const char c = *p;
+        if (c != '/' && c != '\0')
+            continue;
+        *p = '\0';
+        const int bad = mkdir(f->dir, 0777) < 0 && errno != EEXIST;
+        *p = c;
+        if (bad) {
+            const int err = errno;
+            char where[4200];
+            snprintf(where, sizeof where, "%.*s", (int)(p - f->dir), f->dir);
+            return nc_cfg_error(nc_cfg_get(opts, "directory") ? nc_cfg_get(opts, "directory") : opts,
+                                "file output: cannot make %s: %s", where, strerror(err));
+        }
+        if (!c)
+            break;
+    }
     if (sidecar[0]) {
         snprintf(f->sidecar_path, sizeof f->sidecar_path, "%s/%s", f->dir, sidecar);
         f->sidecar = fopen(f->sidecar_path, "w");

@@ -29,7 +29,7 @@ static int64_t default_width(int64_t period_ns) { return period_ns / 2 < 1000000
 
 static const struct nc_param timer_params[] = {
     NC_P_DOUBLE("rate_hz", "10", 1e-3, 10000, "Hz", "pulses per second"),
-    NC_P_DOUBLE("pulse_width_s", NULL, 1e-6, 1000, "s", "from the rising to the falling edge (default 1 ms, or half the period when that is shorter)"),
+    NC_P_DOUBLE("pulse_width_s", NULL, 1e-6, 1000, "s", "from the rising to the falling edge, shorter than the period (default 1 ms, or half the period when that is shorter)"),
     NC_P_END,
 };
 

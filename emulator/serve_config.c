@@ -14,8 +14,6 @@ const char *const nc__serve_mode_names[] = {"lockstep", "freerun", "trigger", NU
 
 /* The built-in software source (TRIGGER messages, POSE with CAPTURE, a
  * client's TriggerSoftware) takes only the common keys. */
-static const struct nc_param software_params[] = {NC_P_END};
-
 /* `serve.trigger`: a line driver, or the built-in software source. check:
  * a line driver's options are checked, not opened (the software source
  * opens nothing; its settings are set again by the real pass). */
@@ -24,14 +22,19 @@ static int open_trigger(struct nc__emu *e, struct nc_cfg_node *tr, int check)
     int rc, builtin = 0;
     const struct nc_trigger_driver *d = nc_registry_select_trigger(e->drivers, tr, "software", &builtin, &rc);
     if (builtin) {
-        /* Software commands: no line, so no activation or debounce. */
-        const struct nc_param *const tables[] = {nc_trigger_common_params, software_params};
+        /* Software commands: no line, so no activation or debounce; the
+         * common keys' delay_s alone. */
         double delay_s = 0;
-        if ((rc = nc_params_check(tr, tables, 2, "trigger source 'software'")) < 0)
-            return rc;
-        if (nc_cfg_get(tr, "activation") || nc_cfg_get(tr, "debounce_s"))
-            return nc_cfg_error(tr, "trigger source 'software' gives commands, not line edges: activation and "
-                                    "debounce_s do not apply");
+        if (tr && tr->kind != NC_CFG_MAP)
+            return nc_cfg_error(tr, "expected a map of keys for trigger source 'software'");
+        for (size_t i = 0; tr && i < tr->nchild; i++) {
+            const struct nc_cfg_node *c = tr->child[i];
+            if (!strcmp(c->key, "activation") || !strcmp(c->key, "debounce_s"))
+                return nc_cfg_error(c, "trigger source 'software' gives commands, not line edges: activation and "
+                                       "debounce_s do not apply (it takes: driver, delay_s)");
+            if (strcmp(c->key, "driver") && strcmp(c->key, "delay_s"))
+                return nc_cfg_error(c, "unknown key for trigger source 'software' (it takes: driver, delay_s)");
+        }
         if ((rc = nc_param_double(tr, nc_trigger_common_params, "delay_s", &delay_s)) < 0)
             return rc;
         e->software_configured = 1;

@@ -103,23 +103,30 @@ static int push_job(struct nc__emu *e, struct nc__job *j)
 {
     pthread_mutex_lock(&e->jlock);
     if (e->mode != NC__MODE_LOCKSTEP && too_late(e, j)) {
-        atomic_fetch_add(&e->dropped[NC__DROP_OVERRUN], 1);
         pthread_mutex_unlock(&e->jlock);
+        nc__serve_drop(e, j, NC__DROP_OVERRUN); /* counted, and answered if a TCP client asked */
         return 0;
     }
+    struct nc__job oldest;
+    int replaced = 0;
     if (e->jcount == e->job_cap) {
-        atomic_fetch_add(&e->dropped[e->mode == NC__MODE_LOCKSTEP ? NC__DROP_QUEUE_FULL : NC__DROP_OVERRUN], 1);
+        const enum nc__drop_reason why = e->mode == NC__MODE_LOCKSTEP ? NC__DROP_QUEUE_FULL : NC__DROP_OVERRUN;
         if (!e->drop_oldest || e->mode == NC__MODE_LOCKSTEP) {
             pthread_mutex_unlock(&e->jlock);
-            return 0; /* the newest job goes */
+            nc__serve_drop(e, j, why); /* the newest job goes */
+            return 0;
         }
-        e->jhead = (e->jhead + 1) % e->queue_frames; /* the oldest goes */
+        oldest = e->jobs[e->jhead]; /* the oldest goes */
+        replaced = 1;
+        e->jhead = (e->jhead + 1) % e->queue_frames;
         e->jcount--;
     }
     e->jobs[(e->jhead + e->jcount) % e->queue_frames] = *j;
     e->jcount++;
     pthread_cond_signal(&e->jcond);
     pthread_mutex_unlock(&e->jlock);
+    if (replaced)
+        nc__serve_drop(e, &oldest, NC__DROP_OVERRUN);
     return 1;
 }
 

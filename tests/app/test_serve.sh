@@ -267,6 +267,23 @@ assert [r["trigger_source"] for r in rows] == ["software", "software"], rows
 assert [r["trigger_sim_ns"] for r in rows] == [2_000_000_000, 2_500_000_000]
 print("software trigger: 2 frames at 2.0 s and 2.5 s")
 PY
+# Three software triggers at once over TCP to a slow render: the ones that
+# overrun are answered too (dropped), so every CAPTURE gets one answer.
+start burst 12 --set serve.mode=trigger --set serve.max_extrapolation_s=10 "${slow[@]}"
+"$navcam" pose send --port "$udp" --time 1 --position 0,-6000,0 > /dev/null 2>&1
+python3 - "$src/examples" "$tcp" <<'PY' && ok || bad "software triggers that overrun are not all answered"
+import socket, struct, sys
+sys.path.insert(0, sys.argv[1])
+import python_client as pc
+s = socket.create_connection(("127.0.0.1", int(sys.argv[2])))
+s.settimeout(30)
+s.sendall(b"".join(struct.pack("<I", len(m)) + m for m in
+                   (pc.encode(pc.TRIGGER, k, pc.CAPTURE, 10**9 + k * 10**6) for k in (1, 2, 3))))
+got = sorted(pc.read_frame_answer(s)[::2] for _ in range(3))
+print("three software triggers at once:", got, "(sequence, status: 0 delivered, 1 dropped)")
+assert [q for q, _ in got] == [1, 2, 3] and any(st == 0 for _, st in got) and any(st == 1 for _, st in got), got
+PY
+stop
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
