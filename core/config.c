@@ -142,6 +142,17 @@ static int cfg_error_key(const struct nc_cfg_node *parent, const char *key, cons
 
 int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected)
 {
+    /* a key of the map that no reader took and that is a typo of this one */
+    for (size_t i = 0; parent && parent->kind == NC_CFG_MAP && i < parent->nchild; i++) {
+        const struct nc_cfg_node *c = parent->child[i];
+        if (!c->used && c->key && nc__cfg_edits(c->key, key) <= strlen(key) / 3) {
+            char at[32] = "";
+            if (c->line > 0)
+                snprintf(at, sizeof at, " (line %d)", c->line);
+            return cfg_error_key(parent, key, "missing required key (expected %s); '%s'%s is not a key here: a "
+                                              "misspelling of it?", expected, c->key, at);
+        }
+    }
     return cfg_error_key(parent, key, "missing required key (expected %s)", expected);
 }
 

@@ -50,6 +50,8 @@ int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top);
 
 /* Child of a map by key without marking it used (internal to config*.c). */
 struct nc_cfg_node *nc__cfg_find(struct nc_cfg_node *map, const char *key);
+/* Edit distance of two keys, two swapped neighbours counting one (config_read.c). */
+size_t nc__cfg_edits(const char *a, const char *b);
 /* Child of a map by key, or NULL. Marks it used. */
 struct nc_cfg_node *nc_cfg_get(struct nc_cfg_node *map, const char *key);
 /* Readers: return 1 when the key was present and valid, 0 when absent

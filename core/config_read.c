@@ -220,7 +220,7 @@ static struct nc_cfg_node *first_unused(struct nc_cfg_node *n)
 /* Edit distance of two keys (a few dozen characters): insertions,
  * deletions, substitutions and swaps of two neighbours (hurts: hurst)
  * count one each, as optimal string alignment. */
-static size_t edits(const char *a, const char *b)
+size_t nc__cfg_edits(const char *a, const char *b)
 {
     size_t la = strlen(a), lb = strlen(b), r0[65], r1[65], r2[65], *prev = r0, *row = r1, *back = r2;
     if (la > 64 || lb > 64)
@@ -293,7 +293,7 @@ int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
     const char *best = NULL;
     size_t bd = strlen(u->key) / 3; /* a third of its letters: none for one- or two-letter keys */
     for (size_t i = 0; i < p->nasked; i++) {
-        const size_t d = edits(u->key, p->asked[i]);
+        const size_t d = nc__cfg_edits(u->key, p->asked[i]);
         if (d <= bd && (!best || d < bd))
             best = p->asked[i], bd = d;
     }

@@ -25,7 +25,7 @@ int nc_client_connect(const char *host, int port, int tcp, struct nc_client **ou
 {
     struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
     if (inet_pton(AF_INET, host, &a.sin_addr) != 1)
-        return nc_error(NC_EUSAGE, "'%s' is not a numeric IPv4 address", host);
+        return nc_error(-EINVAL, "'%s' is not a numeric IPv4 address", host);
     struct nc_client *c = calloc(1, sizeof *c);
     if (!c)
         return nc_error(-ENOMEM, "out of memory");
@@ -51,15 +51,19 @@ long nc_client_send(struct nc_client *c, struct nc_pose_msg *m)
     m->sequence = c->next_sequence++;
     size_t n = nc_msg_encode(m, buf + 4, NC_PROTO_MAX_BYTES);
     if (!n)
-        return nc_error(NC_ERANGE, "message too large");
+        return nc_error(-EMSGSIZE, "message too large");
     for (int i = 0; i < 4; i++)
         buf[i] = (uint8_t)(n >> (8 * i));
     const uint8_t *p = c->tcp ? buf : buf + 4;
     size_t len = c->tcp ? n + 4 : n;
+    int refused = 0;
     while (len > 0) {
         ssize_t w = send(c->fd, p, len, MSG_NOSIGNAL);
         if (w < 0) {
-            if (errno == EINTR)
+            /* UDP: a refusal is the port unreachable that an earlier
+             * datagram met, reported now; this one is sent anyway, fire and
+             * forget. */
+            if (errno == EINTR || (!c->tcp && errno == ECONNREFUSED && !refused++))
                 continue;
             return nc_error(-errno, "send: %s", strerror(errno));
         }
@@ -72,10 +76,10 @@ long nc_client_send(struct nc_client *c, struct nc_pose_msg *m)
 int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence, uint64_t *frame, uint32_t *status)
 {
     if (!c->tcp)
-        return nc_error(NC_EUNSUPPORTED, "frames are answered over TCP only");
+        return nc_error(-EOPNOTSUPP, "frames are answered over TCP only");
     struct timespec t0;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (;;) {
+    for (int polled = 0;; polled = 1) {
         while (c->have >= 4) {
             uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
                            (uint32_t)c->buf[3] << 24;
@@ -98,13 +102,14 @@ int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence
             *status = m.status;
             return 0;
         }
+        /* timeout_ms < 0: no limit; 0: what has already arrived, no wait */
         struct timespec t1;
         clock_gettime(CLOCK_MONOTONIC, &t1);
         long left = timeout_ms - ((t1.tv_sec - t0.tv_sec) * 1000 + (t1.tv_nsec - t0.tv_nsec) / 1000000);
-        if (left <= 0)
+        if (timeout_ms >= 0 && left <= 0 && polled)
             return nc_error(-ETIMEDOUT, "no frame answer within %d ms", timeout_ms);
         struct pollfd pf = {c->fd, POLLIN, 0};
-        if (poll(&pf, 1, (int)left) <= 0)
+        if (poll(&pf, 1, timeout_ms < 0 ? -1 : left > 0 ? (int)left : 0) <= 0)
             continue;
         ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
         if (n <= 0)
@@ -121,7 +126,7 @@ int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms,
         clock_gettime(CLOCK_MONOTONIC, &t1);
         long left = timeout_ms - ((t1.tv_sec - t0.tv_sec) * 1000 + (t1.tv_nsec - t0.tv_nsec) / 1000000);
         uint32_t seq;
-        int rc = nc_client_next_frame(c, left > 0 ? (int)left : 0, &seq, frame, status);
+        int rc = nc_client_next_frame(c, timeout_ms < 0 ? -1 : left > 0 ? (int)left : 0, &seq, frame, status);
         if (rc == -ETIMEDOUT)
             return nc_error(rc, "no frame for request %u within %d ms", sequence, timeout_ms);
         if (rc < 0 || seq == sequence)

@@ -12,27 +12,41 @@
 
 #include "navcam/protocol.h"
 
+#ifdef __cplusplus
+extern "C" { /* C linkage, for simulators written in C++ */
+#endif
+
 struct nc_client;
 
-/* TCP (lock-step: frames are answered) or UDP (fire and forget). */
+/* TCP (lock-step: frames are answered) or UDP (fire and forget: a send
+ * never fails for want of a listener). Errors are negative errno values:
+ * -EINVAL for a host that is not a numeric IPv4 address, -ECONNREFUSED
+ * when nothing listens on a TCP port, ... */
 int nc_client_connect(const char *host, int port, int tcp, struct nc_client **out);
 /* Send a POSE or TRIGGER message (its sequence is set by the client). Returns
- * the sequence used, or a negative error. */
+ * the sequence used, or a negative errno (-EMSGSIZE, -EPIPE, ...). */
 long nc_client_send(struct nc_client *c, struct nc_pose_msg *m);
 /* The next FRAME answer (TCP), in the order NavCam sent them: the request's
- * sequence, the frame number and the status (NC_FRAME_DELIVERED or
- * NC_FRAME_DROPPED) out. For simulators that send several captures before
- * reading: in lock-step every capture is answered exactly once, in request
- * order. Returns 0, -ETIMEDOUT, -ECONNREFUSED (NavCam had no client slot
- * for this connection: serve.max_clients), or another negative error. */
+ * sequence, the frame number (UINT64_MAX when dropped) and the status
+ * (NC_FRAME_DELIVERED or NC_FRAME_DROPPED) out. For simulators that send
+ * several captures before reading: every capture is answered exactly once,
+ * in lock-step in request order. timeout_ms: how long to wait, 0 for what
+ * has already arrived (no wait), negative for no limit. Returns 0,
+ * -ETIMEDOUT, -ECONNREFUSED (NavCam had no client slot for this connection:
+ * serve.max_clients), -EOPNOTSUPP on a UDP client, or another negative
+ * errno (-ECONNRESET: NavCam closed the connection). */
 int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence, uint64_t *frame, uint32_t *status);
 /* Wait (TCP) for the FRAME answer to `sequence`, passing over answers to
  * other requests; frame and status out. Returns 0, or -ETIMEDOUT / a
  * negative error as nc_client_next_frame. */
 int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms, uint64_t *frame, uint32_t *status);
 void nc_client_close(struct nc_client *c);
-/* What the last failing call on this thread said, e.g. "connect 127.0.0.1:5751:
- * Connection refused". */
+/* What the last failing call on this thread said, e.g. "TCP 127.0.0.1:5751:
+ * connect: Connection refused". */
 const char *nc_client_errmsg(void);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

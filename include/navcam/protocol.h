@@ -15,6 +15,10 @@
 
 #include "navcam/types.h"
 
+#ifdef __cplusplus
+extern "C" { /* C linkage, for simulators written in C++ */
+#endif
+
 #define NC_PROTO_MAGIC 0x4D41434Eu /* bytes "NCAM" */
 #define NC_PROTO_VERSION 1
 #define NC_PROTO_HEADER_BYTES 24
@@ -90,5 +94,9 @@ size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap);
 /* Decode and validate one message of exactly len bytes. Returns
  * NC_REJECT_NONE and fills *m, or the reason of the rejection. */
 enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg *m);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -67,6 +67,8 @@ int main(void)
     expect_error("wrong length", "  position_m: [0, 0, -5000]\n", "  position_m: [0, -5000]\n", NULL, 0,
                  "camera.position_m", "expected a list of 3 numbers");
     expect_error("missing key", "  width_px: 64\n", "", NULL, 0, "camera.width_px", "missing required key");
+    expect_error("missing key, misspelt", "  width_px: 64\n", "  widht_px: 64\n", NULL, 0,
+                 "camera.width_px: missing required key", "'widht_px' (line 7) is not a key here: a misspelling");
     expect_error("out of range", "A: 0.1}", "A: 1.5}", NULL, 0, "test.yaml:3: bodies[0].material.A",
                  "expected a number in [0, 1]");
     expect_error("unknown model", "model: lambert", "model: phong", NULL, 0, "bodies[0].material.model",

@@ -118,6 +118,21 @@ static void twenty_back_to_back(void)
     printf("lock-step, 20 captures sent without waiting, 4-deep queue: %d of 20 delivered in %.2f s\n", got,
            now_s() - t0);
     CHECK(got == 20, "20 captures sent back to back: %d frames delivered", got);
+    /* A timeout of 0 polls: -ETIMEDOUT at once until the answer is there,
+     * then the answer (not another wait). */
+    capture(c, 2.5);
+    int polls = 0, rc = -ETIMEDOUT, slow = 0;
+    uint32_t seq = 0, status = 0;
+    uint64_t frame = 0;
+    while (rc == -ETIMEDOUT && polls++ < 1200) {
+        double t = now_s();
+        rc = nc_client_next_frame(c, 0, &seq, &frame, &status);
+        slow += now_s() - t > 0.05;
+        if (rc == -ETIMEDOUT)
+            usleep(50000);
+    }
+    CHECK(rc == 0 && seq == 21 && status == NC_FRAME_DELIVERED && slow == 0,
+          "timeout 0: rc %d after %d polls, sequence %u, status %u, %d polls waited", rc, polls, seq, status, slow);
     nc_client_close(c);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
 }
@@ -216,6 +231,22 @@ static void shutdown_answers_everything(void)
     nc_client_close(c);
 }
 
+/* UDP is fire and forget: with nothing listening, every send still
+ * succeeds (the port-unreachable an earlier datagram met is not this
+ * one's failure). */
+static void udp_to_nothing(void)
+{
+    struct nc_client *c = NULL;
+    CHECK(nc_client_connect("127.0.0.1", 9, 0, &c) == 0, "UDP connect: %s", nc_client_errmsg());
+    long last = 0;
+    for (int i = 0; c && i < 5; i++) {
+        last = capture(c, i);
+        usleep(20000);
+    }
+    CHECK(last == 5, "UDP to a port with no listener: the 5th send returned %ld (%s)", last, nc_client_errmsg());
+    nc_client_close(c);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 3)
@@ -224,6 +255,7 @@ int main(int argc, char **argv)
     tmp = argv[2];
     mkdir(tmp, 0777);
     signal(SIGPIPE, SIG_IGN);
+    udp_to_nothing();
     twenty_back_to_back();
     fifty_clients_and_a_slow_one();
     refused_beyond_the_limit();

@@ -61,6 +61,25 @@ grep -q '^CMAKE_BUILD_TYPE:STRING=Asan' "$build/CMakeCache.txt" && san=(-fsaniti
 cc -std=c11 -D_POSIX_C_SOURCE=200809L -Wall -Werror "${san[@]}" -o "$tmp/sim" "$tmp/sim.c" $(pkg-config --cflags --libs navcam-client) \
   2>"$tmp/cc.log" && ok || { bad "the simulator does not build against the installed library: $(cat "$tmp/cc.log")"; }
 
+# Only the public functions are global in the library: a simulator with
+# functions of NavCam's internal names (nc_error, nc_errmsg) still links, and
+# in C++ too (the headers declare C linkage).
+lib=$(pkg-config --variable=libdir navcam-client)/libnavcam-client.a
+[ "$(nm -g --defined-only "$lib" | awk 'NF == 3 {print $3}' | sort | tr '\n' ' ')" = \
+  "nc_client_close nc_client_connect nc_client_errmsg nc_client_next_frame nc_client_send nc_client_wait_frame nc_msg_decode nc_msg_encode nc_msg_size nc_reject_name " ] \
+  && ok || bad "the library exports more than its API: $(nm -g --defined-only "$lib" | awk 'NF == 3 {print $3}' | tr '\n' ' ')"
+cat >"$tmp/clash.c" <<'SIM'
+#include <navcam/client.h>
+int nc_error(int code, const char *fmt) { return code + (fmt != 0); }
+const char *nc_errmsg(void) { return "mine"; }
+int main(void) { struct nc_client *c = 0; return nc_client_connect("x", 1, 1, &c) == -22 && nc_error(1, 0) == 1 ? 0 : 1; }
+SIM
+cc -std=c11 -Wall -Werror "${san[@]}" -o "$tmp/clash" "$tmp/clash.c" $(pkg-config --cflags --libs navcam-client) \
+  2>"$tmp/clash.log" && "$tmp/clash" && ok || bad "a simulator with its own nc_error: $(cat "$tmp/clash.log")"
+cp "$tmp/clash.c" "$tmp/clash.cc"
+c++ -Wall -Werror "${san[@]}" -o "$tmp/clashpp" "$tmp/clash.cc" $(pkg-config --cflags --libs navcam-client) \
+  2>"$tmp/clashpp.log" && "$tmp/clashpp" && ok || bad "the client library from C++: $(cat "$tmp/clashpp.log")"
+
 port=$((20000 + RANDOM % 20000))
 "$prefix/bin/navcam" serve --set serve.mode=lockstep --set serve.tcp_port=$port --set serve.udp_port=0 \
   --set 'outputs=[{driver: null}]' --set camera.width_px=64 --set camera.height_px=48 -n 1 -t 60 \
