@@ -540,7 +540,11 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             nc__rt_rocks_place(&b->rocks, &R, b->origin_rel);
             nc__rt_rocks_mesh_px(&b->rocks, s->render.boulder_mesh_px, 1 / fmax(s->camera.fx_px, s->camera.fy_px));
             rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
-            rt->stats.boulder_mesh_px[i] = b->rocks.mesh_k2 > 0 ? s->render.boulder_mesh_px : 0;
+            /* recorded where a rock can have its detailed surface: the
+             * largest spans the pixels asked for at the nearest possible range */
+            const int can_mesh = b->rocks.mesh_k2 > 0 && b->rocks.traced &&
+                                 (dmin <= 0 || 2 * src->boulders.rock[0].half_m >= s->render.boulder_mesh_px * px_m);
+            rt->stats.boulder_mesh_px[i] = can_mesh ? s->render.boulder_mesh_px : 0;
             rt->stats.boulders_traced[i] = b->rocks.traced;
             rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
             rt->rocks_on |= b->rocks.traced > 0;
