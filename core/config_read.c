@@ -303,9 +303,10 @@ int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
         if ((la > lk && !strncmp(a, k, lk) && a[lk] == '_') || (lk > la && !strncmp(a, k, la) && k[la] == '_'))
             best = a;
     }
-    /* a key that several sections read (a seed) names none of them */
+    /* the one section within this one that reads the key, else the one in
+     * the whole file; a key that several read (a seed) names none of them */
     const struct nc_cfg_node *w = NULL;
-    if (!best && askers(cfg->root, u->key, p, &w) != 1)
+    if (!best && askers(p, u->key, p, &w) != 1 && (w = NULL, askers(cfg->root, u->key, p, &w) != 1))
         w = NULL;
     if (best)
         snprintf(hint, sizeof hint, "; did you mean '%s'?", best);

@@ -102,6 +102,10 @@ int main(void)
         const char *moved[] = {"bodies.0.radius_m=5"};
         expect_error("key in another section", NULL, NULL, moved, 1, "bodies[0].radius_m: unknown key; 'radius_m' is "
                      "read in bodies[0].shape", "(this section takes: name, shape,");
+        const char *two[] = {"bodies.1={shape: {type: sphere, radius_m: 5}, material: {model: lambert, A: 0.1}, "
+                             "position_m: [0, 0, 900]}", "bodies.0.radius_m=5"};
+        expect_error("key in another section, two bodies", NULL, NULL, two, 2,
+                     "bodies[0].radius_m: unknown key; 'radius_m' is read in bodies[0].shape", NULL);
         /* the Sun's and render settings are read and checked before any body is built */
         expect_error("render key before the bodies", "{type: sphere, radius_m: 500}",
                      "{type: mesh, file: nowhere.obj, unit: km}", cut, 1, "render.samples: unknown key", NULL);
