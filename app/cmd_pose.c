@@ -73,7 +73,8 @@ int main(int argc, char **argv)
             if (parse_vec(optarg, att, 4) < 0)
                 goto bad;
             why = "not a unit quaternion within 1e-6";
-            if (fabs(sqrt(att[0] * att[0] + att[1] * att[1] + att[2] * att[2] + att[3] * att[3]) - 1) > 1e-6)
+            if (fabs(sqrt(att[0] * att[0] + att[1] * att[1] + att[2] * att[2] + att[3] * att[3]) - 1) >
+                NC_PROTO_QUAT_TOL)
                 goto bad;
             break;
         case 'S':
@@ -84,12 +85,14 @@ int main(int argc, char **argv)
         case 'c': m.flags |= NC_MSG_CAPTURE; break;
         case 'R': m.type = NC_MSG_TRIGGER; m.flags |= NC_MSG_CAPTURE; break;
         case 'e':
-            if (parse_vec(optarg, &v, 1) < 0 || (why = "not within 0 to 3600 s", !(v >= 0 && v <= 3600)))
+            if (parse_vec(optarg, &v, 1) < 0 ||
+                (why = "not within 0 to 3600 s", !(v >= 0 && v <= NC_PROTO_EXPOSURE_MAX_S)))
                 goto bad;
             m.exposure_s = v, m.flags |= NC_MSG_EXPOSURE;
             break;
         case 'g':
-            if (parse_vec(optarg, &v, 1) < 0 || (why = "not within -60 to 60 dB", !(v >= -60 && v <= 60)))
+            if (parse_vec(optarg, &v, 1) < 0 ||
+                (why = "not within -60 to 60 dB", !(v >= -NC_PROTO_GAIN_MAX_DB && v <= NC_PROTO_GAIN_MAX_DB)))
                 goto bad;
             m.gain_db = v, m.flags |= NC_MSG_GAIN;
             break;

@@ -201,9 +201,9 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
         return NC_REJECT_BAD_QUATERNION;
     if (type == NC_MSG_POSE && nc_v3_norm(m->sun) == 0)
         return NC_REJECT_BAD_VALUE;
-    if ((flags & NC_MSG_EXPOSURE) && !(m->exposure_s >= 0 && m->exposure_s <= 3600))
+    if ((flags & NC_MSG_EXPOSURE) && !(m->exposure_s >= 0 && m->exposure_s <= NC_PROTO_EXPOSURE_MAX_S))
         return NC_REJECT_BAD_VALUE;
-    if ((flags & NC_MSG_GAIN) && !(m->gain_db >= -60 && m->gain_db <= 60))
+    if ((flags & NC_MSG_GAIN) && !(m->gain_db >= -NC_PROTO_GAIN_MAX_DB && m->gain_db <= NC_PROTO_GAIN_MAX_DB))
         return NC_REJECT_BAD_VALUE;
     return NC_REJECT_NONE;
 }

@@ -24,6 +24,8 @@ extern "C" { /* C linkage, for simulators written in C++ */
 #define NC_PROTO_HEADER_BYTES 24
 #define NC_PROTO_MAX_BYTES 1024 /* any valid message is smaller */
 #define NC_PROTO_QUAT_TOL 1e-6  /* | |q| - 1 | allowed, then normalised */
+#define NC_PROTO_EXPOSURE_MAX_S 3600.0 /* EXPOSURE: 0 to this */
+#define NC_PROTO_GAIN_MAX_DB 60.0      /* GAIN: -this to this */
 
 /* POSE and TRIGGER: simulator -> NavCam. FRAME: NavCam -> simulator over
  * TCP, one per captured request, once the frame is with every output. */
