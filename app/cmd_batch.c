@@ -371,6 +371,11 @@ int main(int argc, char **argv)
         nc_scene_pose(&base, 0, &pose);
         pose.cam_position_m = rows[i].p;
         pose.cam_attitude_q = rows[i].q;
+        if (rows[i].body_frame) { /* SUM-like: moved with bodies[0], as camera.sumfile is */
+            const struct nc_body *b0 = &base.body[0];
+            pose.cam_position_m = nc_v3_add(b0->position_m, nc_quat_rotate(b0->attitude_q, rows[i].p));
+            pose.cam_attitude_q = nc_quat_mul(b0->attitude_q, rows[i].q);
+        }
         pose.sun = nc_v3_unit(rows[i].sun);
         pose.sun_is_position = 0;
         nc_scene_apply_pose(&s, &pose);

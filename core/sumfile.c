@@ -10,11 +10,16 @@
 
 #include "core/error.h"
 
-enum { IT_SIZE, IT_MMFL, IT_SCOBJ, IT_CX, IT_CY, IT_CZ, IT_SZ, IT_K, IT_N };
+enum { IT_SIZE, IT_MMFL, IT_SCOBJ, IT_CX, IT_CY, IT_CZ, IT_SZ, IT_K, IT_DIST, IT_SIGMA_VSO, IT_SIGMA_PTG, IT_N };
 static const struct {
     const char *label; /* how the line's label starts */
-    int count;         /* numbers before it */
-} items[IT_N] = {{"NPX", 4}, {"MMFL", 3}, {"SCOBJ", 3}, {"CX", 3}, {"CY", 3}, {"CZ", 3}, {"SZ", 3}, {"K-MATRIX", 6}};
+    int count;         /* numbers before it (-1: not read) */
+} items[IT_N] = {{"NPX", 4},   {"MMFL", 3},     {"SCOBJ", 3},     {"CX", 3},        {"CY", 3},       {"CZ", 3},
+                 {"SZ", 3},    {"K-MATRIX", 6}, {"DISTORTION", 4}, {"SIGMA_VSO", -1}, {"SIGMA_PTG", -1}};
+
+/* Skew the pixel grid may have (K12, K21) and still be taken as none: the
+ * most it moves a pixel over the image, px. */
+#define SKEW_MAX_PX 0.05
 
 static void trim(char *s)
 {
@@ -23,31 +28,118 @@ static void trim(char *s)
         s[--n] = 0;
 }
 
-/* Numbers at the start of line (D exponents read as E), then the label. */
-static int split(char *line, double *v, int max, char **label)
+/* The item whose label the line carries after its numbers (a label starts
+ * the line or follows a blank or a comma), and where: -1 if none. */
+static int find_label(const char *line, const char **at)
 {
-    for (char *c = line; *c; c++)
-        if ((*c == 'D' || *c == 'd') && c > line && (isdigit((unsigned char)c[-1]) || c[-1] == '.') &&
-            (c[1] == '+' || c[1] == '-' || isdigit((unsigned char)c[1])))
-            *c = 'E';
+    for (int it = 0; it < IT_N; it++) {
+        const size_t n = strlen(items[it].label);
+        for (const char *p = strstr(line, items[it].label); p; p = strstr(p + 1, items[it].label))
+            if ((p == line || isspace((unsigned char)p[-1]) || p[-1] == ',') && !isalnum((unsigned char)p[n]) &&
+                p[n] != '_') {
+                *at = p;
+                return it;
+            }
+    }
+    return -1;
+}
+
+/* The numbers of text (blank- or comma-separated; Fortran D exponents read
+ * as E) into v[0..max); how many, or -1 with *bad the token that is not a
+ * number (NUL-terminated in place). */
+static int numbers(char *text, double *v, int max, char **bad)
+{
     int n = 0;
-    char *s = line, *end;
-    for (;;) {
+    for (char *s = text;;) {
         s += strspn(s, " \t,");
-        double x = strtod(s, &end);
-        if (end == s || (*end && !isspace((unsigned char)*end) && *end != ','))
-            break;
+        if (!*s)
+            return n;
+        char *tok = s, num[64], *end;
+        s += strcspn(s, " \t,");
+        if (*s)
+            *s++ = 0;
+        snprintf(num, sizeof num, "%s", tok);
+        for (char *c = num + 1; *c; c++)
+            if ((*c == 'D' || *c == 'd') && (isdigit((unsigned char)c[-1]) || c[-1] == '.'))
+                *c = 'E';
+        const double x = strtod(num, &end);
+        if (*end || end == num || strlen(tok) >= sizeof num) {
+            *bad = tok;
+            return -1;
+        }
         if (n < max)
             v[n] = x;
         n++;
-        s = end;
     }
-    *label = s;
-    trim(s);
-    return n;
 }
 
 static double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+int nc_sumfile_rotation(const double *const ax[3], struct nc_quat *q, int *item)
+{
+    static const char *const names[3] = {"CX", "CY", "CZ"};
+    for (int a = 0; a < 3; a++) {
+        *item = a;
+        const double len = sqrt(dot(ax[a], ax[a]));
+        if (!(fabs(len - 1) <= NC_SUMFILE_AXES_TOL))
+            return nc_error(NC_ECONFIG, "%s: not a unit vector (length %.9g; within %g of 1 is taken)", names[a],
+                            len, NC_SUMFILE_AXES_TOL);
+        for (int b = 0; b < a; b++)
+            if (!(fabs(dot(ax[a], ax[b])) <= NC_SUMFILE_AXES_TOL))
+                return nc_error(NC_ECONFIG, "%s and %s are not perpendicular (dot product %.6g; up to %g is taken)",
+                                names[b], names[a], dot(ax[a], ax[b]), NC_SUMFILE_AXES_TOL);
+    }
+    const double *x0 = ax[0], *y0 = ax[1], *z0 = ax[2];
+    const double c[3] = {x0[1] * y0[2] - x0[2] * y0[1], x0[2] * y0[0] - x0[0] * y0[2], x0[0] * y0[1] - x0[1] * y0[0]};
+    if (dot(c, z0) < 0)
+        return nc_error(NC_ECONFIG, "CX, CY, CZ are left-handed (CX x CY = -CZ): not a rotation");
+    /* Exactly orthonormal: CZ kept (a point on the boresight stays at CTR,
+     * as SPC projects it), CX made perpendicular to it, CY = CZ x CX. */
+    double z[3], x[3], y[3];
+    const double lz = sqrt(dot(z0, z0)), xz = dot(x0, z0) / (lz * lz);
+    for (int i = 0; i < 3; i++) {
+        z[i] = z0[i] / lz;
+        x[i] = x0[i] - xz * z0[i];
+    }
+    const double lx = sqrt(dot(x, x));
+    for (int i = 0; i < 3; i++)
+        x[i] /= lx;
+    y[0] = z[1] * x[2] - z[2] * x[1];
+    y[1] = z[2] * x[0] - z[0] * x[2];
+    y[2] = z[0] * x[1] - z[1] * x[0];
+    struct nc_mat3 r; /* columns: the camera axes in the body frame */
+    for (int i = 0; i < 3; i++) {
+        r.m[i][0] = x[i];
+        r.m[i][1] = y[i];
+        r.m[i][2] = z[i];
+    }
+    *q = nc_quat_from_mat(&r);
+    return 0;
+}
+
+/* The K-MATRIX terms NavCam's camera does not model: K13 and K23 must be
+ * 0, and K12, K21 (a skewed grid) may move no pixel by more than
+ * SKEW_MAX_PX over the image; the DISTORTION terms must be 0. */
+static int unmodelled(const char *path, const int *seen, const struct nc_sumfile *s, const double *dist)
+{
+    const double *k = s->k;
+    if (k[2] != 0 || k[5] != 0)
+        return nc_error(NC_ECONFIG, "%s:%d: K-MATRIX: K13 = %g, K23 = %g: NavCam's camera has no such terms (it "
+                                    "needs both 0)",
+                        path, seen[IT_K], k[2], k[5]);
+    const double ex = fmax(fabs(1 - s->ctr[0]), fabs(s->npx - s->ctr[0])) / fabs(k[0]), /* mm from CTR */
+        ey = fmax(fabs(1 - s->ctr[1]), fabs(s->nln - s->ctr[1])) / fabs(k[4]);
+    const double skew = fmax(fabs(k[1]) * ey, fabs(k[3]) * ex);
+    if (!(skew <= SKEW_MAX_PX))
+        return nc_error(NC_ECONFIG, "%s:%d: K-MATRIX: K12 = %g, K21 = %g skew the pixel grid, moving pixels by up "
+                                    "to %.3g px; NavCam's camera has no skew and takes it as none only up to %g px",
+                        path, seen[IT_K], k[1], k[3], skew, SKEW_MAX_PX);
+    if (seen[IT_DIST] && (dist[0] != 0 || dist[1] != 0 || dist[2] != 0 || dist[3] != 0))
+        return nc_error(NC_ECONFIG, "%s:%d: DISTORTION: %g %g %g %g: NavCam does not model SPC's distortion terms "
+                                    "(it needs all four 0)",
+                        path, seen[IT_DIST], dist[0], dist[1], dist[2], dist[3]);
+    return 0;
+}
 
 int nc_sumfile_read(const char *path, struct nc_sumfile *out)
 {
@@ -57,6 +149,7 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
         return nc_error(-errno, "%s: %s", path, strerror(errno));
     char line[1024];
     int lineno = 0, seen[IT_N] = {0}, rc = 0;
+    double dist[4] = {0};
     while (fgets(line, sizeof line, f)) {
         lineno++;
         if (!strchr(line, '\n') && !feof(f)) {
@@ -73,25 +166,38 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
             snprintf(out->utc, sizeof out->utc, "%s", line + strspn(line, " \t"));
             continue;
         }
-        double v[8];
-        char *label;
-        int n = split(line, v, 8, &label);
-        if (!strncmp(label, "LANDMARKS", 9) || !strncmp(label, "END FILE", 8))
+        const char *start = line + strspn(line, " \t");
+        if (!strncmp(start, "LANDMARKS", 9) || !strncmp(start, "END FILE", 8))
             break;
-        int it = 0;
-        for (; it < IT_N; it++)
-            if (!strncmp(label, items[it].label, strlen(items[it].label)) &&
-                !isalnum((unsigned char)label[strlen(items[it].label)]))
-                break;
-        if (it == IT_N)
-            continue; /* DISTORTION, SIGMA_VSO, SIGMA_PTG: not used */
+        const char *at;
+        const int it = find_label(line, &at);
+        if (it < 0 || items[it].count < 0)
+            continue; /* SIGMA_VSO, SIGMA_PTG, lines NavCam does not know */
+        if (seen[it]) {
+            rc = nc_error(NC_ECONFIG, "%s:%d: %s: given twice (lines %d and %d)", path, lineno, items[it].label,
+                          seen[it], lineno);
+            break;
+        }
+        line[at - line] = 0;
+        double v[8];
+        char *bad;
+        const int n = numbers(line, v, 8, &bad);
+        if (n < 0) {
+            rc = nc_error(NC_ECONFIG, "%s:%d: %s: '%s' is not a number", path, lineno, items[it].label, bad);
+            break;
+        }
         if (n != items[it].count) {
             rc = nc_error(NC_ECONFIG, "%s:%d: %s: expected %d numbers before the label, found %d", path, lineno,
                           items[it].label, items[it].count, n);
             break;
         }
+        for (int k = 0; k < n && !rc; k++)
+            if (!isfinite(v[k]))
+                rc = nc_error(NC_ECONFIG, "%s:%d: %s: number %d is not finite", path, lineno, items[it].label, k + 1);
+        if (rc)
+            break;
         seen[it] = lineno;
-        double *dst[IT_N] = {NULL, NULL, out->scobj_km, out->cx, out->cy, out->cz, out->sz, out->k};
+        double *dst[IT_N] = {NULL, NULL, out->scobj_km, out->cx, out->cy, out->cz, out->sz, out->k, dist};
         if (it == IT_SIZE) {
             if (v[0] != floor(v[0]) || v[1] != floor(v[1]) || v[0] < 1 || v[0] > 16384 || v[1] < 1 || v[1] > 16384) {
                 rc = nc_error(NC_ECONFIG, "%s:%d: NPX, NLN: expected image sizes of 1..16384 pixels, got %g x %g",
@@ -107,13 +213,6 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
         } else {
             memcpy(dst[it], v, (size_t)items[it].count * sizeof *v);
         }
-        for (int k = 0; k < items[it].count; k++)
-            if (!isfinite(v[k])) {
-                rc = nc_error(NC_ECONFIG, "%s:%d: %s: number %d is not finite", path, lineno, items[it].label, k + 1);
-                break;
-            }
-        if (rc)
-            break;
     }
     fclose(f);
     if (rc < 0)
@@ -121,7 +220,7 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
     if (lineno < 2)
         return nc_error(NC_ECONFIG, "%s: %d lines: not a SUM file (picture name, UTC, then the geometry)", path,
                         lineno);
-    for (int it = 0; it < IT_N; it++)
+    for (int it = 0; it <= IT_K; it++)
         if (!seen[it])
             return nc_error(NC_ECONFIG, "%s: no %s line (expected %d numbers followed by the label '%s')", path,
                             items[it].label, items[it].count, items[it].label);
@@ -129,26 +228,17 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
         return nc_error(NC_ECONFIG, "%s:%d: MMFL: the focal length must be > 0 mm, got %g", path, seen[IT_MMFL],
                         out->mmfl_mm);
     const double *ax[3] = {out->cx, out->cy, out->cz};
-    static const char *const names[3] = {"CX", "CY", "CZ"};
-    for (int a = 0; a < 3; a++) {
-        if (fabs(dot(ax[a], ax[a]) - 1) > 2e-3)
-            return nc_error(NC_ECONFIG, "%s:%d: %s: not a unit vector (length %.6g)", path, seen[IT_CX + a],
-                            names[a], sqrt(dot(ax[a], ax[a])));
-        for (int b = a + 1; b < 3; b++)
-            if (fabs(dot(ax[a], ax[b])) > 1e-3)
-                return nc_error(NC_ECONFIG, "%s:%d: %s and %s are not perpendicular (dot product %.6g)", path,
-                                seen[IT_CX + b], names[a], names[b], dot(ax[a], ax[b]));
+    int item;
+    if (nc_sumfile_rotation(ax, &out->q, &item) < 0) {
+        char why[256];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_error(NC_ECONFIG, "%s:%d: %s", path, seen[IT_CX + item], why);
     }
-    double cross[3] = {out->cx[1] * out->cy[2] - out->cx[2] * out->cy[1], out->cx[2] * out->cy[0] - out->cx[0] * out->cy[2],
-                       out->cx[0] * out->cy[1] - out->cx[1] * out->cy[0]};
-    if (dot(cross, out->cz) < 0)
-        return nc_error(NC_ECONFIG, "%s:%d: CX, CY, CZ are left-handed (CX x CY = -CZ): not a rotation", path,
-                        seen[IT_CZ]);
     if (!(dot(out->sz, out->sz) > 0))
         return nc_error(NC_ECONFIG, "%s:%d: SZ: the Sun direction is zero", path, seen[IT_SZ]);
     if (out->k[0] == 0 || out->k[4] == 0)
         return nc_error(NC_ECONFIG, "%s:%d: K-MATRIX: K11 and K22 (pixels/mm) must not be zero", path, seen[IT_K]);
-    return 0;
+    return unmodelled(path, seen, out, dist);
 }
 
 int nc_sumfile_write(const char *path, const struct nc_sumfile *s)

@@ -1,6 +1,7 @@
 /* traj.c - reading trajectories (traj.h). */
 #include "core/traj.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -8,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/sumfile.h"
 
 /* The built-in approach to the default scene's asteroid (as `make demo`):
  * 8 poses, 16 km to 3 km, one per second, looking at the body. */
@@ -36,24 +38,30 @@ static const char sum_cols[] = "t_s,scobj_x_km,scobj_y_km,scobj_z_km,cx_x,cx_y,c
 /* A SUM-like row: v[1..3] SCOBJ km, v[4..12] CX CY CZ, v[13..15] SZ. */
 static int sum_row(const char *path, size_t lineno, const double *v, struct nc_traj_row *r)
 {
-    struct nc_mat3 m;
-    for (int a = 0; a < 3; a++) {
-        const double *ax = v + 4 + 3 * a;
-        double len = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
-        if (fabs(len - 1) > 2e-3)
-            return nc_error(NC_ECONFIG, "%s:%zu: %s is not a unit vector (length %.6g)", path, lineno,
-                            a == 0 ? "CX" : a == 1 ? "CY" : "CZ", len);
-        for (int i = 0; i < 3; i++)
-            m.m[i][a] = ax[i];
+    const double *ax[3] = {v + 4, v + 7, v + 10};
+    int item;
+    if (nc_sumfile_rotation(ax, &r->q, &item) < 0) {
+        char why[256];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_error(NC_ECONFIG, "%s:%zu: %s", path, lineno, why);
     }
-    struct nc_vec3 x = nc_v3(v[4], v[5], v[6]), y = nc_v3(v[7], v[8], v[9]), z = nc_v3(v[10], v[11], v[12]);
-    if (fabs(nc_v3_dot(x, y)) > 1e-3 || fabs(nc_v3_dot(y, z)) > 1e-3 || fabs(nc_v3_dot(x, z)) > 1e-3 ||
-        nc_v3_dot(nc_v3_cross(x, y), z) < 0)
-        return nc_error(NC_ECONFIG, "%s:%zu: CX, CY, CZ are not a right-handed orthonormal set", path, lineno);
     r->p = nc_v3(-1e3 * v[1], -1e3 * v[2], -1e3 * v[3]);
-    r->q = nc_quat_from_mat(&m);
     r->sun = nc_v3(v[13], v[14], v[15]);
+    r->body_frame = 1;
     return 0;
+}
+
+/* Whether a header names the SUM-like layout: its first names t_s and
+ * scobj_x_km, blanks around the comma allowed. */
+static int sum_header(const char *line)
+{
+    char c[32];
+    size_t n = 0;
+    for (const char *s = line; *s && n < sizeof c - 1; s++)
+        if (!isspace((unsigned char)*s))
+            c[n++] = *s;
+    c[n] = 0;
+    return !strncmp(c, "t_s,scobj_x_km", 14);
 }
 
 int nc_traj_read(const char *path, struct nc_traj_row **out)
@@ -84,7 +92,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
                 s++;
         }
         if (k == 0 && n == 0 && !sum) { /* a header: which layout */
-            sum = !strncmp(line + strspn(line, " \t"), "t_s,scobj_x_km", 14);
+            sum = sum_header(line);
             continue;
         }
         int bad = k < need || (*s && *s != '\n' && *s != '\r');
@@ -108,6 +116,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         r->t_s = v[0];
         r->capture = k == need + 1 ? v[need] != 0 : 1;
         r->line = (int)lineno;
+        r->body_frame = 0;
         if (sum) {
             if ((rc = sum_row(path, lineno, v, r)) < 0)
                 break;

@@ -11,9 +11,9 @@
  *   cy_z, cz_x, cz_y, cz_z, sz_x, sz_y, sz_z[, capture]
  * an SPC SUM file's geometry (core/sumfile.h) per row: SCOBJ (km,
  * spacecraft -> body centre), the camera axes CX, CY, CZ and the Sun
- * direction SZ, all in bodies[0]'s body-fixed frame, which is then the
- * scene frame (bodies[0] at the origin, unturned). The intrinsics are the
- * scene's camera.
+ * direction SZ, all in bodies[0]'s body-fixed frame (body_frame set: a
+ * user that knows the scene moves the pose with bodies[0], as
+ * camera.sumfile does). The intrinsics are the scene's camera.
  * "builtin:approach" names the default scene's built-in approach.
  */
 #ifndef NC_TRAJ_H
@@ -28,6 +28,7 @@ struct nc_traj_row {
     struct nc_vec3 sun; /* toward the Sun, bodies[0] frame */
     int capture;
     int line;         /* in the file (0: built in) */
+    int body_frame;   /* 1: p and q are in bodies[0]'s body-fixed frame (SUM-like rows) */
 };
 
 /* Rows of path into *out (caller frees); the count, or < 0 with a message

@@ -26,10 +26,7 @@ static int sumfile_intrinsics(struct nc_cfg_node *map, struct nc_camera *c, stru
         snprintf(why, sizeof why, "%s", nc_errmsg());
         return nc_cfg_error(node, "%s", why);
     }
-    const double *k = sum->k;
-    if (fabs(k[1]) > 1e-6 * fabs(k[0]) || fabs(k[3]) > 1e-6 * fabs(k[4]))
-        return nc_cfg_error(node, "%s: K-MATRIX K12 = %g, K21 = %g: a skewed pixel grid, which NavCam's camera "
-                                  "does not model (it needs K12 = K21 = 0)", path, k[1], k[3]);
+    const double *k = sum->k; /* K12, K21: a skew of 0.05 px at most (nc_sumfile_read), taken as none */
     c->width_px = sum->npx;
     c->height_px = sum->nln;
     c->fx_px = sum->mmfl_mm * fabs(k[0]);
@@ -137,13 +134,7 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
         return rc;
     if (c->from_sumfile) { /* the pose in bodies[0]'s frame (the scene moves it with that body) */
         c->position_m = nc_v3(-1e3 * sum.scobj_km[0], -1e3 * sum.scobj_km[1], -1e3 * sum.scobj_km[2]);
-        struct nc_mat3 r; /* columns: the camera axes in the body frame */
-        for (int i = 0; i < 3; i++) {
-            r.m[i][0] = sum.cx[i];
-            r.m[i][1] = sum.cy[i];
-            r.m[i][2] = sum.cz[i];
-        }
-        c->attitude_q = nc_quat_from_mat(&r);
+        c->attitude_q = sum.q;
         return 0;
     }
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)

@@ -9,8 +9,9 @@
  * v(I, J), v(I, J+1), v(I+1, J+1), v(I+1, J), wound outward on every face
  * (the PDS icqm.txt description; its face axes are tabulated in
  * docs/sumfiles.md); it becomes two triangles with the same winding.
- * Vertices on the cube's edges are listed once per face; copies with equal
- * coordinates are welded into one, so the surface is closed.
+ * Vertices on the cube's edges are listed once per face; the copies of one
+ * (the same point of the cube, by the face axes) are welded into one, so
+ * the surface is closed, and must agree to 1e-6 of the model's extent.
  */
 #include <errno.h>
 #include <math.h>
@@ -21,15 +22,32 @@
 #include "core/error.h"
 #include "render/mesh.h"
 
-static const double *sort_base; /* qsort has no context argument; loading is single-threaded */
+/* Face F's axes (docs/sumfiles.md): outward, I's and J's directions, each
+ * an axis 1..3 (x, y, z) with its sign. */
+static const int face_axes[6][3] = {{3, 1, -2}, {-2, 1, -3}, {-1, -2, -3}, {2, -1, -3}, {1, 2, -3}, {-3, 1, 2}};
 
-static int by_xyz(const void *a, const void *b)
+/* Vertex (F, I, J) as a point of the cube [-Q, Q]^3 (twice its own
+ * coordinates, so whole numbers), packed into one key: the copies of an
+ * edge's vertex have the same. */
+static uint64_t cube_point(long q, size_t face, size_t i, size_t j)
 {
-    const double *p = sort_base + 3 * (size_t)*(const uint32_t *)a, *q = sort_base + 3 * (size_t)*(const uint32_t *)b;
-    for (int k = 0; k < 3; k++)
-        if (p[k] != q[k])
-            return p[k] < q[k] ? -1 : 1;
-    return *(const uint32_t *)a < *(const uint32_t *)b ? -1 : 1;
+    const long w[3] = {q, 2 * (long)i - q, 2 * (long)j - q};
+    long p[3] = {q, q, q}; /* from 0 to 2Q: 13 bits each for Q <= 2048 */
+    for (int k = 0; k < 3; k++) {
+        const int a = face_axes[face][k];
+        p[abs(a) - 1] += a > 0 ? w[k] : -w[k];
+    }
+    return (uint64_t)p[0] << 26 | (uint64_t)p[1] << 13 | (uint64_t)p[2];
+}
+
+static const uint64_t *sort_base; /* qsort has no context argument; loading is single-threaded */
+
+static int by_point(const void *a, const void *b)
+{
+    const uint32_t i = *(const uint32_t *)a, j = *(const uint32_t *)b;
+    if (sort_base[i] != sort_base[j])
+        return sort_base[i] < sort_base[j] ? -1 : 1;
+    return i < j ? -1 : 1;
 }
 
 int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
@@ -42,7 +60,8 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
     long q = 0;
     size_t lineno = 0, nv = 0, want = 0;
     double *v = NULL;
-    uint32_t *tri = NULL, *order = NULL, *weld = NULL;
+    uint32_t *tri = NULL, *order = NULL, *weld = NULL, *vline = NULL;
+    uint64_t *cube = NULL;
     int rc = 0;
     while (fgets(line, sizeof line, f)) {
         lineno++;
@@ -58,7 +77,7 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
                 break;
             }
             want = 6 * (size_t)(q + 1) * (size_t)(q + 1);
-            if (!(v = malloc(3 * want * sizeof *v))) {
+            if (!(v = malloc(3 * want * sizeof *v)) || !(vline = malloc(want * sizeof *vline))) {
                 rc = nc_error(-ENOMEM, "%s: out of memory for %zu vertices", path, want);
                 break;
             }
@@ -84,6 +103,7 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
         }
         for (int c = 0; c < 3; c++)
             v[3 * nv + (size_t)c] = x[c] * scale;
+        vline[nv] = (uint32_t)lineno;
         nv++;
     }
     fclose(f);
@@ -91,21 +111,38 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
         rc = nc_error(NC_EMESH, "%s: empty: no Q line", path);
     if (rc == 0 && nv != want)
         rc = nc_error(NC_EMESH, "%s: %zu vertices, but Q = %ld needs 6 (Q+1)^2 = %zu", path, nv, q, want);
-    /* Weld equal coordinates: the first of each run keeps its place. */
-    if (rc == 0 && (!(order = malloc(nv * sizeof *order)) || !(weld = malloc(nv * sizeof *weld))))
+    /* Weld the copies of each point of the cube: the first keeps its place. */
+    const size_t side = (size_t)q + 1;
+    if (rc == 0 && (!(order = malloc(nv * sizeof *order)) || !(weld = malloc(nv * sizeof *weld)) ||
+                    !(cube = malloc(nv * sizeof *cube))))
         rc = nc_error(-ENOMEM, "%s: out of memory", path);
     if (rc == 0) {
-        for (size_t i = 0; i < nv; i++)
-            order[i] = (uint32_t)i;
-        sort_base = v;
-        qsort(order, nv, sizeof *order, by_xyz);
+        double extent = 0;
         for (size_t i = 0; i < nv; i++) {
-            size_t first = i;
-            while (first > 0 && !memcmp(v + 3 * (size_t)order[first - 1], v + 3 * (size_t)order[i], 3 * sizeof *v))
-                first--;
-            weld[order[i]] = order[first]; /* runs are short: at most 3 copies of a corner */
+            order[i] = (uint32_t)i;
+            cube[i] = cube_point(q, i / (side * side), i % side, i / side % side);
+            for (int c = 0; c < 3; c++)
+                extent = fmax(extent, fabs(v[3 * i + (size_t)c]));
         }
-        const size_t Q = (size_t)q, side = Q + 1, nt = 12 * Q * Q;
+        sort_base = cube;
+        qsort(order, nv, sizeof *order, by_point);
+        for (size_t i = 0; i < nv && rc == 0; i++) {
+            size_t first = i;
+            while (first > 0 && cube[order[first - 1]] == cube[order[i]])
+                first--;
+            const uint32_t a = order[first], b = order[i];
+            weld[b] = a; /* runs are short: at most 3 copies of a corner */
+            const double *pa = v + 3 * (size_t)a, *pb = v + 3 * (size_t)b;
+            const double d = sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
+                                  (pa[2] - pb[2]) * (pa[2] - pb[2]));
+            if (d > 1e-6 * extent)
+                rc = nc_error(NC_EMESH, "%s:%u: this vertex and the one on line %u are the same point of the cube's "
+                                        "edges (faces %zu and %zu), but lie %.6g m apart: not a closed ICQ surface",
+                              path, vline[b], vline[a], (size_t)a / (side * side) + 1, (size_t)b / (side * side) + 1, d);
+        }
+    }
+    if (rc == 0) {
+        const size_t Q = (size_t)q, nt = 12 * Q * Q;
         if (!(tri = malloc(3 * nt * sizeof *tri)))
             rc = nc_error(-ENOMEM, "%s: out of memory", path);
         for (size_t face = 0, t = 0; rc == 0 && face < 6; face++)
@@ -129,5 +166,7 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
     free(tri);
     free(order);
     free(weld);
+    free(cube);
+    free(vline);
     return rc;
 }

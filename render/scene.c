@@ -192,6 +192,10 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const st
                                                           "sun.direction");
     if ((hp = nc_cfg_vec3(map, "position_m", &sun->position_m)) < 0)
         return hp;
+    if (sum_dir && hp)
+        return nc_cfg_error(nc_cfg_get(map, "position_m"), "camera.sumfile gives the Sun's direction (SZ): give "
+                                                           "sun.distance_au or sun.irradiance_w_m2 instead of "
+                                                           "sun.position_m");
     if ((hdist = nc_cfg_double(map, "distance_au", 1e-3, 1e4, &dist_au)) < 0)
         return hdist;
     if ((rc = nc_cfg_double(map, "irradiance_w_m2", 0, 1e9, &sun->irradiance_w_m2)) < 0)
@@ -199,10 +203,10 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const st
     sun->irradiance_override = rc;
     if (hd && hp)
         return nc_cfg_error(nc_cfg_get(map, "position_m"), "give either direction or position_m, not both");
-    if (sum_dir && !hp && !hdist && !sun->irradiance_override)
+    if (sum_dir && !hdist && !sun->irradiance_override)
         return nc_cfg_missing(map, "distance_au", "the heliocentric distance in au (camera.sumfile gives the Sun's "
                                                   "direction only)");
-    if (sum_dir && !hp) {
+    if (sum_dir) {
         sun->direction = *sum_dir;
         hd = 1;
     }

@@ -92,6 +92,17 @@ import json; d = json.load(open('sumcmp.json'))
 assert d['relative_error']['p95'] < 0.02 and d['limb_iou'] > 0.99, d
 print('SUM-like rows: p95 %.4f, IoU %.4f' % (d['relative_error']['p95'], d['limb_iou']))" || fail "SUM-like rows differ"
 
+# SUM-like rows are in bodies[0]'s frame: with the body moved and turned,
+# the camera moves with it and sees the same frame.
+"$navcam" batch traj_sum.csv -o sum_moved "${scene[@]}" --no-geometry --set 'bodies.0.position_m=[300,-200,100]' \
+  --set 'bodies.0.attitude_q=[0.9238795,0.3826834,0,0]' > /dev/null 2>&1 || fail "SUM-like rows, body moved"
+"$navcam" compare sum/frame_000003.fits sum_moved/frame_000003.fits --fit none > movedcmp.json || fail "compare"
+python3 -c "
+import json; d = json.load(open('movedcmp.json'))
+assert d['relative_error']['p95'] < 0.02 and d['limb_iou'] > 0.99, d
+print('SUM-like rows, body moved: p95 %.4f, IoU %.4f' % (d['relative_error']['p95'], d['limb_iou']))" ||
+  fail "SUM-like rows with bodies[0] moved and turned: the camera did not move with it"
+
 # Errors: bad shard, bad row.
 "$navcam" batch traj.csv -o x --shard 3/3 2> err.txt && fail "--shard 3/3 accepted"
 grep -q "0 <= K < N" err.txt || fail "shard error: $(cat err.txt)"

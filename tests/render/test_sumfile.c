@@ -176,8 +176,9 @@ static void replaced(char *out, size_t len, const char *text, const char *from, 
 
 /* An ICQ sphere of radius r_km: face axes of docs/sumfiles.md (outward,
  * I direction, J direction), vertices from integer cube points so that the
- * copies on the cube's edges are equal. */
-static void write_icq(const char *path, int q, double r_km)
+ * copies on the cube's edges are equal; except that face 2's copies of
+ * its edge with face 1 (J = 0) are moved by shift_km along x. */
+static void write_icq(const char *path, int q, double r_km, double shift_km)
 {
     static const int ax[6][3][3] = {{{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},  {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
                                     {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}}, {{0, 1, 0}, {-1, 0, 0}, {0, 0, -1}},
@@ -191,18 +192,20 @@ static void write_icq(const char *path, int q, double r_km)
                 for (int k = 0; k < 3; k++)
                     p[k] = q * ax[face][0][k] + (2 * i - q) * ax[face][1][k] + (2 * j - q) * ax[face][2][k];
                 unit(p);
-                fprintf(f, "%15.5f%15.5f%15.5f\n", r_km * p[0], r_km * p[1], r_km * p[2]);
+                const double dx = face == 1 && j == 0 ? shift_km : 0;
+                fprintf(f, "%.12f %.12f %.12f\n", r_km * p[0] + dx, r_km * p[1], r_km * p[2]);
             }
     fclose(f);
 }
 
-static void check_icq(void)
+/* The ICQ sphere at path (Q = q, 250 m) loads closed, wound outward, of
+ * the sphere's area. */
+static void check_closed(const char *path, int q)
 {
-    const int q = 16;
-    const char *path = nc_test_path("SHAPE.TXT");
-    write_icq(path, q, 0.25);
     struct nc_mesh m;
     CHECK(nc_mesh_load(path, 1000, &m) == 0, "load ICQ: %s", nc_errmsg());
+    if (m.nt == 0)
+        return;
     CHECK(m.nt == 12 * q * q, "%zu triangles (12 Q^2 = %d)", m.nt, 12 * q * q);
     /* closed: every edge in exactly two triangles, once each way */
     size_t used = 0, open_edges = 0, outward = 0;
@@ -231,6 +234,29 @@ static void check_icq(void)
     double area = nc_mesh_area_m2(&m), sphere = 4 * M_PI * 250.0 * 250.0;
     CHECK(area < sphere && area > 0.98 * sphere, "area %.1f m^2 vs the sphere's %.1f", area, sphere);
     nc_mesh_free(&m);
+}
+
+static void check_icq(void)
+{
+    const int q = 16;
+    const char *path = nc_test_path("SHAPE.TXT");
+    write_icq(path, q, 0.25, 0);
+    check_closed(path, q);
+    /* Copies of an edge's vertex 0.1 mm apart (under 1e-6 of the 250 m
+     * extent) are still welded: the surface stays closed. */
+    write_icq(path, q, 0.25, 1e-7);
+    check_closed(path, q);
+    /* 1 m apart: an error naming both lines, the first at fault face 2's
+     * vertex I = 0, J = 0 (line 2 + (Q+1)^2), a copy of face 1's I = 0,
+     * J = Q (line 2 + Q (Q+1)). */
+    write_icq(path, q, 0.25, 1e-3);
+    struct nc_mesh m;
+    char want[128];
+    snprintf(want, sizeof want, "SHAPE.TXT:%d: this vertex and the one on line %d", 2 + (q + 1) * (q + 1),
+             2 + q * (q + 1));
+    CHECK(nc_mesh_load(path, 1000, &m) < 0 && nc_test_contains(nc_errmsg(), want) &&
+              nc_test_contains(nc_errmsg(), "lie 1 m apart: not a closed ICQ surface"),
+          "ICQ edge copies 1 m apart: %s (expected '%s')", nc_errmsg(), want);
     nc_test_write(nc_test_path("short.icq"), "4\n 1 2 3\n");
     CHECK(nc_mesh_load(nc_test_path("short.icq"), 1, &m) < 0 && nc_test_contains(nc_errmsg(), "1 vertices, but Q = 4 "
                                                                                                 "needs 6 (Q+1)^2 = 150"),
@@ -273,7 +299,49 @@ int main(void)
              "    0.8728715609D+00   -0.4364357805D+00    0.2182178902D+00");
     expect_error(bad, NULL, 0, "left-handed");
     replaced(bad, sizeof bad, good, " 0.00000 117.64700", " 0.50000 117.64700"); /* K21 */
-    expect_error(bad, NULL, 0, "skewed pixel grid");
+    expect_error(bad, NULL, 0, "bad.SUM:10: K-MATRIX: K12 = 0, K21 = 0.5 skew the pixel grid, moving pixels by up to "
+                               "2.17 px");
+    /* DART DRACO's K21 = 0.0031 px/mm moves these pixels by 0.013 px at most: taken as none */
+    replaced(bad, sizeof bad, good, " 0.00000 117.64700", " 0.00310 117.64700");
+    nc_test_write(nc_test_path("skew.SUM"), bad);
+    CHECK(nc_sumfile_read(nc_test_path("skew.SUM"), &sum) == 0, "a skew of 0.013 px: %s", nc_errmsg());
+    replaced(bad, sizeof bad, good, "   0.00000  K-MATRIX", "   0.10000  K-MATRIX"); /* K23 */
+    expect_error(bad, NULL, 0, "K13 = 0, K23 = 0.1: NavCam's camera has no such terms");
+    replaced(bad, sizeof bad, good, "    0.00000D+00    0.00000D+00  DISTORTION", "    0.00000D+00    0.20000D-02  DISTORTION");
+    expect_error(bad, NULL, 0, "bad.SUM:11: DISTORTION: 0 0 0 0.002: NavCam does not model SPC's distortion");
+    replaced(bad, sizeof bad, good, "    0.2000000000D+01   -0.1000000000D+01  SCOBJ",
+             "    0.2000X00000D+01   -0.1000000000D+01  SCOBJ");
+    expect_error(bad, NULL, 0, "bad.SUM:5: SCOBJ: '0.2000X00000D+01' is not a number");
+    replaced(bad, sizeof bad, good, "  SZ\n", "  SZ\n 0.6 0.8 0  SZ\n");
+    expect_error(bad, NULL, 0, "bad.SUM:10: SZ: given twice (lines 9 and 10)");
+    /* Axes off unit length or perpendicular within 1e-3 are made
+     * orthonormal keeping CZ, the boresight: CX 1.0005 long, then CX . CY
+     * = 9e-4 (CY turned about CZ). */
+    const char *cx = "    0.4472135955D+00    0.8944271910D+00    0.0000000000D+00  CX";
+    const double cz[3] = {-0.8728715609, 0.4364357805, -0.2182178902};
+    char line[128];
+    for (int k = 0; k < 2; k++) {
+        const double *c0 = (const double[]){0.4472135955, 0.8944271910, 0}, e = 9e-4;
+        const double *cy0 = (const double[]){0.1951800146, -0.09759000729, -0.9759000729};
+        if (k == 0)
+            snprintf(line, sizeof line, "%.10f %.10f %.10f  CX", 1.0005 * c0[0], 1.0005 * c0[1], 1.0005 * c0[2]);
+        else
+            snprintf(line, sizeof line, "%.10f %.10f %.10f  CX", c0[0] + e * cy0[0], c0[1] + e * cy0[1],
+                     c0[2] + e * cy0[2]);
+        replaced(bad, sizeof bad, good, cx, line);
+        nc_test_write(nc_test_path("axes.SUM"), bad);
+        CHECK(nc_sumfile_read(nc_test_path("axes.SUM"), &sum) == 0, "axes within 1e-3: %s", nc_errmsg());
+        struct nc_vec3 z = nc_quat_rotate(sum.q, nc_v3(0, 0, 1)), x = nc_quat_rotate(sum.q, nc_v3(1, 0, 0));
+        double dz = nc_v3_norm(nc_v3_sub(z, nc_v3_unit(nc_v3(cz[0], cz[1], cz[2])))),
+               dx = nc_v3_norm(nc_v3_sub(x, nc_v3(c0[0], c0[1], c0[2])));
+        CHECK(dz < 1e-9 && dx < 1e-9 + (k ? e : 0), "%s: the boresight %.3g from CZ, +X %.3g from CX",
+              k ? "CX . CY 9e-4" : "CX 1.0005 long", dz, dx);
+    }
+    snprintf(line, sizeof line, "%.10f %.10f %.10f  CX", 1.0015 * 0.4472135955, 1.0015 * 0.8944271910, 0.0);
+    replaced(bad, sizeof bad, good, cx, line);
+    expect_error(bad, NULL, 0, "bad.SUM:6: CX: not a unit vector (length 1.0015");
+    const char *sun_pos[] = {"sun={position_m: [1.0e11, 0, 0]}"};
+    expect_error(good, sun_pos, 1, "instead of sun.position_m");
     replaced(bad, sizeof bad, good, "  CY\n", " 0.3  CY\n");
     expect_error(bad, NULL, 0, "CY: expected 3 numbers before the label, found 4");
     const char *with_dir[] = {"sun={direction: [1, 0, 0], distance_au: 1}"};
