@@ -248,7 +248,7 @@ static int render(const struct nc_bench_scene *sc, const struct nc_bench_opts *o
              drawn.render.bounces, drawn.render.soft_shadows, autod && qc.all_rocks ? " rocks=all" : "",
              autod && qc.full_mesh ? " lod=off" : "");
     if (autod)
-        nc_quality_describe(&qc, out->why, sizeof out->why);
+        nc_quality_describe(&qc, 1, out->why, sizeof out->why);
     out->sw = cs.width_px;
     out->sh = cs.height_px;
     if (rc >= 0 && !(out->e = malloc((size_t)cs.width_px * (size_t)cs.height_px * sizeof *out->e)))

@@ -9,7 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include "app/cli.h"
@@ -17,6 +18,7 @@
 #include "camera/shot.h"
 #include "core/clock.h"
 #include "core/error.h"
+#include "core/fs.h"
 #include "core/traj.h"
 #include "render/image_io.h"
 
@@ -39,9 +41,10 @@ static const char batch_help[] =
     "  DIR/frame_NNNNNN.json           the row's pose, Sun, bodies, camera and render\n"
     "                                  settings and the files above; written last\n"
     "A row whose .json exists is done and skipped: rerun the same command after a\n"
-    "crash to finish. Files are written under temporary names and renamed.\n"
+    "crash to finish. Files are written under temporary names, flushed and\n"
+    "renamed; a row another process is rendering (its lock held) is passed over.\n"
     "\n"
-    "  -o, --output DIR      the dataset directory (made if missing)\n"
+    "  -o, --output DIR      the dataset directory (made with its missing parents)\n"
     "      --scene FILE      the scene (default: the built-in default scene)\n"
     "  -s, --set KEY=VALUE   override a scene key (as navcam render); repeatable\n"
     "  -q, --quantity Q      dn (default), electrons, radiance, iof, range or rock_id\n"
@@ -63,12 +66,35 @@ static void json_vec(FILE *f, const char *key, const double *v, int n, const cha
     fprintf(f, "]%s", sep);
 }
 
-/* Every file is written under a temporary name, renamed when complete. */
-static int finish(const char *tmp, const char *path)
+/* Every file is written under a temporary name, flushed to the disk and
+ * renamed when complete (nc_commit_file). */
+static int finish(const char *tmp, const char *path) { return nc_commit_file(tmp, path); }
+
+/* Row stem's lock (DIR/.STEM.lock, flock): held while the row is rendered,
+ * so that two processes given the same rows (a shard submitted again while
+ * it still runs) never write the same temporary files; the other skips the
+ * row. 1 with *fd held, 0 if another process holds it, < 0 on error. */
+static int lock_row(const char *dir, const char *stem, int *fd)
 {
-    if (rename(tmp, path) < 0)
-        return nc_error(-errno, "%s: rename to %s: %s", tmp, path, strerror(errno));
-    return 0;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/.%s.lock", dir, stem);
+    if ((*fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666)) < 0)
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    if (flock(*fd, LOCK_EX | LOCK_NB) == 0)
+        return 1;
+    const int err = errno;
+    close(*fd);
+    *fd = -1;
+    return err == EWOULDBLOCK ? 0 : nc_error(-err, "%s: flock: %s", path, strerror(err));
+}
+
+static void unlock_row(const char *dir, const char *stem, int fd, int done)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/.%s.lock", dir, stem);
+    if (done) /* the JSON is in place: nobody renders the row again */
+        unlink(path);
+    close(fd);
 }
 
 /* A text file DIR/NAME: opened as DIR/.NAME.tmp (tmp holds that path) ... */
@@ -240,6 +266,64 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
 
 static double now_s(void) { return (double)nc_mono_ns() * 1e-9; }
 
+/* ", N being rendered by another process" (a static buffer), or "" */
+static const char *busy_txt(long busy)
+{
+    static char t[64];
+    if (!busy)
+        return "";
+    snprintf(t, sizeof t, ", %ld being rendered by another process", busy);
+    return t;
+}
+
+/* Row i of the trajectory into DIR/STEM.*: the frame, the geometry and its
+ * lists (unless geometry is 0), then the JSON. */
+static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const struct nc_camsys *cs,
+                     struct nc_sky *sky, const struct nc_traj_row *row, long i, const char *dir,
+                     const char *stem, const char *ext, enum nc_quantity q, double exposure, int geometry, float *geom,
+                     int32_t *rock)
+{
+    const double t0 = now_s();
+    struct nc_scene s = *base; /* shares the meshes; render settings fresh per row */
+    struct nc_pose pose;
+    nc_scene_pose(base, 0, &pose);
+    pose.cam_position_m = row->p;
+    pose.cam_attitude_q = row->q;
+    if (row->body_frame) { /* SUM-like: moved with bodies[0], as camera.sumfile is */
+        const struct nc_body *b0 = &base->body[0];
+        pose.cam_position_m = nc_v3_add(b0->position_m, nc_quat_rotate(b0->attitude_q, row->p));
+        pose.cam_attitude_q = nc_quat_mul(b0->attitude_q, row->q);
+    }
+    pose.sun = nc_v3_unit(row->sun);
+    pose.sun_is_position = 0;
+    nc_scene_apply_pose(&s, &pose);
+    struct nc_shot_info info;
+    char tmp[4200], path[4200], rowtxt[32];
+    snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%s", dir, stem, ext);
+    snprintf(path, sizeof path, "%s/%s.%s", dir, stem, ext);
+    snprintf(rowtxt, sizeof rowtxt, "%ld", i);
+    const struct nc_image_attr extra[] = {{"navcam:batch_row", rowtxt}};
+    int rc;
+    if ((rc = nc_shot(r, &s, cs, sky, q, exposure, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
+        (rc = finish(tmp, path)) < 0)
+        return rc;
+    int nrocks = -1, ncraters = -1;
+    if (geometry) {
+        snprintf(tmp, sizeof tmp, "%s/.%s_geometry.tmp.fits", dir, stem);
+        snprintf(path, sizeof path, "%s/%s_geometry.fits", dir, stem);
+        if ((rc = nc_shot_geometry(r, &s, geom, rock)) < 0 ||
+            (rc = nc_image_write_planes(tmp, geom, s.camera.width_px, s.camera.height_px, NC_GEOM_PLANES,
+                                        nc_geom_plane_names, extra, 1)) < 0 ||
+            (rc = finish(tmp, path)) < 0 || (rc = lists(dir, stem, &s, geom, rock, &nrocks, &ncraters)) < 0)
+            return rc;
+    }
+    if ((rc = truth(dir, stem, ext, geometry, i, row, &s, q, exposure, info.quality, nrocks, ncraters)) < 0)
+        return rc;
+    printf("%s (row %ld, t = %.6g s): %.0f ms\n", stem, i, row->t_s, 1e3 * (now_s() - t0));
+    fflush(stdout);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     nc_cli_init("batch");
@@ -319,12 +403,6 @@ int main(int argc, char **argv)
         free(sets);
         return nc_cli_fail();
     }
-    if (mkdir(dir, 0777) < 0 && errno != EEXIST) {
-        fprintf(stderr, "navcam batch: %s: %s\n", dir, strerror(errno));
-        free(sets);
-        free(rows);
-        return 1;
-    }
     struct nc_scene base;
     struct nc_camsys cs;
     struct nc_sky sky;
@@ -352,63 +430,44 @@ int main(int argc, char **argv)
     snprintf(probe, sizeof probe, "f.%s", ext);
     if (rc >= 0)
         rc = nc_image_prepare(probe);
-    long done = 0, skipped = 0, mine = 0;
+    if (rc >= 0) /* once the configuration is known good: no empty directory left by a mistake in it */
+        rc = nc_mkdirs(dir);
+    long done = 0, skipped = 0, busy = 0, mine = 0;
     double t_all = now_s();
     for (long i = 0; i < nrows && rc >= 0; i++) {
         if (i % shard_n != shard_k || !rows[i].capture)
             continue;
         mine++;
-        char stem[32], path[4200], tmp[4200];
+        char stem[32], path[4200];
         snprintf(stem, sizeof stem, "frame_%06ld", i);
         snprintf(path, sizeof path, "%s/%s.json", dir, stem);
+        int lock = -1;
         if (access(path, F_OK) == 0) {
             skipped++;
             continue;
         }
-        double t0 = now_s();
-        struct nc_scene s = base; /* shares the meshes; render settings fresh per row */
-        struct nc_pose pose;
-        nc_scene_pose(&base, 0, &pose);
-        pose.cam_position_m = rows[i].p;
-        pose.cam_attitude_q = rows[i].q;
-        if (rows[i].body_frame) { /* SUM-like: moved with bodies[0], as camera.sumfile is */
-            const struct nc_body *b0 = &base.body[0];
-            pose.cam_position_m = nc_v3_add(b0->position_m, nc_quat_rotate(b0->attitude_q, rows[i].p));
-            pose.cam_attitude_q = nc_quat_mul(b0->attitude_q, rows[i].q);
-        }
-        pose.sun = nc_v3_unit(rows[i].sun);
-        pose.sun_is_position = 0;
-        nc_scene_apply_pose(&s, &pose);
-        struct nc_shot_info info;
-        snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%s", dir, stem, ext);
-        snprintf(path, sizeof path, "%s/%s.%s", dir, stem, ext);
-        char rowtxt[32];
-        snprintf(rowtxt, sizeof rowtxt, "%ld", i);
-        const struct nc_image_attr extra[] = {{"navcam:batch_row", rowtxt}};
-        if ((rc = nc_shot(&r, &s, &cs, &sky, q, exposure, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
-            (rc = finish(tmp, path)) < 0)
-            break;
-        int nrocks = -1, ncraters = -1;
-        if (geometry) {
-            snprintf(tmp, sizeof tmp, "%s/.%s_geometry.tmp.fits", dir, stem);
-            snprintf(path, sizeof path, "%s/%s_geometry.fits", dir, stem);
-            if ((rc = nc_shot_geometry(&r, &s, geom, rock)) < 0 ||
-                (rc = nc_image_write_planes(tmp, geom, s.camera.width_px, s.camera.height_px, NC_GEOM_PLANES,
-                                            nc_geom_plane_names, extra, 1)) < 0 ||
-                (rc = finish(tmp, path)) < 0 || (rc = lists(dir, stem, &s, geom, rock, &nrocks, &ncraters)) < 0)
+        if ((rc = lock_row(dir, stem, &lock)) <= 0) {
+            busy += rc == 0;
+            if (rc < 0)
                 break;
+            continue;
         }
-        if ((rc = truth(dir, stem, ext, geometry, i, &rows[i], &s, q, exposure, info.quality, nrocks, ncraters)) < 0)
+        if (access(path, F_OK) == 0) { /* finished by another process while we took the lock */
+            unlock_row(dir, stem, lock, 0);
+            skipped++;
+            continue;
+        }
+        rc = batch_row(&r, &base, &cs, &sky, &rows[i], i, dir, stem, ext, q, exposure, geometry, geom, rock);
+        unlock_row(dir, stem, lock, rc >= 0);
+        if (rc < 0)
             break;
         done++;
-        printf("%s (row %ld, t = %.6g s): %.0f ms\n", stem, i, rows[i].t_s, 1e3 * (now_s() - t0));
-        fflush(stdout);
     }
     double el = now_s() - t_all;
     if (rc >= 0)
-        printf("navcam batch: shard %ld/%ld: %ld of %d rows are this shard's; %ld rendered, %ld already done; %.1f s "
+        printf("navcam batch: shard %ld/%ld: %ld of %d rows are this shard's; %ld rendered, %ld already done%s; %.1f s "
                "(%.0f frames per hour)\n",
-               shard_k, shard_n, mine, nrows, done, skipped, el, el > 0 ? done * 3600 / el : 0.0);
+               shard_k, shard_n, mine, nrows, done, skipped, busy_txt(busy), el, el > 0 ? done * 3600 / el : 0.0);
     free(geom);
     free(rock);
     free(rows);

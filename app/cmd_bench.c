@@ -11,6 +11,7 @@
 #include "app/bench_accuracy.h"
 #include "app/cli.h"
 #include "core/error.h"
+#include "core/fs.h"
 #include "core/log.h"
 
 static const char bench_help[] =
@@ -30,7 +31,7 @@ static const char bench_help[] =
     "(procedural asteroid with boulders), crater (a bowl crater at low Sun),\n"
     "icy (a bright body), comet (67P's neck). docs/accuracy.md shows the charts.\n"
     "\n"
-    "  -o, --output DIR     output directory (default: accuracy; made if missing)\n"
+    "  -o, --output DIR     output directory (default: accuracy; made with its missing parents)\n"
     "      --scene NAME     only this scene; repeatable\n"
     "      --size N         frames of N x N pixels with the default camera's field\n"
     "                       (default 256)\n"
@@ -215,10 +216,8 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (mkdir(dir, 0777) < 0 && errno != EEXIST) {
-        fprintf(stderr, "navcam bench: %s: %s\n", dir, strerror(errno));
-        return 1;
-    }
+    if (nc_mkdirs(dir) < 0)
+        return nc_cli_fail();
     o.work_dir = dir;
     nc_log_set_level(NC_LOG_WARN); /* not the scene's notes at every load */
     char path[4096];

@@ -12,6 +12,7 @@
 
 #include "app/cli.h"
 #include "core/error.h"
+#include "core/fs.h"
 #include "core/imgcmp.h"
 #include "core/texture.h"
 #include "render/image_io.h"
@@ -182,10 +183,8 @@ int main(int argc, char **argv)
         goto done;
     }
     nc_image_flip(real, sizeof *real, w, h, flip & 2, flip & 1);
-    if (dir && mkdir(dir, 0777) < 0 && errno != EEXIST) {
-        rc = nc_error(-errno, "%s: %s", dir, strerror(errno));
+    if (dir && (rc = nc_mkdirs(dir)) < 0)
         goto done;
-    }
     size_t n = (size_t)w * (size_t)h;
     if (!(rel = malloc(n * sizeof *rel)) || !(moved = malloc(n * sizeof *moved))) {
         rc = nc_error(-ENOMEM, "out of memory");

@@ -205,7 +205,7 @@ int main(int argc, char **argv)
                out, scene.camera.width_px, scene.camera.height_px, nc_quantity_names[q], nc_quantity_units(q), scene.render.samples_per_pixel,
                tsamples, tsamples == 1 ? "" : "s", r.threads, t0 - tl, t1 - t0, t2 - t1);
         if (chosen[0])
-            printf("  render.quality auto: %s\n", chosen);
+            printf("  render.quality auto: %s; the pilots took %.1f ms\n", chosen, info.quality_ms);
         if (sunwarn[0])
             printf("  WARNING: %s (its centre %.2f deg off axis)\n", sunwarn, sv.off_axis_deg);
         if (sky.on)

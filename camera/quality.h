@@ -65,7 +65,8 @@ struct nc_quality_choice {
  * r is the renderer that will draw the frame (its threads do the pilots). */
 int nc_quality_auto(struct nc_renderer *r, struct nc_scene *s, const struct nc_camsys *cs, double exposure_s,
                     struct nc_quality_choice *out);
-/* "spp=16 bounces=1 soft=1" and the figures behind it. */
-void nc_quality_describe(const struct nc_quality_choice *q, char *buf, size_t len);
+/* "spp=16 bounces=1 soft=1" and the figures behind it; with timing, the
+ * pilots' time too (left out of files, which must not depend on it). */
+void nc_quality_describe(const struct nc_quality_choice *q, int timing, char *buf, size_t len);
 
 #endif

@@ -104,7 +104,8 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
         if ((rc = nc_quality_auto(r, &sensor, cs, exposure, &qc)) >= 0) {
             drawn.render = sensor.render;
             scene->render = sensor.render; /* recorded in the file */
-            nc_quality_describe(&qc, info->quality, sizeof info->quality);
+            nc_quality_describe(&qc, 0, info->quality, sizeof info->quality);
+            info->quality_ms = qc.pilot_ms;
         }
     }
     if (rc >= 0)

@@ -16,7 +16,8 @@
 
 struct nc_shot_info {
     int time_samples;
-    char quality[300];     /* render.quality auto's choice ("" when manual) */
+    char quality[300];     /* render.quality auto's choice ("" when manual), without the pilots' time */
+    double quality_ms;     /* the pilots' time, ms */
     struct nc_sky_stats stars;
     double stars_ms;
     struct nc_sun_view sun;

@@ -51,6 +51,43 @@ static int sum_row(const char *path, size_t lineno, const double *v, struct nc_t
     return 0;
 }
 
+/* The name of column c (0-based) of a layout's columns, into buf. */
+static const char *col_name(const char *cols, int c, char *buf, size_t len)
+{
+    const char *p = cols;
+    for (int i = 0; i < c && p; i++)
+        p = strchr(p, ',') ? strchr(p, ',') + 1 : NULL;
+    if (!p)
+        return "";
+    snprintf(buf, len, "%.*s", (int)strcspn(p, ",["), p);
+    return buf;
+}
+
+/* What is wrong with a data row (k numbers read into v, s where reading
+ * stopped), naming the column: an error, or 0 if nothing. */
+static int row_error(const char *path, size_t lineno, int sum, const double *v, int k, const char *s)
+{
+    const char *cols = sum ? sum_cols : pose_cols;
+    const int need = sum ? 16 : 11;
+    char name[32];
+    const size_t tok = strcspn(s, " \t,\r\n");
+    if (tok && k < need + 1)
+        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s): '%.*s' is not a number", path, lineno, k + 1,
+                        col_name(cols, k, name, sizeof name), (int)tok, s);
+    if (*s && *s != '\n' && *s != '\r')
+        return nc_error(NC_ECONFIG, "%s:%zu: more than %d columns: %s", path, lineno, need + 1, cols);
+    if (k < need)
+        return nc_error(NC_ECONFIG, "%s:%zu: %d columns, expected %d or %d: %s", path, lineno, k, need, need + 1, cols);
+    for (int i = 0; i < k; i++)
+        if (!isfinite(v[i]))
+            return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s) is not finite", path, lineno, i + 1,
+                            col_name(cols, i, name, sizeof name));
+    if (k == need + 1 && v[need] != 0 && v[need] != 1)
+        return nc_error(NC_ECONFIG, "%s:%zu: column %d (capture): %g, expected 0 or 1", path, lineno, need + 1,
+                        v[need]);
+    return 0;
+}
+
 /* Whether a header names the SUM-like layout: its first names t_s and
  * scobj_x_km, blanks around the comma allowed. */
 static int sum_header(const char *line)
@@ -74,7 +111,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
     struct nc_traj_row *rows = NULL;
     size_t n = 0, cap = 0, lineno = 0;
     char line[2048];
-    int rc = 0, sum = 0;
+    int rc = 0, sum = 0, header = 0;
     while (fgets(line, sizeof line, f)) {
         lineno++;
         if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
@@ -91,18 +128,13 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
             if (*s == ',')
                 s++;
         }
-        if (k == 0 && n == 0 && !sum) { /* a header: which layout */
+        if (k == 0 && n == 0 && !header && isalpha((unsigned char)line[strspn(line, " \t")])) {
+            header = (int)lineno; /* a header: which layout */
             sum = sum_header(line);
             continue;
         }
-        int bad = k < need || (*s && *s != '\n' && *s != '\r');
-        for (int i = 0; i < k && !bad; i++)
-            bad = !isfinite(v[i]);
-        if (bad) {
-            rc = nc_error(NC_ECONFIG, "%s:%zu: expected %d or %d finite numbers: %s", path, lineno, need, need + 1,
-                          sum ? sum_cols : pose_cols);
+        if ((rc = row_error(path, lineno, sum, v, k, s)) < 0)
             break;
-        }
         if (n == cap) {
             cap = cap ? 2 * cap : 256;
             struct nc_traj_row *r2 = realloc(rows, cap * sizeof *rows);

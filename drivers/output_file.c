@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
+#include "core/fs.h"
 #include "render/image_io.h"
 #include "emulator/output.h"
 
@@ -61,23 +62,11 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     }
     snprintf(f->dir, sizeof f->dir, "%s", dir);
     snprintf(f->pattern, sizeof f->pattern, "%s", pattern);
-    /* made with every missing parent, as mkdir -p */
-    for (char *p = f->dir + 1;; p++) {
-        const char c = *p;
-        if (c != '/' && c != '\0')
-            continue;
-        *p = '\0';
-        const int bad = mkdir(f->dir, 0777) < 0 && errno != EEXIST;
-        *p = c;
-        if (bad) {
-            const int err = errno;
-            char where[4200];
-            snprintf(where, sizeof where, "%.*s", (int)(p - f->dir), f->dir);
-            return nc_cfg_error(nc_cfg_get(opts, "directory") ? nc_cfg_get(opts, "directory") : opts,
-                                "file output: cannot make %s: %s", where, strerror(err));
-        }
-        if (!c)
-            break;
+    if (nc_mkdirs(f->dir) < 0) { /* with every missing parent, as mkdir -p */
+        char why[4200];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        return nc_cfg_error(nc_cfg_get(opts, "directory") ? nc_cfg_get(opts, "directory") : opts, "file output: %s",
+                            why);
     }
     if (sidecar[0]) {
         snprintf(f->sidecar_path, sizeof f->sidecar_path, "%s/%s", f->dir, sidecar);

@@ -33,6 +33,10 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
     ImageSpec spec(w, h, 1, td);
     spec.channelnames = {"Y"};
     spec.attribute("oiio:ColorSpace", "linear");
+    // No write time unless the caller gives one: OpenImageIO would stamp
+    // the time of writing (TIFF DateTime, EXR capDate), and a file must be
+    // the same bytes whenever it is written (docs/batch.md).
+    spec.attribute("DateTime", "");
     for (int i = 0; i < nattrs; i++)
         spec.attribute(attrs[i].name, attrs[i].value);
     if (description)

@@ -46,6 +46,24 @@ void nc_test_write(const char *path, const char *text)
     }
 }
 
+char *nc_test_read(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    long n = f && fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (n >= 0 && fseek(f, 0, SEEK_SET) == 0 && (buf = malloc((size_t)n + 1)) &&
+        fread(buf, 1, (size_t)n, f) == (size_t)n) {
+        buf[n] = 0;
+        *len = (size_t)n;
+    } else {
+        free(buf);
+        buf = NULL;
+    }
+    if (f)
+        fclose(f);
+    return buf;
+}
+
 int nc_test_scene_rc(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s)
 {
     struct nc_cfg cfg;

@@ -32,6 +32,9 @@ extern const char nc_test_asteroid_yaml[];
 const char *nc_test_tmp(void);
 const char *nc_test_path(const char *name);
 void nc_test_write(const char *path, const char *text);
+/* The bytes of a file (NUL-terminated, malloc'd; its length in *len), or
+ * NULL if it cannot be read. */
+char *nc_test_read(const char *path, size_t *len);
 /* Scene from YAML text plus overrides; aborts the test on error. */
 void nc_test_scene(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s);
 /* Load YAML text + sets; returns the error code and leaves nc_errmsg(). */

@@ -84,6 +84,27 @@ head -c 1000 ref/frame_000005.fits > crashed/.frame_000005.tmp.fits
 grep -q "1 rendered, 7 already done" resume.log || fail "resume: $(tail -1 resume.log)"
 diff -r -x '.frame_*' ref crashed > /dev/null || fail "resumed dataset differs from the reference"
 
+# A row another process is rendering (its lock held) is left to it, not
+# rendered twice; once the lock is free, a rerun renders it.
+cp -r ref busy
+rm busy/frame_000002.json
+python3 -c "import fcntl, sys, time; f = open(sys.argv[1], 'w'); fcntl.flock(f, fcntl.LOCK_EX)
+open(sys.argv[2], 'w').close(); time.sleep(60)" busy/.frame_000002.lock busy.held &
+holder=$!
+for _ in $(seq 100); do [ -e busy.held ] && break; sleep 0.1; done
+"$navcam" batch traj.csv -o busy "${scene[@]}" > busy.log 2>&1 || fail "busy: $(cat busy.log)"
+kill $holder; wait $holder 2>/dev/null || true
+grep -q "0 rendered, 7 already done, 1 being rendered by another process" busy.log || fail "busy: $(tail -1 busy.log)"
+"$navcam" batch traj.csv -o busy "${scene[@]}" > busy.log 2>&1 || fail "busy, rerun"
+grep -q "1 rendered, 7 already done;" busy.log || fail "busy, rerun: $(tail -1 busy.log)"
+diff -r -x '.frame_*' ref busy > /dev/null || fail "the row rendered after the lock was freed differs"
+
+# -o makes missing parents; a configuration error leaves no directory behind.
+"$navcam" batch traj.csv -o nest/a/b "${scene[@]}" --shard 0/8 --no-geometry > /dev/null 2>&1 || fail "-o nest/a/b"
+[ -s nest/a/b/frame_000000.json ] || fail "-o nest/a/b: no frame"
+"$navcam" batch traj.csv -o none/x "${scene[@]}" --set camera.widht_px=3 2> err.txt && fail "a misspelt key accepted"
+[ ! -e none ] || fail "a configuration error left the directory none/"
+
 # SUM-like rows of the same poses: the same frames (to the pose's rounding).
 "$navcam" batch traj_sum.csv -o sum "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "SUM-like rows"
 "$navcam" compare ref/frame_000003.fits sum/frame_000003.fits --fit none > sumcmp.json || fail "compare"
@@ -108,7 +129,13 @@ print('SUM-like rows, body moved: p95 %.4f, IoU %.4f' % (d['relative_error']['p9
 grep -q "0 <= K < N" err.txt || fail "shard error: $(cat err.txt)"
 printf 't_s,cam_x_m\n0,1,2\n' > bad.csv
 "$navcam" batch bad.csv -o x 2> err.txt && fail "bad trajectory accepted"
-grep -q "bad.csv:2: expected 11 or 12 finite numbers" err.txt || fail "trajectory error: $(cat err.txt)"
+grep -q "bad.csv:2: 3 columns, expected 11 or 12" err.txt || fail "trajectory error: $(cat err.txt)"
+printf 't_s,cam_x_m\n0,1,2,x,0,1,0,0,0,1,0\n' > bad.csv
+"$navcam" batch bad.csv -o x 2> err.txt && fail "a word in a row accepted"
+grep -q "bad.csv:2: column 4 (cam_z_m): 'x' is not a number" err.txt || fail "trajectory error: $(cat err.txt)"
+printf '0,1,2,3,1,0,0,0,0,1,0,0.5\n' > bad.csv
+"$navcam" batch bad.csv -o x 2> err.txt && fail "capture 0.5 accepted"
+grep -q "bad.csv:1: column 12 (capture): 0.5, expected 0 or 1" err.txt || fail "trajectory error: $(cat err.txt)"
 
 # Slurm: a job array of 4 tasks into one directory.
 slurm=$(mktemp -d /tmp/nc_slurm.XXXXXX)

@@ -118,7 +118,7 @@ static struct nc_quality_choice choose(double z_m, double *y0, double *y1, doubl
     free(e_auto);
     free(e_one);
     char why[512];
-    nc_quality_describe(&q, why, sizeof why);
+    nc_quality_describe(&q, 1, why, sizeof why);
     printf("look %.0f m below: sphere on rows %.1f-%.1f: %s; sigma RMS %.3f (1 sample: %.3f)\n", -z_m, *y0, *y1,
            why, *sigma_auto, *sigma_one);
     nc_renderer_free(&r);
@@ -162,7 +162,7 @@ static void check_scratch(void)
         rc = nc_quality_auto(&dirty, &b, &cs, cs.exposure_s, &qb);
     CHECK(rc >= 0, "auto: %s", nc_errmsg());
     char why[512];
-    nc_quality_describe(&qb, why, sizeof why);
+    nc_quality_describe(&qb, 1, why, sizeof why);
     printf("icy asteroid with boulders, scratch frames full of NaN: %s\n", why);
     CHECK(qb.bounces > 0 && qb.lod_rms > 0, "the case should take a bounce (%d) and see the level of detail (%g)",
           qb.bounces, qb.lod_rms);

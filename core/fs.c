@@ -1,0 +1,59 @@
+/* fs.c - directories and files that must survive a crash (fs.h). */
+#include "core/fs.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/error.h"
+
+int nc_mkdirs(const char *dir)
+{
+    char d[4096];
+    if (snprintf(d, sizeof d, "%s", dir) >= (int)sizeof d)
+        return nc_error(-ENAMETOOLONG, "%s: path too long", dir);
+    for (char *p = d + 1;; p++) {
+        const char c = *p;
+        if (c != '/' && c != '\0')
+            continue;
+        *p = '\0';
+        if (mkdir(d, 0777) < 0 && errno != EEXIST)
+            return nc_error(-errno, "cannot make %s: %s", d, strerror(errno));
+        *p = c;
+        if (!c)
+            return 0;
+    }
+}
+
+/* fsync of path (a file or a directory) */
+static int sync_path(const char *path)
+{
+    const int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    const int rc = fsync(fd) < 0 && errno != EINVAL ? -errno : 0; /* EINVAL: a file system without fsync */
+    close(fd);
+    return rc < 0 ? nc_error(rc, "%s: fsync: %s", path, strerror(-rc)) : 0;
+}
+
+int nc_commit_file(const char *tmp, const char *path)
+{
+    int rc = sync_path(tmp);
+    if (rc < 0)
+        return rc;
+    if (rename(tmp, path) < 0)
+        return nc_error(-errno, "%s: rename to %s: %s", tmp, path, strerror(errno));
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (slash == dir)
+        dir[1] = '\0';
+    else
+        *slash = '\0';
+    return sync_path(dir);
+}

@@ -1,0 +1,17 @@
+/* fs.h - directories and files that must survive a crash: a directory
+ * made with its missing parents, and a file put in place whole. */
+#ifndef NC_FS_H
+#define NC_FS_H
+
+/* Make dir and every missing parent, as mkdir -p (0777 less the umask).
+ * 0, or -errno with a message naming the directory that could not be
+ * made. */
+int nc_mkdirs(const char *dir);
+
+/* Put the complete file tmp in place as path: its data flushed to the disk
+ * (fsync), renamed, and the rename flushed (fsync of path's directory), so
+ * that after a crash or a power cut path is either absent or whole. 0, or
+ * -errno with a message naming the file. */
+int nc_commit_file(const char *tmp, const char *path);
+
+#endif
