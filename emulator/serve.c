@@ -59,6 +59,11 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
     if (rc >= 0 && !(e->cs.sensor.pixel_pitch_m > 0))
         rc = nc_error(NC_ECONFIG,
                       "serve needs the camera model: give camera.focal_length_m and pixel_pitch_m, or sensor.pixel_pitch_m");
+    if (rc >= 0 && (e->scene.camera.flip_rows || e->scene.camera.flip_cols))
+        nc_log_warn("camera", "the SUM file's K-MATRIX mirrors its image (%s), but serve delivers the view "
+                    "unmirrored, +X along CX and +Y along CY (docs/sumfiles.md)",
+                    e->scene.camera.flip_rows ? (e->scene.camera.flip_cols ? "K11 < 0 and K22 < 0" : "K22 < 0")
+                                              : "K11 < 0");
     if (rc >= 0)
         rc = nc_sky_prepare(&e->sky, &e->cs, &e->scene.camera);
     if (rc >= 0)
