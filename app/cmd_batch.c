@@ -66,10 +66,6 @@ static void json_vec(FILE *f, const char *key, const double *v, int n, const cha
     fprintf(f, "]%s", sep);
 }
 
-/* Every file is written under a temporary name, flushed to the disk and
- * renamed when complete (nc_commit_file). */
-static int finish(const char *tmp, const char *path) { return nc_commit_file(tmp, path); }
-
 /* Row stem's lock (DIR/.STEM.lock, flock): held while the row is rendered,
  * so that two processes given the same rows (a shard submitted again while
  * it still runs) never write the same temporary files; the other skips the
@@ -113,7 +109,7 @@ static int commit(FILE *f, int rc, const char *tmp, const char *dir, const char 
     if (fclose(f) != 0 && rc >= 0)
         rc = nc_error(-EIO, "%s: write failed", tmp);
     snprintf(path, sizeof path, "%s/%s", dir, name);
-    return rc < 0 ? rc : finish(tmp, path);
+    return rc < 0 ? rc : nc_commit_file(tmp, path);
 }
 
 /* The boulders and craters seen in a geometry render, as CSV files. */
@@ -305,7 +301,7 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
     const struct nc_image_attr extra[] = {{"navcam:batch_row", rowtxt}};
     int rc;
     if ((rc = nc_shot(r, &s, cs, sky, q, exposure, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
-        (rc = finish(tmp, path)) < 0)
+        (rc = nc_commit_file(tmp, path)) < 0)
         return rc;
     int nrocks = -1, ncraters = -1;
     if (geometry) {
@@ -314,7 +310,7 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
         if ((rc = nc_shot_geometry(r, &s, geom, rock)) < 0 ||
             (rc = nc_image_write_planes(tmp, geom, s.camera.width_px, s.camera.height_px, NC_GEOM_PLANES,
                                         nc_geom_plane_names, extra, 1)) < 0 ||
-            (rc = finish(tmp, path)) < 0 || (rc = lists(dir, stem, &s, geom, rock, &nrocks, &ncraters)) < 0)
+            (rc = nc_commit_file(tmp, path)) < 0 || (rc = lists(dir, stem, &s, geom, rock, &nrocks, &ncraters)) < 0)
             return rc;
     }
     if ((rc = truth(dir, stem, ext, geometry, i, row, &s, q, exposure, info.quality, nrocks, ncraters)) < 0)
