@@ -70,6 +70,7 @@ struct v4l2_out {
     int64_t next_try_ns;
     long tries;
     unsigned long written, lost, reopened;
+    unsigned long lost_at_close; /* lost when the device was closed: the outage's own count is lost less this */
 };
 
 static int xioctl(int fd, unsigned long req, void *arg)
@@ -420,19 +421,26 @@ static int v4l2_submit(void *priv, const struct nc_frame_record *r)
     struct v4l2_out *v = priv;
     if (v->fd < 0) {
         int64_t now = nc_mono_ns();
-        if (!v->reopen_ns || (v->reopen_limit && v->tries >= v->reopen_limit) || now < v->next_try_ns) {
+        const int gave_up = v->reopen_limit && v->tries >= v->reopen_limit;
+        if (!v->reopen_ns || gave_up || now < v->next_try_ns) {
             v->lost++;
-            return nc_error(-ENODEV, "v4l2 output: no device (%s); %lu frames lost so far", v->path, v->lost);
+            return nc_error(-ENODEV, "v4l2 output: no device (%s)%s; %lu frames lost so far", v->path,
+                            gave_up ? ", not looked for any more (reopen_limit)" : "", v->lost);
         }
         v->tries++;
         v->next_try_ns = now + v->reopen_ns;
         if (connect_device(v) < 0) {
+            char why[256];
+            snprintf(why, sizeof why, "%s", nc_errmsg());
             v->lost++;
-            return nc_error(-ENODEV, "v4l2 output: reopening failed (attempt %ld): %s", v->tries, nc_errmsg());
+            if (v->reopen_limit && v->tries >= v->reopen_limit)
+                nc_log_error("output/v4l2", "%s (card '%s'): %ld attempts to reopen it failed (reopen_limit): "
+                             "given up, its frames are lost from now on", v->path, v->card, v->tries);
+            return nc_error(-ENODEV, "v4l2 output: reopening failed (attempt %ld): %s", v->tries, why);
         }
         v->reopened++;
         nc_log_info("output/v4l2", "%s (card '%s') reopened after %lu lost frames", v->path, v->card,
-                v->lost);
+                    v->lost - v->lost_at_close);
         v->tries = 0;
     }
     int rc = v->io == IO_MMAP ? put_mmap(v, r->dn) : put_write(v, r->dn);
@@ -447,6 +455,7 @@ static int v4l2_submit(void *priv, const struct nc_frame_record *r)
     char why[128];
     snprintf(why, sizeof why, "%s", nc_errmsg());
     disconnect(v);
+    v->lost_at_close = v->lost - 1; /* this frame is the outage's first */
     v->next_try_ns = nc_mono_ns() + v->reopen_ns;
     char again[96] = "it is not reopened (reopen_interval_s: 0)";
     if (v->reopen_ns)

@@ -2,7 +2,10 @@
 # test_v4l2_setup.sh - the v4l2 output's set-up on a device whose
 # VIDIOC_REQBUFS succeeds with no buffers (v4l2_shim.so makes /dev/null such
 # a device): `navcam serve` must stop with exit 1 and say so, not report a
-# stale errno or run on with the device closed.
+# stale errno or run on with the device closed. Then, with the shim's
+# NAVCAM_SHIM_UNPLUG, a device that is unplugged for 2.5 s: the failure and
+# the failed reopenings say why, the reopening counts that outage's frames;
+# and with reopen_limit the output says once that it gave up.
 # Usage: test_v4l2_setup.sh NAVCAM SHIM
 set -u
 navcam=$1 shim=$2
@@ -18,5 +21,29 @@ case "$out" in
   *"/dev/null (card 'No Buffers'): VIDIOC_REQBUFS granted no buffers"*) pass=$((pass + 1)) ;;
   *) fail=$((fail + 1)); echo "FAIL: the message does not say the device granted no buffers: $out" ;;
 esac
+expect() { # what, text, pattern
+  case "$2" in
+    *$3*) pass=$((pass + 1)) ;;
+    *) fail=$((fail + 1)); echo "FAIL: $1: no '$3' in: $2" ;;
+  esac
+}
+unplugged() { # extra output keys
+  NAVCAM_SHIM_UNPLUG=1 LD_PRELOAD=$shim timeout 60 "$navcam" serve --set camera.width_px=64 \
+    --set camera.height_px=48 --set serve.udp_port=0 --set serve.tcp_port=0 --max-seconds 5 \
+    --set serve.mode=freerun --set serve.frame_rate_hz=10 \
+    --set "outputs=[{driver: v4l2, device: /dev/null, reopen_interval_s: 0.05$1}]" 2>&1
+}
+out=$(unplugged "")
+expect unplug "$out" "/dev/null (card 'Unplugged') failed: write: No such device; closed, looking for it again every 0.05 s"
+expect "failed reopening" "$out" "reopening failed (attempt *): v4l2 output: /dev/null: No such file or directory"
+# the outage's frames only (2.5 s at 10 Hz), not the EAGAIN frame before
+# it; every frame while the device is away tries to reopen it (0.05 s), so
+# the error the log shows a second after the first is a failed reopening
+n=$(printf '%s\n' "$out" | sed -n "s/.*(card 'Unplugged') reopened after \([0-9]*\) lost frames.*/\1/p")
+if [ -n "$n" ] && [ "$n" -ge 18 ] && [ "$n" -le 30 ]; then pass=$((pass + 1)); else
+  fail=$((fail + 1)); echo "FAIL: reopened after '$n' lost frames, want the outage's 25 to 30: $out"; fi
+out=$(unplugged ", reopen_limit: 2")
+expect "reopen_limit" "$out" "2 attempts to reopen it failed (reopen_limit): given up, its frames are lost from now on"
+expect "reopen_limit" "$out" "not looked for any more (reopen_limit)"
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -4,12 +4,22 @@
  * output's set-up be tested on the host, without a kernel driver: the
  * output must refuse such a device with its own message instead of
  * reporting a stale errno (or success) with the device closed.
- * Everything else goes to the real ioctl(). */
+ * With NAVCAM_SHIM_UNPLUG set, /dev/null is instead a v4l2loopback-like
+ * device taking frames by write(): the 3rd frame finds no free buffer
+ * (EAGAIN), the 6th finds the device unplugged (ENODEV), and for 2.5 s
+ * after that /dev/null cannot be opened (ENOENT), as a device that is
+ * away; then it is back.
+ * Everything else goes to the real calls. */
 #define _GNU_SOURCE 1
 #include <dlfcn.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <stdlib.h>
+#include <time.h>
+#include <unistd.h>
 #include <linux/videodev2.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
@@ -23,6 +33,52 @@ static int is_dev_null(int fd)
     return fstat(fd, &st) == 0 && S_ISCHR(st.st_mode) && major(st.st_rdev) == 1 && minor(st.st_rdev) == 3;
 }
 
+static int frames;
+static double away_until_s;
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int unplug(void) { return getenv("NAVCAM_SHIM_UNPLUG") != NULL; }
+
+static int away(const char *path) { return unplug() && !strcmp(path, "/dev/null") && now_s() < away_until_s; }
+
+int open(const char *path, int flags, ...)
+{
+    va_list ap;
+    va_start(ap, flags);
+    const mode_t mode = (mode_t)va_arg(ap, int);
+    va_end(ap);
+    if (away(path)) {
+        errno = ENOENT;
+        return -1;
+    }
+    int (*real)(const char *, int, ...) = (int (*)(const char *, int, ...))dlsym(RTLD_NEXT, "open");
+    return real(path, flags, mode);
+}
+
+ssize_t write(int fd, const void *buf, size_t n)
+{
+    ssize_t (*real)(int, const void *, size_t) = (ssize_t(*)(int, const void *, size_t))dlsym(RTLD_NEXT, "write");
+    if (unplug() && n > 1000 && is_dev_null(fd)) { /* a frame, not a log line */
+        if (++frames == 3) {
+            errno = EAGAIN;
+            return -1;
+        }
+        if (frames == 6) {
+            away_until_s = now_s() + 2.5;
+            errno = ENODEV;
+            return -1;
+        }
+    }
+    return real(fd, buf, n);
+}
+
+
 int ioctl(int fd, unsigned long request, ...)
 {
     va_list ap;
@@ -34,12 +90,14 @@ int ioctl(int fd, unsigned long request, ...)
         case VIDIOC_QUERYCAP: {
             struct v4l2_capability *c = arg;
             memset(c, 0, sizeof *c);
-            strcpy((char *)c->driver, "shim");
-            strcpy((char *)c->card, "No Buffers");
-            c->capabilities = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING | V4L2_CAP_DEVICE_CAPS;
-            c->device_caps = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING;
+            strcpy((char *)c->driver, unplug() ? "v4l2 loopback" : "shim");
+            strcpy((char *)c->card, unplug() ? "Unplugged" : "No Buffers");
+            const uint32_t rw = unplug() ? V4L2_CAP_READWRITE : 0;
+            c->capabilities = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING | rw | V4L2_CAP_DEVICE_CAPS;
+            c->device_caps = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING | rw;
             return 0;
         }
+        case VIDIOC_STREAMON: return 0;
         case VIDIOC_S_FMT: kept = *(struct v4l2_format *)arg; return 0;
         case VIDIOC_G_FMT: *(struct v4l2_format *)arg = kept; return 0;
         case VIDIOC_S_PARM: return 0;
