@@ -21,12 +21,18 @@ int64_t nc_windows_plan(struct nc_windows *s, int64_t now, uint32_t *active)
 {
     int64_t next = INT64_MAX;
     *active = 0;
-    while (s->count && s->w[s->head].end_ns <= now) {
-        if (!s->w[s->head].seen)
-            s->missed++;
-        s->head = (s->head + 1) % NC_WINDOWS_MAX;
-        s->count--;
+    /* Every window that has ended goes, not only the first: one added
+     * later may end sooner (a shorter exposure), and must not stay active
+     * or due. The rest keep their order. */
+    int kept = 0;
+    for (int i = 0; i < s->count; i++) {
+        const struct nc_window w = s->w[(s->head + i) % NC_WINDOWS_MAX];
+        if (w.end_ns <= now)
+            s->missed += !w.seen;
+        else
+            s->w[(s->head + kept++) % NC_WINDOWS_MAX] = w;
     }
+    s->count = kept;
     for (int i = 0; i < s->count; i++) {
         struct nc_window *w = &s->w[(s->head + i) % NC_WINDOWS_MAX];
         if (w->start_ns <= now) {

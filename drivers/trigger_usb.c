@@ -129,7 +129,8 @@ static int parse_id(struct nc__usb_trig *u, struct nc_cfg_node *opts)
         return rc;
     unsigned v, p;
     char end;
-    if (sscanf(id, "%x:%x%c", &v, &p, &end) != 2 || v > 0xffff || p > 0xffff)
+    if (strlen(id) != 9 || strspn(id, "0123456789abcdefABCDEF") != 4 || id[4] != ':' ||
+        strspn(id + 5, "0123456789abcdefABCDEF") != 4 || sscanf(id, "%x:%x%c", &v, &p, &end) != 2)
         return nc_cfg_error(nc_cfg_get(opts, "id"), "'%s' is not VID:PID (four hexadecimal digits each, as lsusb "
                             "prints them, e.g. 1209:0001)", id);
     u->vid = (int)v, u->pid = (int)p;
@@ -146,13 +147,15 @@ static int open_first(struct nc__usb_trig *u)
     for (ssize_t i = 0; i < n && rc == 0; i++)
         rc = nc__usb_try_open(u, list[i]);
     libusb_free_device_list(list, 1);
-    if (rc == 0)
-        return nc_error(NC_EUNSUPPORTED, "usb trigger: no USB trigger adapter%s%s%s found among %zd USB devices (one "
-                        "with interface %02x/%02x/%02x \"%s\"; `lsusb -v` lists interfaces; is navcam-usb-adapter "
-                        "running on the adapter?)", u->serial[0] ? " with serial " : "", u->serial,
-                        u->vid >= 0 ? " of the id asked for" : "", n, NC_UT_CLASS, NC_UT_SUBCLASS, NC_UT_PROTOCOL,
-                        NC_UT_INTERFACE_NAME);
-    return rc < 0 ? rc : 0;
+    if (rc != 0)
+        return rc < 0 ? rc : 0;
+    char idtxt[24] = "";
+    if (u->vid >= 0)
+        snprintf(idtxt, sizeof idtxt, " with id %04x:%04x", (unsigned)u->vid, (unsigned)u->pid);
+    return nc_error(NC_EUNSUPPORTED, "usb trigger: no USB trigger adapter%s%s%s found among %zd USB devices (one "
+                    "with interface %02x/%02x/%02x \"%s\"; `lsusb -v` lists interfaces; is navcam-usb-adapter "
+                    "running on the adapter?)", u->serial[0] ? " with serial " : "", u->serial, idtxt, n,
+                    NC_UT_CLASS, NC_UT_SUBCLASS, NC_UT_PROTOCOL, NC_UT_INTERFACE_NAME);
 }
 
 static int usb_open(void *priv, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx)

@@ -12,7 +12,7 @@
 # /etc/machine-id. Needs root, configfs and the libcomposite and usb_f_fs
 # modules (Raspberry Pi OS: dtoverlay=dwc2 in config.txt, then modprobe dwc2).
 set -eu
-usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 cmd=$1; shift
 name=navcam ffs=/run/navcam-usb-adapter id=1209:0001

@@ -129,6 +129,18 @@ static void on_message(struct nc__usb_trig *u, const struct nc_ut_msg *m, int64_
     }
 }
 
+void nc__usb_receive(struct nc__usb_trig *u, const uint8_t *buf, int len, int64_t now)
+{
+    for (int off = 0; off + NC_UT_MSG_BYTES <= len; off += NC_UT_MSG_BYTES) {
+        struct nc_ut_msg m;
+        if (nc_ut_decode(buf + off, &m) < 0) { /* skipped, but numbered like any: not a gap */
+            u->unknown++;
+            m.type = 0;
+        }
+        on_message(u, &m, now);
+    }
+}
+
 static void LIBUSB_CALL in_done(struct libusb_transfer *t)
 {
     struct nc__usb_trig *u = t->user_data;
@@ -136,13 +148,7 @@ static void LIBUSB_CALL in_done(struct libusb_transfer *t)
     pthread_mutex_lock(&u->lock);
     u->nfire = 0;
     if (t->status == LIBUSB_TRANSFER_COMPLETED) {
-        for (int off = 0; off + NC_UT_MSG_BYTES <= t->actual_length; off += NC_UT_MSG_BYTES) {
-            struct nc_ut_msg m;
-            if (nc_ut_decode(t->buffer + off, &m) < 0)
-                u->unknown++;
-            else
-                on_message(u, &m, now);
-        }
+        nc__usb_receive(u, t->buffer, t->actual_length, now);
     } else if (t->status != LIBUSB_TRANSFER_CANCELLED && t->status != LIBUSB_TRANSFER_TIMED_OUT) {
         u->gone = 1; /* NO_DEVICE, or an error the session does not survive */
     }

@@ -61,6 +61,12 @@ struct nc__usb_trig {
     double edge_bound_max_ns;
 };
 
+/* The whole messages of buf[0 .. len) from the adapter: counted, edges
+ * queued in fire[] (nfire), clock replies added. A message of a type this
+ * host does not know is counted as unknown and skipped, its sequence
+ * number taken (not a gap). Lock held. */
+void nc__usb_receive(struct nc__usb_trig *u, const uint8_t *buf, int len, int64_t now);
+
 /* Queue one message to the adapter. Lock held. */
 int nc__usb_send_msg(struct nc__usb_trig *u, const struct nc_ut_msg *m);
 /* Send a clock exchange's request. Lock held. */

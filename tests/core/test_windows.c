@@ -31,6 +31,17 @@ int main(void)
           "the last window kept covers the storm's end");
     nc_windows_add(&s, 5000, 5001, 2);
     CHECK(s.dropped == 0, "room again after the plan retired windows");
+    /* A window added later that ends sooner (the exposure shortened while
+     * one ran): once it ends it is gone, its line off and its end not due
+     * again, while the longer one before it stays. */
+    static struct nc_windows t;
+    nc_windows_add(&t, 0, 100, 0);
+    nc_windows_add(&t, 10, 20, 1);
+    CHECK(nc_windows_plan(&t, 15, &on) == 20 && on == 3, "both on at 15 (on %x)", on);
+    CHECK(nc_windows_plan(&t, 50, &on) == 100 && on == 1 && t.count == 1,
+          "at 50 only line 0 (on %x), next change its end (%d kept)", on, t.count);
+    nc_windows_add(&t, 60, 70, 1);
+    CHECK(nc_windows_plan(&t, 65, &on) == 70 && on == 3, "a third window in order after the compaction (on %x)", on);
     struct timespec ts;
     CHECK(nc_windows_timeout(INT64_MAX, 0, &ts) == NULL, "no change due: no timeout");
     CHECK(nc_windows_timeout(3500000000ll, 1000000000ll, &ts) == &ts && ts.tv_sec == 2 && ts.tv_nsec == 500000000,
