@@ -151,7 +151,8 @@ static int find_device(struct v4l2_out *v)
                 snprintf(v->path, sizeof v->path, "%s", path);
         }
         if (fd < 0)
-            return nc_error(-ENODEV, "v4l2 output: no video output device%s%s%s (seen: %s)",
+            return nc_error(-ENODEV, "v4l2 output: no video output device%s%s%s (seen: %s; is v4l2loopback "
+                            "loaded with that card_label? docs/setup.md)",
                             v->want_card[0] ? " with card label '" : "", v->want_card,
                             v->want_card[0] ? "'" : "", len ? seen : "no /dev/video* device");
     }

@@ -97,9 +97,12 @@ static int find_line(struct nc_cfg_node *opts, const struct nc_param *params, st
     struct nc_cfg_node *ln = nc_cfg_get(opts, "line");
     if (chip) {
         out->chip = gpiod_chip_open_lookup(chip);
-        if (!out->chip)
-            return nc_cfg_error(nc_cfg_get(opts, "chip"), "cannot open GPIO chip '%s': %s (gpiodetect lists the chips)",
-                                chip, strerror(errno));
+        if (!out->chip) {
+            const int err = errno;
+            return nc_cfg_error(nc_cfg_get(opts, "chip"), "cannot open GPIO chip '%s': %s (%s)", chip, strerror(err),
+                                err == EACCES ? "udev/99-navcam.rules gives group gpio access: docs/setup.md"
+                                              : "gpiodetect lists the chips");
+        }
     }
     struct gpiod_chip *c = out->chip ? out->chip : shared;
     if (all_digits(name)) {

@@ -91,9 +91,12 @@ static void on_message(struct nc__usb_trig *u, const struct nc_ut_msg *m, int64_
                     m->line, m->level, u->input, u->strobe_out >= 0 ? ", strobe on an output" : "");
         if (m->arg != NC_UT_VERSION)
             nc_log_warn(LOG, "adapter %s speaks protocol %u, NavCam %d", u->desc, m->arg, NC_UT_VERSION);
-        if (u->input >= m->line || u->strobe_out >= m->level)
-            nc_log_error(LOG, "adapter %s has no input %d or no output %d (serve.trigger input, strobe_output)",
-                         u->desc, u->input, u->strobe_out);
+        if (u->input >= m->line)
+            nc_log_error(LOG, "adapter %s has %d inputs, no input %d (serve.trigger.input): no edge will come",
+                         u->desc, m->line, u->input);
+        if (u->strobe_out >= m->level)
+            nc_log_error(LOG, "adapter %s has %d outputs, no output %d (serve.trigger.strobe_output): no strobe "
+                         "will be driven", u->desc, m->level, u->strobe_out);
         u->burst = NC__USB_BURST, u->next_sync_ns = now;
         return;
     }
