@@ -5,6 +5,8 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -22,6 +24,25 @@ int nc_cli_fail(void)
 {
     fprintf(stderr, "%s: %s\n", name, nc_errmsg());
     return 1;
+}
+
+int nc_cli_gnuplot(const char *dir, const char *script)
+{
+    fflush(stdout);
+    const pid_t pid = fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        if (dup2(STDERR_FILENO, STDOUT_FILENO) < 0 || chdir(dir) < 0)
+            _exit(127);
+        execlp("gnuplot", "gnuplot", script, (char *)NULL);
+        _exit(127);
+    }
+    int status;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR)
+            return -1;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? 0 : -1;
 }
 
 int nc_cli_out_open(const char *path, FILE **f)

@@ -19,6 +19,10 @@ int nc_cli_fail(void);
 int nc_cli_out_open(const char *path, FILE **f);
 int nc_cli_out_close(FILE *f, const char *path);
 
+/* gnuplot SCRIPT run in directory dir (no shell: any directory name is
+ * safe), its output to stderr; 0 if it ran and succeeded. */
+int nc_cli_gnuplot(const char *dir, const char *script);
+
 /* JSON members: "key": v then sep (null when v is not finite), and
  * "key": "v", (the string escaped). */
 void nc_cli_json_num(FILE *f, const char *key, double v, const char *sep);

@@ -186,9 +186,9 @@ int main(int argc, char **argv)
             break;
         case 'z': bad = parse_int("size", optarg, 16, 4096, &o.size_px); break;
         case 'r':
-            bad = parse_int("ref-spp", optarg, 1, 4096, &o.ref_spp);
+            bad = parse_int("ref-spp", optarg, 1, 1024, &o.ref_spp); /* render.samples_per_pixel's range */
             if (!bad && (int)lround(sqrt(o.ref_spp)) * (int)lround(sqrt(o.ref_spp)) != o.ref_spp) {
-                fprintf(stderr, "navcam bench: --ref-spp expects a square number of samples (1, 4, 9, ... 4096), "
+                fprintf(stderr, "navcam bench: --ref-spp expects a square number of samples (1, 4, 9, ... 1024), "
                                 "got '%s'\n", optarg);
                 bad = 1;
             }
@@ -288,13 +288,11 @@ int main(int argc, char **argv)
     fclose(gp);
     if (rc < 0)
         return nc_cli_fail();
-    char cmd[4200];
-    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot accuracy.gp", dir);
     if (!nplots) {
         fprintf(stderr, "navcam bench: every scene asked for was skipped: nothing measured, no chart\n");
         return 1;
     }
-    if (system(cmd) != 0)
+    if (nc_cli_gnuplot(dir, "accuracy.gp") != 0)
         printf("no chart: gnuplot failed or is missing (Debian: gnuplot-nox); %s/accuracy.gp draws it\n", dir);
     else
         printf("wrote %s/accuracy.csv, %s/accuracy.png\n", dir, dir);

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <sys/stat.h>
 
 #include "app/cli.h"
@@ -98,10 +99,12 @@ static int plots(const char *dir, const float *rel, int w, int h, const struct n
             "plot 'error_histogram.csv' using 1:2 skip 1 with boxes fill solid 0.5 notitle\n",
             res->rel_mean, res->rel_p95, h - 1, w - 1, -hi, hi, w, h);
     fclose(f);
-    char cmd[4300];
-    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot .compare.gp 2>&1 && rm -f .compare.gp .relative_error.f32", dir);
-    if (system(cmd) != 0)
+    if (nc_cli_gnuplot(dir, ".compare.gp") != 0)
         return nc_error(NC_EIMAGE, "%s: gnuplot failed to draw the plots (is gnuplot installed?)", dir);
+    for (int i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, i ? ".relative_error.f32" : ".compare.gp");
+        unlink(path);
+    }
     snprintf(path, sizeof path, "%s/relative_error.fits", dir);
     return nc_image_write(path, rel, w, h, NULL, 0, NULL);
 }

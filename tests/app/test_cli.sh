@@ -262,6 +262,11 @@ assert abs(b['grad_mean'] / a['grad_mean'] - 1) < 0.1 and abs(b['psd_beta'] - a[
 for f in relative_error.png error_histogram.png error_histogram.csv relative_error.fits; do
   [ -s "$tmp/cmp/$f" ] && ok || bad "navcam compare -o: no $f"
 done
+# a directory name no shell parses: gnuplot runs in it, nothing else runs
+odd="$tmp/cmp'; touch $tmp/injected; '"
+"$navcam" compare "$tmp/real.fits" "$tmp/moved.fits" -o "$odd" > /dev/null 2>&1 && [ -s "$odd/relative_error.png" ] &&
+  [ ! -e "$tmp/injected" ] && [ ! -e "$odd/.compare.gp" ] && ok ||
+  bad "navcam compare -o with a quote in the name: $(ls -a "$odd" 2>&1)"
 "$navcam" render -o "$tmp/other.fits" "${small[@]}" --set camera.width_px=64 > /dev/null 2>&1
 expect 1 "is 96x96 but $tmp/other.fits is 64x96: the images must have the same size" -- \
   "$navcam" compare "$tmp/real.fits" "$tmp/other.fits"
