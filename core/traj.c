@@ -89,13 +89,13 @@ static int row_error(const char *path, size_t lineno, int sum, const double *v, 
 }
 
 /* Whether a header names the SUM-like layout: its first names t_s and
- * scobj_x_km, blanks around the comma allowed. */
+ * scobj_x_km, blanks around the comma and quotes around the names allowed. */
 static int sum_header(const char *line)
 {
     char c[32];
     size_t n = 0;
     for (const char *s = line; *s && n < sizeof c - 1; s++)
-        if (!isspace((unsigned char)*s))
+        if (!isspace((unsigned char)*s) && *s != '"')
             c[n++] = *s;
     c[n] = 0;
     return !strncmp(c, "t_s,scobj_x_km", 14);
@@ -128,7 +128,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
             if (*s == ',')
                 s++;
         }
-        if (k == 0 && n == 0 && !header && isalpha((unsigned char)line[strspn(line, " \t")])) {
+        if (k == 0 && n == 0 && !header) {
             header = (int)lineno; /* a header: which layout */
             sum = sum_header(line);
             continue;
