@@ -2,6 +2,7 @@
 #include "camera/shot.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +49,49 @@ void nc_frame_flip(struct nc_frame *f, int rows, int cols)
                    f->height_px, rows, cols);
 }
 
+/* A celestial WCS (FITS WCS paper II, gnomonic: RA---TAN, DEC--TAN, ICRS)
+ * for the stored image of pinhole camera c whose scene frame is the ICRS
+ * (a scene with stars), as attributes "fits:KEY" (the FITS writer writes
+ * them as bare keywords and turns them for bottom-up rows; the other
+ * formats leave them out) into out, their values in val: how many (0 for a
+ * camera with distortion, which a TAN WCS cannot describe). For pixel
+ * (x, y) the camera sees u = (x - cx) / fx, v = (y - cy) / fy, the scene
+ * direction R (u, v, 1); the standard coordinates east and north of the
+ * boresight b are u R_x . e + v R_y . e (e east) and the same with north:
+ * linear in (u, v), so the CD matrix is exact. */
+static int wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out)
+{
+    if (c->distorted)
+        return 0;
+    const struct nc_mat3 R = nc_quat_to_mat(c->attitude_q);
+    const struct nc_vec3 x = nc_v3(R.m[0][0], R.m[1][0], R.m[2][0]), y = nc_v3(R.m[0][1], R.m[1][1], R.m[2][1]),
+                         b = nc_v3(R.m[0][2], R.m[1][2], R.m[2][2]);
+    const double ra = atan2(b.y, b.x), dec = asin(fmax(-1.0, fmin(1.0, b.z))), deg = 180 / M_PI;
+    const struct nc_vec3 east = nc_v3(-sin(ra), cos(ra), 0),
+                         north = nc_v3(-sin(dec) * cos(ra), -sin(dec) * sin(ra), cos(dec));
+    /* the stored image: mirrored columns x = W - p1, rows y = H - p2 (FITS
+     * p 1-based); else x = p1 - 1, y = p2 - 1 */
+    const double sx = c->flip_cols ? -1 : 1, sy = c->flip_rows ? -1 : 1;
+    const double crpix1 = c->flip_cols ? c->width_px - c->cx_px : c->cx_px + 1,
+                 crpix2 = c->flip_rows ? c->height_px - c->cy_px : c->cy_px + 1;
+    const double num[8] = {fmod(ra * deg + 360, 360), dec * deg, crpix1, crpix2,
+                           sx * deg * nc_v3_dot(x, east) / c->fx_px, sy * deg * nc_v3_dot(y, east) / c->fy_px,
+                           sx * deg * nc_v3_dot(x, north) / c->fx_px, sy * deg * nc_v3_dot(y, north) / c->fy_px};
+    static const char *const nkeys[8] = {"fits:CRVAL1", "fits:CRVAL2", "fits:CRPIX1", "fits:CRPIX2",
+                                         "fits:CD1_1",  "fits:CD1_2",  "fits:CD2_1",  "fits:CD2_2"};
+    static const char *const skeys[6][2] = {{"fits:WCSAXES", "2"},        {"fits:CTYPE1", "RA---TAN"},
+                                            {"fits:CTYPE2", "DEC--TAN"}, {"fits:CUNIT1", "deg"},
+                                            {"fits:CUNIT2", "deg"},      {"fits:RADESYS", "ICRS"}};
+    int n = 0;
+    for (int k = 0; k < 6; k++)
+        out[n++] = (struct nc_image_attr){skeys[k][0], skeys[k][1]};
+    for (int k = 0; k < 8; k++) {
+        snprintf(val[k], sizeof val[k], "%.17g", num[k]);
+        out[n++] = (struct nc_image_attr){nkeys[k], val[k]};
+    }
+    return n;
+}
+
 /* Electrons (float) or a digitised frame of a rendered radiance image (the
  * camera model's render size: the sensor plus the PSF's margin). */
 static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
@@ -58,12 +102,12 @@ static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc
     size_t n = (size_t)W * (size_t)H;
     float *e = malloc(n * sizeof *e);
     uint16_t *dn = malloc(n * sizeof *dn);
-    struct nc_image_attr attrs[40];
+    struct nc_image_attr attrs[64];
     char text[32][200];
     int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
     int na = nc_frame_meta(s, q, attrs, text, 32);
     na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 31 - na);
-    for (int i = 0; i < nextra && na < 40; i++)
+    for (int i = 0; i < nextra && na < 64; i++)
         attrs[na++] = extra[i];
     if (rc >= 0 && q == NC_Q_ELECTRONS)
         rc = nc_image_write(out, e, W, H, attrs, na, scale);
@@ -147,7 +191,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
                           r->fold_theta_bar_deg[i]);
     char flip[40];
     snprintf(flip, sizeof flip, "rows=%d columns=%d", scene->camera.flip_rows, scene->camera.flip_cols);
-    struct nc_image_attr extra[24] = {
+    struct nc_image_attr extra[48] = {
         {"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {"navcam:boulder_mesh_px", mesh}};
     int nextra = 3;
     if (suninfo[0])
@@ -162,7 +206,10 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
         extra[nextra++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
     if (scene->camera.from_sumfile)
         extra[nextra++] = (struct nc_image_attr){"navcam:sumfile_utc", scene->camera.sumfile_utc};
-    for (int i = 0; i < nextra_in && nextra < 24; i++)
+    char wcsval[8][32];
+    if (sky->on)
+        nextra += wcs_attrs(&scene->camera, wcsval, extra + nextra);
+    for (int i = 0; i < nextra_in && nextra < 48; i++)
         extra[nextra++] = extra_in[i];
     if (rc >= 0 && q <= NC_Q_ROCK_ID)
         rc = nc_frame_write(out, &f, q, scene, extra, nextra, &info->preview_scale);

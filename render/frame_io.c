@@ -83,10 +83,10 @@ int nc_frame_write(const char *path, const struct nc_frame *f, enum nc_quantity 
         return nc_error(NC_EUSAGE, "quantity %s needs the camera model", nc_quantity_names[q]);
     if (q == NC_Q_ROCK_ID && !f->rock_id)
         return nc_error(NC_EUSAGE, "quantity rock_id needs a frame with its rock-id plane");
-    struct nc_image_attr attrs[32];
+    struct nc_image_attr attrs[64];
     char text[24][200];
     int n = nc_frame_meta(s, q, attrs, text, 24);
-    for (int i = 0; i < nextra && n < 32; i++)
+    for (int i = 0; i < nextra && n < 64; i++)
         attrs[n++] = extra[i];
     const float *px = q == NC_Q_RADIANCE ? f->radiance : q == NC_Q_IOF ? f->iof : f->range_m;
     float *ids = NULL;

@@ -86,6 +86,10 @@ static void *flip_rows(const void *px, size_t elem, int w, int h, int depth)
 
 static void fits_key(const char *attr, char *key, size_t len)
 {
+    if (!strncmp(attr, "fits:", 5)) { /* a FITS keyword of its own (the WCS) */
+        snprintf(key, len, "%s", attr + 5);
+        return;
+    }
     for (size_t i = 0; i < sizeof fits_keys / sizeof fits_keys[0]; i++)
         if (!strcmp(attr, fits_keys[i][0])) {
             snprintf(key, len, "%s", fits_keys[i][1]);
@@ -130,6 +134,10 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
             continue; /* written below, in the keyword's own spelling */
         /* Numbers as FITS numbers (EXPTIME, ADCBITS, ...), the rest as strings. */
         double v = strtod(attrs[i].value, &end);
+        if (up && !strcmp(key, "CRPIX2")) /* the WCS of top-down rows, turned: FITS row p2 becomes h + 1 - p2 */
+            v = h + 1 - v;
+        else if (up && (!strcmp(key, "CD1_2") || !strcmp(key, "CD2_2")))
+            v = -v;
         if (end != attrs[i].value && !*end && isfinite(v)) {
             if (v == floor(v) && fabs(v) < 1e15 && !strpbrk(attrs[i].value, ".eE"))
                 fits_write_key_lng(f, key, (LONGLONG)v, attrs[i].name, &status);

@@ -8,6 +8,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 #include "core/error.h" // the codes only
@@ -38,7 +39,8 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
     // the same bytes whenever it is written (docs/batch.md).
     spec.attribute("DateTime", "");
     for (int i = 0; i < nattrs; i++)
-        spec.attribute(attrs[i].name, attrs[i].value);
+        if (std::strncmp(attrs[i].name, "fits:", 5)) // FITS keywords of their own (the WCS): FITS files only
+            spec.attribute(attrs[i].name, attrs[i].value);
     if (description)
         spec.attribute("ImageDescription", description);
     auto out = ImageOutput::create(path);

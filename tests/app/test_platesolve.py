@@ -9,6 +9,9 @@ as a FITS file with row 1 at the bottom (the FITS convention); solve-field
 finds the WCS; the sky positions it gives to the boresight pixel and to a
 pixel 400 px above it are compared with the pose's:
   pointing within 5 arcsec, roll (the position angle of "up") within 0.05 deg.
+And NavCam's own WCS header (RA---TAN, DEC--TAN), read by wcs-xy2rd from the
+frame itself, bottom-up and top-down: within 0.01 arcsec of the pose at two
+pixels.
 
 Usage: test_platesolve.py NAVCAM TMPDIR   (stars.dat: $NAVCAM_STARS_DAT or
 /usr/local/share/navcam/stars.dat)
@@ -131,6 +134,25 @@ stars: {{catalogue: '{index}'}}
     if out.returncode != 0 or not stars_line:
         print(out.stdout, out.stderr)
         sys.exit(f"test_platesolve: {name}: the render failed")
+    # NavCam's own WCS in the frame's header (TAN, exact for a pinhole),
+    # read by astrometry.net's wcs-xy2rd: bottom-up rows, then the same frame
+    # written top-down (image (x, y) is FITS (x + 1, y + 1) there).
+    top = os.path.join(tmp, name + "_top.fits")
+    if subprocess.run([navcam, "render", scene, "-o", top, "-q", "dn"], capture_output=True).returncode != 0:
+        sys.exit(f"test_platesolve: {name}: the top-down render failed")
+    cx, cy = (W - 1) / 2, (H - 1) / 2
+    for path, row in ((img, lambda y: H - y), (top, lambda y: y + 1)):
+        own = []
+        for px, py in ((cx, cy), (cx - 300, cy - 400)):
+            r = subprocess.run(["wcs-xy2rd", "-w", path, "-x", repr(px + 1), "-y", repr(row(py))],
+                               capture_output=True, text=True, check=True)
+            a, b = r.stdout.split("RA,Dec")[1].strip().strip("()").split(",")[:2]
+            own.append(((float(a), float(b.strip(" )\n"))), sky_of_pixel(m, f_m / PITCH, px, py)))
+        worst = max(sep_arcsec(got, want) for got, want in own)
+        ok = worst < 0.01
+        failed += not ok
+        print(f"{name}: NavCam's own WCS ({os.path.basename(path)}): worst {worst:.2e} arcsec "
+              f"{'ok' if ok else 'FAILED (0.01 arcsec)'}")
     sol = os.path.join(tmp, name)
     subprocess.run(["solve-field", "--overwrite", "--no-plots", "--no-remove-lines", "--cpulimit", "120",
                     "--scale-units", "degwidth", "--scale-low", str(0.9 * fov), "--scale-high", str(1.1 * fov),
