@@ -69,9 +69,11 @@ static char *describe(const struct nc_image_attr *attrs, int nattrs)
     if (!s)
         return NULL;
     *p++ = '{';
-    for (int i = 0; i < nattrs; i++) {
+    for (int i = 0, n = 0; i < nattrs; i++) {
+        if (!strncmp(attrs[i].name, "fits:", 5))
+            continue; /* FITS keywords of their own (the WCS): FITS files only */
         const char *parts[2] = {attrs[i].name, attrs[i].value};
-        if (i)
+        if (n++)
             *p++ = ',', *p++ = ' ';
         for (int k = 0; k < 2; k++) {
             *p++ = '"';
