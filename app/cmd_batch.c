@@ -66,30 +66,29 @@ static void json_vec(FILE *f, const char *key, const double *v, int n, const cha
     fprintf(f, "]%s", sep);
 }
 
-/* Row stem's lock (DIR/.STEM.lock, flock): held while the row is rendered,
- * so that two processes given the same rows (a shard submitted again while
- * it still runs) never write the same temporary files; the other skips the
- * row. 1 with *fd held, 0 if another process holds it, < 0 on error. */
-static int lock_row(const char *dir, const char *stem, int *fd)
+/* Row stem's lock (DIR/.STEM.lock, flock; its path into lock): held while
+ * the row is rendered, so that two processes given the same rows (a shard
+ * submitted again while it still runs) never write the same temporary
+ * files; the other skips the row. 1 with *fd held, 0 if another process
+ * holds it, < 0 on error. */
+static int lock_row(const char *dir, const char *stem, char *lock, size_t len, int *fd)
 {
-    char path[4200];
-    snprintf(path, sizeof path, "%s/.%s.lock", dir, stem);
-    if ((*fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666)) < 0)
-        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    snprintf(lock, len, "%s/.%s.lock", dir, stem);
+    if ((*fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0666)) < 0)
+        return nc_error(-errno, "%s: %s", lock, strerror(errno));
     if (flock(*fd, LOCK_EX | LOCK_NB) == 0)
         return 1;
     const int err = errno;
     close(*fd);
-    *fd = -1;
-    return err == EWOULDBLOCK ? 0 : nc_error(-err, "%s: flock: %s", path, strerror(err));
+    return err == EWOULDBLOCK ? 0 : nc_error(-err, "%s: flock: %s", lock, strerror(err));
 }
 
-static void unlock_row(const char *dir, const char *stem, int fd, int done)
+/* Released; the file removed once the row is done (its JSON in place:
+ * nobody renders it again). */
+static void unlock_row(const char *lock, int fd, int done)
 {
-    char path[4200];
-    snprintf(path, sizeof path, "%s/.%s.lock", dir, stem);
-    if (done) /* the JSON is in place: nobody renders the row again */
-        unlink(path);
+    if (done)
+        unlink(lock);
     close(fd);
 }
 
@@ -437,24 +436,25 @@ int main(int argc, char **argv)
         char stem[32], path[4200];
         snprintf(stem, sizeof stem, "frame_%06ld", i);
         snprintf(path, sizeof path, "%s/%s.json", dir, stem);
-        int lock = -1;
+        char lock[4200];
+        int fd;
         if (access(path, F_OK) == 0) {
             skipped++;
             continue;
         }
-        if ((rc = lock_row(dir, stem, &lock)) <= 0) {
+        if ((rc = lock_row(dir, stem, lock, sizeof lock, &fd)) <= 0) {
             busy += rc == 0;
             if (rc < 0)
                 break;
             continue;
         }
         if (access(path, F_OK) == 0) { /* finished by another process while we took the lock */
-            unlock_row(dir, stem, lock, 0);
+            unlock_row(lock, fd, 0);
             skipped++;
             continue;
         }
         rc = batch_row(&r, &base, &cs, &sky, &rows[i], i, dir, stem, ext, q, exposure, geometry, geom, rock);
-        unlock_row(dir, stem, lock, rc >= 0);
+        unlock_row(lock, fd, rc >= 0);
         if (rc < 0)
             break;
         done++;

@@ -129,7 +129,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
                 s++;
         }
         if (k == 0 && n == 0 && !header) {
-            header = (int)lineno; /* a header: which layout */
+            header = 1; /* a header: which layout */
             sum = sum_header(line);
             continue;
         }

@@ -143,15 +143,12 @@ static void test_log(void)
     nc_log_info("emulator", "not shown at error level");
     dup2(saved, 2);
     close(saved);
-    char buf[512] = "";
-    FILE *f = fopen(path, "r");
-    size_t got = f ? fread(buf, 1, sizeof buf - 1, f) : 0;
-    buf[got] = '\0';
-    if (f)
-        fclose(f);
-    CHECK(!strcmp(buf, "navcam test: output/v4l2: /dev/video42 reopened after 3 lost frames\n"
-                       "navcam test: trigger/gpio: warning: late\n"),
-          "log lines:\n%s", buf);
+    size_t got;
+    char *buf = nc_test_read(path, &got);
+    CHECK(buf && !strcmp(buf, "navcam test: output/v4l2: /dev/video42 reopened after 3 lost frames\n"
+                              "navcam test: trigger/gpio: warning: late\n"),
+          "log lines:\n%s", buf ? buf : "(none)");
+    free(buf);
 }
 
 int main(void)

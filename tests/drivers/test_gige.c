@@ -435,7 +435,7 @@ static void test_client_killed(void)
 /* navcam serve with extra settings must fail (exit 1) with needle in stderr. */
 static void expect_fail(const char *name, const char *const *extra, int n, const char *needle)
 {
-    char dir[4096], log[4200], text[4096] = "";
+    char dir[4096], log[4200];
     snprintf(dir, sizeof dir, "%s/%s", tmp, name);
     pid_t pid = serve(dir, extra, n);
     int st = 0;
@@ -446,14 +446,12 @@ static void expect_fail(const char *name, const char *const *extra, int n, const
         st = 0;
     }
     snprintf(log, sizeof log, "%s/serve.log", dir);
-    FILE *f = fopen(log, "r");
-    size_t got = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    text[got] = 0;
-    if (f)
-        fclose(f);
-    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 1 && strstr(text, needle), "%s: exit %d, stderr '%s', want '%s'", name,
-          WIFEXITED(st) ? WEXITSTATUS(st) : -1, text, needle);
-    printf("%s: %s", name, text);
+    size_t got;
+    char *text = nc_test_read(log, &got);
+    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 1 && text && strstr(text, needle), "%s: exit %d, stderr '%s', want '%s'",
+          name, WIFEXITED(st) ? WEXITSTATUS(st) : -1, text ? text : "", needle);
+    printf("%s: %s", name, text ? text : "");
+    free(text);
 }
 
 static void test_errors(void)

@@ -184,15 +184,13 @@ static void refused_beyond_the_limit(void)
     nc_client_close(b);
     nc_client_close(x);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
-    char log[4200], text[4096] = "";
+    char log[4200];
     snprintf(log, sizeof log, "%s/limit/serve.log", tmp);
-    FILE *f = fopen(log, "r");
-    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    text[n] = '\0';
-    if (f)
-        fclose(f);
-    CHECK(nc_test_contains(text, "refused a TCP client: all 2 client slots are in use (serve.max_clients"),
-          "the refusal is not in the log:\n%s", text);
+    size_t n;
+    char *text = nc_test_read(log, &n);
+    CHECK(text && nc_test_contains(text, "refused a TCP client: all 2 client slots are in use (serve.max_clients"),
+          "the refusal is not in the log:\n%s", text ? text : "(none)");
+    free(text);
 }
 
 static void shutdown_answers_everything(void)
