@@ -44,6 +44,7 @@
 #include "core/log.h"
 #include "drivers/gige/gige_check.h"
 #include "drivers/gige/gige_image.h"
+#include "drivers/gige/gige_net.h"
 #include "drivers/gige/gige_regs.h"
 #include "drivers/gige/gvsp.h"
 #include "drivers/navcam_genicam_xml.h"
@@ -79,6 +80,8 @@ struct gige {
     struct nc_acquisition applied; /* what the registers said last time */
     uint32_t held[NC_GIGE_HELD];     /* the image registers' last values that held */
     unsigned long rejected_settings;
+    int probe_fd;    /* the heartbeat check's socket (gige_net.h), or -1 */
+    int controlled;  /* a client held the control at the last poll */
 };
 
 /* The registers a client sees, from the emulator's settings. */
@@ -112,10 +115,12 @@ static void apply_settings(struct gige *g)
     nc__gige_read_settings(g->fc, &g->applied, &want);
     if (nc__gige_same(&want, &g->applied) || !g->ctl)
         return;
-    if (!(want.exposure_s >= 1e-6 && want.exposure_s <= 10.0) || !(want.gain_db >= 0 && want.gain_db <= 48) ||
-        !(want.frame_rate_hz >= 0.01))
-        nc_error(NC_ERANGE, "ExposureTime %g us, Gain %g dB or AcquisitionFrameRate %g Hz beyond the device's range",
-                 want.exposure_s * 1e6, want.gain_db, want.frame_rate_hz);
+    if (!(want.exposure_s >= 1e-6 && want.exposure_s <= 10.0))
+        nc_error(NC_ERANGE, "ExposureTime %g us outside 1 us to 10 s", want.exposure_s * 1e6);
+    else if (!(want.gain_db >= 0 && want.gain_db <= 48))
+        nc_error(NC_ERANGE, "Gain %g dB outside 0 to 48 dB", want.gain_db);
+    else if (!(want.frame_rate_hz >= 0.01))
+        nc_error(NC_ERANGE, "AcquisitionFrameRate %g Hz below 0.01 Hz", want.frame_rate_hz);
     else if (g->ctl->set(g->ctl->emu, &want) >= 0) {
         g->applied = want; /* the registers already say so */
         return;
@@ -126,11 +131,26 @@ static void apply_settings(struct gige *g)
     publish(g, &want);
 }
 
+/* The controlling client released the device, or its heartbeat ran out
+ * (the device found it so at a message: nc__gige_probe sends one four
+ * times a second while a client holds the control): as a GigE Vision
+ * camera does, the acquisition stops and the stream channel closes, so
+ * that no frame goes to a client that is gone, nor to it again when
+ * another client takes the control. */
+static void control_ended(struct gige *g)
+{
+    const int acquiring = arv_fake_camera_get_acquisition_status(g->fc) != 0;
+    nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_ACQUISITION, 0);
+    nc__gige_reg_set(g->fc, REG_HOST_PORT, 0);
+    nc_log_info("output/gige", "the controlling client released the device or its heartbeat (%u ms) ran out%s",
+                nc__gige_reg(g->fc, REG_HEARTBEAT), acquiring ? ": acquisition stopped, stream channel closed" : "");
+}
+
 static void *poll_thread(void *arg)
 {
     struct gige *g = arg;
     const long period_ns = (long)(1e9 / g->poll_hz);
-    int64_t next_rate_ns = 0;
+    int64_t next_rate_ns = 0, next_probe_ns = 0;
     while (!atomic_load(&g->stop)) {
         nanosleep(&(struct timespec){0, period_ns}, NULL);
         /* What a client wrote within one period is taken in the order a
@@ -139,8 +159,16 @@ static void *poll_thread(void *arg)
          * opens to exposures starting from now, and a trigger right after
          * the start or a setting makes a frame that is sent, with that
          * setting. */
-        int acquiring = arv_fake_camera_get_acquisition_status(g->fc) != 0 &&
-                        arv_fake_camera_get_control_channel_privilege(g->fc) != 0;
+        const int controlled = arv_fake_camera_get_control_channel_privilege(g->fc) != 0;
+        if (g->controlled && !controlled)
+            control_ended(g);
+        g->controlled = controlled;
+        int64_t now = nc_mono_ns();
+        if (controlled && g->probe_fd >= 0 && now >= next_probe_ns) {
+            nc__gige_probe(g->probe_fd);
+            next_probe_ns = now + 250000000;
+        }
+        int acquiring = controlled && arv_fake_camera_get_acquisition_status(g->fc) != 0;
         check_registers(g);
         apply_settings(g);
         if (acquiring && !atomic_load(&g->acq_start_ns))
@@ -152,7 +180,6 @@ static void *poll_thread(void *arg)
             if (g->ctl)
                 g->ctl->software_trigger(g->ctl->emu);
         }
-        int64_t now = nc_mono_ns();
         if (g->ctl && g->ctl->resulting_rate_hz && now >= next_rate_ns) {
             nc__gige_reg_set_double(g->fc, REG_RESULTING_RATE, g->ctl->resulting_rate_hz(g->ctl->emu));
             next_rate_ns = now + 100000000;
@@ -269,6 +296,7 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     const char *iface = NULL, *serial = NULL, *model = NULL, *xml = NULL;
     long packet = -1, meta = 0;
     int fmt = 0, rc;
+    g->probe_fd = -1;
     if ((rc = nc_param_string(opts, gige_params, "interface", &iface)) < 0 ||
         (rc = nc_param_string(opts, gige_params, "serial", &serial)) < 0 ||
         (rc = nc_param_string(opts, gige_params, "model", &model)) < 0 ||
@@ -280,6 +308,10 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         return rc;
     if (strlen(serial) == 0 || strlen(serial) > 15)
         return nc_cfg_error(nc_cfg_get(opts, "serial"), "expected 1 to 15 characters");
+    if (strlen(model) > 31) /* DeviceModelName: 32 bytes, the last a NUL */
+        return nc_cfg_error(nc_cfg_get(opts, "model"), "expected at most 31 characters, not %zu", strlen(model));
+    if (packet > 0 && packet % 4)
+        return nc_cfg_error(nc_cfg_get(opts, "packet_size"), "expected a multiple of 4 (GevSCPSPacketSize's step)");
     if (strlen(iface) >= sizeof g->iface)
         return nc_cfg_error(nc_cfg_get(opts, "interface"), "interface name too long");
     if (ctx->adc_bits > 16 || ctx->adc_bits < 8)
@@ -307,8 +339,11 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         }
         rc = nc__gige_check_xml(path, xml_text, xml_len);
         g_free(xml_text);
-        if (rc < 0)
-            return rc;
+        if (rc < 0) {
+            char why[1024]; /* nc_cfg_error writes nc_errmsg's buffer */
+            snprintf(why, sizeof why, "%s", nc_errmsg());
+            return nc_cfg_error(nc_cfg_get(opts, "xml"), "%s", why);
+        }
     } else {
         if ((rc = nc__gige_check_xml("(built in)", navcam_genicam_xml, sizeof navcam_genicam_xml)) < 0)
             return rc;
@@ -343,7 +378,12 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     g->fill = 0, g->ready = 1, g->send = 2;
     pthread_mutex_init(&g->lock, NULL);
     pthread_cond_init(&g->cond, NULL);
+    const int loopback = !strncmp(g->addr, "127.", 4);
+    int before[16], nbefore = nc__gige_discovery_fds(before, 16);
     g->gv = arv_gv_fake_camera_new_full(g->iface, serial, path);
+    if (loopback) /* no discovery broadcasts from other interfaces */
+        nc__gige_quiet_discovery(before, nbefore);
+    g->probe_fd = nc__gige_probe_open(g->addr);
     if (!xml)
         unlink(path); /* read at construction */
     if (!g->gv || !arv_gv_fake_camera_is_running(g->gv)) {
@@ -445,6 +485,8 @@ static void gige_close(void *priv)
                     g->send_failed, g->rejected_settings);
     if (g->gv)
         g_object_unref(g->gv); /* stops and joins the device thread */
+    if (g->probe_fd >= 0)
+        close(g->probe_fd);
     if (g->buf[0]) {
         pthread_mutex_destroy(&g->lock);
         pthread_cond_destroy(&g->cond);

@@ -31,8 +31,9 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
     nc_cfg_init(&cfg);
     char dir[4096] = ".";
     if (opt->scene_path) {
-        snprintf(dir, sizeof dir, "%s", opt->scene_path);
-        snprintf(dir, sizeof dir, "%s", dirname(dir));
+        char path[4096]; /* dirname may return a pointer into its argument */
+        snprintf(path, sizeof path, "%s", opt->scene_path);
+        snprintf(dir, sizeof dir, "%s", dirname(path));
     }
     int rc = nc_cfg_load_scene(&cfg, opt->scene_path, opt->sets, opt->nsets);
     if (rc >= 0) /* the serve section, trigger and outputs checked before the scene is built */

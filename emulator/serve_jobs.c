@@ -249,6 +249,8 @@ static int control_set(void *emu, const struct nc_acquisition *a)
         !(a->frame_rate_hz >= 1e-3 && a->frame_rate_hz <= 1000) || !(a->trigger_delay_s >= 0 && a->trigger_delay_s <= 10))
         return nc_error(NC_ERANGE, "acquisition settings out of range: exposure %g s, gain %g dB, rate %g Hz, delay %g s",
                         a->exposure_s, a->gain_db, a->frame_rate_hz, a->trigger_delay_s);
+    if (a->source == NC_SOURCE_LINE && !e->have_line)
+        return nc_error(NC_EUNSUPPORTED, "trigger source Line0: serve.trigger names no line (gpio, usb or timer)");
     pthread_mutex_lock(&e->acq_lock);
     struct nc_acquisition old = e->acq;
     int rc = 0;

@@ -74,7 +74,7 @@ int nc__gige_same(const struct nc_acquisition *a, const struct nc_acquisition *b
 
 static const uint32_t held_reg[NC_GIGE_HELD] = {
     ARV_FAKE_CAMERA_REGISTER_WIDTH,    ARV_FAKE_CAMERA_REGISTER_HEIGHT,       ARV_FAKE_CAMERA_REGISTER_X_OFFSET,
-    ARV_FAKE_CAMERA_REGISTER_Y_OFFSET, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, REG_PACKET_SIZE};
+    ARV_FAKE_CAMERA_REGISTER_Y_OFFSET, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, REG_PACKET_SIZE, REG_HEARTBEAT};
 
 void nc__gige_hold(ArvFakeCamera *fc, uint32_t held[NC_GIGE_HELD])
 {
@@ -101,13 +101,14 @@ int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uin
     const uint32_t W = (uint32_t)w, H = (uint32_t)(h + meta_rows), min_w = W < 16 ? W : 16, packet = v[5] & 0xffff;
     const int ok = v[0] >= min_w && v[0] <= W && v[2] <= W - v[0] && v[1] >= 1 && v[1] <= H && v[3] <= H - v[1] &&
                    (v[4] == PF_MONO8 || v[4] == PF_MONO12 || v[4] == PF_MONO16) && packet >= 576 &&
-                   packet <= 65000 && packet % 4 == 0;
+                   packet <= 65000 && packet % 4 == 0 && v[6] >= 500 && v[6] <= 60000;
     if (ok) {
         memcpy(held, v, sizeof v);
     } else if (memcmp(held, v, sizeof v)) {
         for (int i = 0; i < NC_GIGE_HELD; i++)
             nc__gige_reg_set(fc, held_reg[i], held[i]);
-        *why = "Width, Height, OffsetX, OffsetY, PixelFormat or GevSCPSPacketSize outside its range";
+        *why = "Width, Height, OffsetX, OffsetY, PixelFormat, GevSCPSPacketSize or GevHeartbeatTimeout outside its "
+               "range";
         undone++;
     }
     if (nc__gige_reg(fc, REG_TRIGGER_MODE) > 1 || nc__gige_reg(fc, REG_TRIGGER_SOURCE) > 1 ||

@@ -24,6 +24,8 @@ enum {
     REG_RESULTING_RATE = 0x1028, /* double, Hz, read-only */
     REG_META_ROWS = 0x1030,      /* 0 or 1 */
     REG_PACKET_SIZE = 0xd04,     /* stream channel 0: packet size in the low 16 bits */
+    REG_HOST_PORT = 0xd00,       /* stream channel 0: the client's port in the low 16 bits */
+    REG_HEARTBEAT = 0x938,       /* heartbeat timeout, ms */
     REG_VENDOR = 0x48,
     REG_MODEL = 0x68,
     REG_VERSION = 0x88,
@@ -42,9 +44,10 @@ void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a);
 void nc__gige_read_settings(ArvFakeCamera *fc, const struct nc_acquisition *base, struct nc_acquisition *a);
 int nc__gige_same(const struct nc_acquisition *a, const struct nc_acquisition *b);
 
-/* The image registers a client writes, checked together: Width, Height,
- * OffsetX, OffsetY, PixelFormat, GevSCPSPacketSize. */
-#define NC_GIGE_HELD 6
+/* The image and transport registers a client writes, checked together:
+ * Width, Height, OffsetX, OffsetY, PixelFormat, GevSCPSPacketSize,
+ * GevHeartbeatTimeout. */
+#define NC_GIGE_HELD 7
 void nc__gige_hold(ArvFakeCamera *fc, uint32_t held[NC_GIGE_HELD]);
 /* Aravis's device stores whatever a client writes (GenICam's ranges are
  * the client's to check, and Aravis leaves them unchecked by default): the
@@ -52,7 +55,8 @@ void nc__gige_hold(ArvFakeCamera *fc, uint32_t held[NC_GIGE_HELD]);
  * meta_rows metadata rows. The read-only registers get their values back;
  * image registers outside the XML's ranges (the region beyond the sensor,
  * a packet size outside 576..65000 or off its step of 4, a pixel format
- * that is no entry) the last values that held (held, updated when they
+ * that is no entry, a heartbeat timeout outside 500..60000 ms) the last
+ * values that held (held, updated when they
  * hold); a trigger enumeration that is no entry, the settings applied.
  * Returns how many kinds of write were undone, *why the last. */
 int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uint32_t held[NC_GIGE_HELD],

@@ -8,14 +8,20 @@
  * start arrives); TriggerMode On + Software: one frame per
  * TriggerSoftware and none without; settings, AcquisitionStart and
  * TriggerSoftware written at once act in that order; out-of-range writes and
- * writes to read-only registers read back what holds; TriggerSource Line0 follows the line of
+ * writes to read-only registers, TriggerSource Line0 without a line and a
+ * heartbeat timeout under 500 ms read back what holds; the GenICam XML's
+ * Units precede their Representations; TriggerSource Line0 follows the line of
  * serve.trigger; AcquisitionFrameRate within 2% (exposure starts on the
  * rate's grid; a tick skipped under load, an overrun, is allowed at most
  * once in five frames); a client
- * killed mid-stream, then a new client streams; clear errors for a missing
- * interface, a taken port 3956 and an invalid XML.
+ * killed mid-stream: its port gets no packet once its heartbeat ran out,
+ * and a new client streams; clear errors for a missing
+ * interface, a taken port 3956, an invalid XML (also one named relative to
+ * a configuration file elsewhere), a model name too long, a packet size
+ * off its step.
  * Usage: test_gige NAVCAM TMPDIR
  */
+#include <arpa/inet.h>
 #include <arv.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -25,7 +31,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/time.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -345,16 +353,32 @@ static void test_write_order(void)
     CHECK(good == 5, "settings, start and trigger written at once: %d of 5 frames with their exposure", good);
     finish(c, &st);
     ArvDevice *d = arv_camera_get_device(c);
-    static const uint32_t reg[4] = {0x100 /* Width */, 0x110 /* Gain, 0.01 dB */, 0x1010 /* TriggerMode */,
-                                    0x11c /* SensorWidth */},
-                          bad[4] = {W + 10, 6000, 7, 99}, want[4] = {W, 0, 1, W};
-    for (int i = 0; i < 4; i++) {
+    /* TriggerSource Line0 without a line in serve.trigger, a heartbeat
+     * timeout under GigE Vision's 500 ms */
+    static const uint32_t reg[6] = {0x100 /* Width */, 0x110 /* Gain, 0.01 dB */, 0x1010 /* TriggerMode */,
+                                    0x11c /* SensorWidth */, 0x1014 /* TriggerSource */, 0x938 /* heartbeat */},
+                          bad[6] = {W + 10, 6000, 7, 99, 0, 100}, want[6] = {W, 0, 1, W, 1, 3000};
+    for (int i = 0; i < 6; i++) {
         guint32 v = 0;
         arv_device_write_register(d, reg[i], bad[i], NULL);
         usleep(50000);
         arv_device_read_register(d, reg[i], &v, NULL);
         CHECK(v == want[i], "register 0x%x written %u: reads %u, want %u (what holds)", reg[i], bad[i], v, want[i]);
     }
+    /* GenApi's schema orders a number's elements: Unit before
+     * Representation (strict GenICam readers refuse the file otherwise). */
+    size_t len = 0;
+    const char *xml = arv_device_get_genicam_xml(d, &len);
+    int misordered = 0, units = 0;
+    for (const char *p = xml; p && (p = strstr(p, "<Representation>")); p++) {
+        const char *end = strstr(p, "</Integer>"), *endf = strstr(p, "</Float>"), *u = strstr(p, "<Unit>");
+        end = !end || (endf && endf < end) ? endf : end;
+        misordered += u && end && u < end;
+    }
+    for (const char *p = xml; p && (p = strstr(p, "<Unit>")); p++)
+        units++;
+    CHECK(xml && units >= 10 && misordered == 0, "GenICam XML: %d of %d Units after their Representation",
+          misordered, units);
     free(img);
     g_object_unref(c);
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
@@ -390,26 +414,66 @@ static void test_line0(void)
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
 }
 
+/* UDP packets arriving at 127.0.0.1:port within seconds. */
+static int packets_at(int port, double seconds)
+{
+    int fd = socket(AF_INET, SOCK_DGRAM, 0), n = 0;
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (fd < 0 || bind(fd, (struct sockaddr *)&sa, sizeof sa) < 0) {
+        CHECK(0, "bind 127.0.0.1:%d: %s", port, strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    struct timeval tv = {0, 100000};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    char buf[9000];
+    for (double t0 = now_s(); now_s() - t0 < seconds;)
+        n += recv(fd, buf, sizeof buf, 0) > 0;
+    close(fd);
+    return n;
+}
+
 static void test_client_killed(void)
 {
     char dir[4096];
     snprintf(dir, sizeof dir, "%s/killed", tmp);
     const char *extra[] = {"serve.mode=freerun", "outputs=[{driver: gige, pixel_format: Mono16}]"};
     pid_t pid = serve(dir, extra, 2);
+    int fds[2];
+    CHECK(pipe(fds) == 0, "pipe");
     pid_t child = fork();
-    if (child == 0) { /* a client that dies mid-stream */
+    if (child == 0) { /* a client that dies mid-stream, its stream's port told first */
         ArvCamera *c = open_camera();
         uint8_t *img = malloc((size_t)W * H * 2);
         struct stream st = {0};
         if (!c || start(c, &st) < 0 || next_frame(&st, 5, img, NULL) < 0)
             _exit(1);
+        int port = (int)arv_device_get_integer_feature_value(arv_camera_get_device(c), "GevSCPHostPort", NULL);
+        if (write(fds[1], &port, sizeof port) != sizeof port)
+            _exit(1);
         kill(getpid(), SIGKILL);
     }
-    int cst = 0;
+    close(fds[1]);
+    int cst = 0, port = 0;
+    const int got_port = read(fds[0], &port, sizeof port) == sizeof port;
+    close(fds[0]);
     waitpid(child, &cst, 0);
-    CHECK(WIFSIGNALED(cst) && WTERMSIG(cst) == SIGKILL, "the first client did not stream before it was killed");
-    /* The device keeps the dead client's control channel until its 3 s
-     * heartbeat runs out. */
+    double t_kill = now_s();
+    CHECK(WIFSIGNALED(cst) && WTERMSIG(cst) == SIGKILL && got_port && port > 0,
+          "the first client did not stream before it was killed (port %d)", port);
+    /* No one talks to the device now: the stream goes on to the dead
+     * client's port until its 3 s heartbeat runs out, then the device
+     * stops the acquisition and closes the stream channel. */
+    int before = port > 0 ? packets_at(port, 1.0) : -1;
+    while (now_s() - t_kill < 4.0)
+        usleep(50000);
+    int after = port > 0 ? packets_at(port, 2.0) : -1;
+    printf("after a client was killed: %d packets to its port in the first second, %d from 4 to 6 s\n", before,
+           after);
+    CHECK(before > 0 && after == 0, "a killed client's port: %d packets in the first second, %d from 4 to 6 s (want "
+          "some, then none)", before, after);
     double t0 = now_s();
     ArvCamera *c = NULL;
     struct stream st = {0};
@@ -419,6 +483,13 @@ static void test_client_killed(void)
         c = open_camera();
         if (c && start(c, &st) == 0 && next_frame(&st, 2, img, NULL) == 0 && next_frame(&st, 2, img, NULL) == 0)
             ok = 1;
+        if (c && ok) {
+            GError *err = NULL;
+            gint64 hb = arv_device_get_integer_feature_value(arv_camera_get_device(c), "GevHeartbeatTimeout", &err);
+            CHECK(!err && hb == 3000, "GevHeartbeatTimeout %lld ms, want 3000 (%s)", (long long)hb,
+                  err ? err->message : "");
+            g_clear_error(&err);
+        }
         if (c) {
             finish(c, &st);
             g_object_unref(c);
@@ -426,7 +497,7 @@ static void test_client_killed(void)
         if (!ok)
             usleep(500000);
     }
-    printf("after a client was killed: a new client streamed after %.1f s\n", now_s() - t0);
+    printf("then a new client streamed after %.1f s more\n", now_s() - t0);
     CHECK(ok, "no new client could stream after a client was killed");
     free(img);
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
@@ -464,6 +535,28 @@ static void test_errors(void)
     snprintf(set, sizeof set, "outputs=[{driver: gige, xml: %s}]", xml);
     const char *badxml[] = {set};
     expect_fail("bad_xml", badxml, 1, "GenICam XML");
+    const char *model[] = {"outputs=[{driver: gige, model: A model name longer than thirty-one characters}]"};
+    expect_fail("long_model", model, 1, "outputs[0].model: expected at most 31 characters");
+    const char *packet[] = {"outputs=[{driver: gige, packet_size: 8190}]"};
+    expect_fail("packet_step", packet, 1, "outputs[0].packet_size: expected a multiple of 4");
+    /* An xml path relative to the configuration file, whose directory is
+     * not the one serve runs in. */
+    char cfgdir[4200], cfg[4300], rel[4300], log[4300];
+    snprintf(cfgdir, sizeof cfgdir, "%s/xmlrel", tmp);
+    mkdir(cfgdir, 0777);
+    snprintf(cfg, sizeof cfg, "%s/c.yaml", cfgdir);
+    snprintf(rel, sizeof rel, "%s/rel.xml", cfgdir);
+    nc_test_write(cfg, "base: builtin:default\noutputs:\n  - driver: gige\n    xml: rel.xml\n");
+    nc_test_write(rel, "<RegisterDescription></RegisterDescription>");
+    const char *argv[] = {navcam, "serve", cfg, "--max-seconds", "20", NULL};
+    snprintf(log, sizeof log, "%s/run", cfgdir);
+    int st = 0;
+    waitpid(nc_test_spawn(log, argv), &st, 0);
+    snprintf(log, sizeof log, "%s/run/serve.log", cfgdir);
+    size_t got;
+    char *text = nc_test_read(log, &got);
+    CHECK(text && strstr(text, rel) && strstr(text, "is invalid"), "xml relative to %s: '%s'", cfg, text ? text : "");
+    free(text);
     /* Port 3956 taken by a first camera. */
     char dir[4096];
     snprintf(dir, sizeof dir, "%s/first", tmp);
