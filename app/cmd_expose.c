@@ -29,11 +29,12 @@ static const char expose_help[] =
     "                         a whole scene file works too (its pose, bodies and Sun\n"
     "                         are ignored)\n"
     "  -L, --radiance L       uniform scene radiance, W m^-2 sr^-1\n"
-    "  -e, --exposure T       exposure time, seconds (default: exposure.time_s)\n"
+    "  -e, --exposure T       exposure time, seconds, 0 to 3600 (default: exposure.time_s)\n"
     "  -n, --frames N         number of frames (default 1), numbered from --first-frame\n"
     "      --first-frame K    frame number of the first frame (keys the noise; default 0)\n"
     "  -d, --dark             dark frames: no light (radiance 0)\n"
-    "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N), 16-bit unsigned;\n"
+    "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N), 16-bit unsigned (8-bit\n"
+    "                         for an ADC of 8 bits or fewer);\n"
     "                         .png/.tif/.exr: numbered files OUT_0000.ext, OUT_0001.ext, ...\n"
     "      --fits-rows ORDER  .fits only: top_down (default: row 1 is the top image\n"
     "                         row) or bottom_up (row 1 at the bottom, as FITS viewers\n"
@@ -68,9 +69,11 @@ int main(int argc, char **argv)
         double v = 0;
         if (c == 'L' || c == 'e' || c == 'n' || c == 'F') {
             v = strtod(optarg, &end);
-            if (*end || !isfinite(v) || v < 0 || ((c == 'n' || c == 'F') && v != floor(v)) || (c == 'n' && (v < 1 || v > 100000))) {
-                fprintf(stderr, "navcam expose: bad value '%s' for --%s\n", optarg,
-                        c == 'L' ? "radiance" : c == 'e' ? "exposure" : c == 'n' ? "frames" : "first-frame");
+            if (*end || !isfinite(v) || v < 0 || ((c == 'n' || c == 'F') && v != floor(v)) ||
+                (c == 'n' && (v < 1 || v > 100000)) || (c == 'e' && v > 3600)) {
+                fprintf(stderr, "navcam expose: bad value '%s' for --%s%s\n", optarg,
+                        c == 'L' ? "radiance" : c == 'e' ? "exposure" : c == 'n' ? "frames" : "first-frame",
+                        c == 'e' ? " (seconds, 0 to 3600, as exposure.time_s)" : "");
                 goto out;
             }
         }

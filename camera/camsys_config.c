@@ -168,8 +168,8 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
     if (vig && vig->kind == NC_CFG_SCALAR) {
         static const char *const kinds[] = {"none", "cos4", NULL};
         int k;
-        if ((rc = nc_cfg_enum(m, "vignetting", kinds, &k)) < 0)
-            return rc;
+        if (nc_cfg_enum(m, "vignetting", kinds, &k) < 0)
+            return nc_cfg_error(vig, "expected none, cos4, or a table [[field_angle_deg, factor], ...]");
         o->vignetting = k == 0 ? NC_VIGNETTING_NONE : NC_VIGNETTING_COS4;
     } else if (vig) {
         if (vig->kind != NC_CFG_SEQ || vig->nchild < 2)
@@ -439,6 +439,7 @@ void nc_camsys_render_camera(const struct nc_camsys *cs, const struct nc_camera 
     c.height_px = cs->render_height_px;
     c.cx_px += cs->margin_px;
     c.cy_px += cs->margin_px;
+    c.margin_px = cs->margin_px;
     *out = c;
 }
 

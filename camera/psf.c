@@ -60,10 +60,13 @@ int nc_psf_gaussian(double sigma_px, struct nc_psf *psf)
 int nc_psf_airy(double wavelength_m, double f_number, double pitch_m, struct nc_psf *psf)
 {
     /* I(r) = [2 J1(v)/v]^2, v = pi r / (lambda N); first dark ring at
-     * r = 1.22 lambda N. Kernel radius: 12 dark-ring radii (at least 3 px),
-     * integrated over each pixel with 8x8 samples. */
+     * r = 1.22 lambda N. Cut at the 12th dark ring (v = 38.4748, the 12th
+     * zero of J1: r = 12.247 lambda N), a circle, in a square kernel of
+     * that half-width (at least 3 px), integrated over each pixel with 8x8
+     * samples. */
+    const double v12 = 38.4748;
     double lnp = wavelength_m * f_number / pitch_m; /* lambda N in pixels */
-    int r = (int)ceil(fmax(3.0, 12.0 * 1.22 * lnp));
+    int r = (int)ceil(fmax(3.0, v12 / M_PI * lnp));
     if (r > 200)
         return nc_error(NC_ERANGE, "Airy PSF is %d px wide; use a Gaussian or an image kernel", 2 * r + 1);
     psf->kind = NC_PSF_AIRY;
@@ -80,7 +83,7 @@ int nc_psf_airy(double wavelength_m, double f_number, double pitch_m, struct nc_
                     double px = x - 0.5 + (i + 0.5) / ss, py = y - 0.5 + (j + 0.5) / ss;
                     double v = M_PI * sqrt(px * px + py * py) / lnp;
                     double a = v > 1e-8 ? 2.0 * j1(v) / v : 1.0;
-                    sum += a * a;
+                    sum += v < v12 ? a * a : 0.0;
                 }
             psf->kernel[(y + r) * psf->size + (x + r)] = sum;
         }

@@ -140,20 +140,60 @@ static int cfg_error_key(const struct nc_cfg_node *parent, const char *key, cons
     return rc;
 }
 
-int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected)
+/* The key of map parent that no reader took and that most likely misspells
+ * key: key cut short (3 letters or more: 'lat' for 'lat_deg'), else one
+ * within a third of key's letters in edits; *score says how close (lower is
+ * closer). NULL if none. */
+static const struct nc_cfg_node *typo_of(const struct nc_cfg_node *parent, const char *key, size_t *score)
 {
-    /* a key of the map that no reader took and that is a typo of this one */
+    const struct nc_cfg_node *best = NULL;
+    size_t bs = strlen(key) / 3 + 1;
     for (size_t i = 0; parent && parent->kind == NC_CFG_MAP && i < parent->nchild; i++) {
         const struct nc_cfg_node *c = parent->child[i];
-        if (!c->used && c->key && nc__cfg_edits(c->key, key) <= strlen(key) / 3) {
-            char at[32] = "";
-            if (c->line > 0)
-                snprintf(at, sizeof at, " (line %d)", c->line);
-            return cfg_error_key(parent, key, "missing required key (expected %s); '%s'%s is not a key here: a "
-                                              "misspelling of it?", expected, c->key, at);
-        }
+        if (c->used || !c->key)
+            continue;
+        const size_t lc = strlen(c->key), sc = lc >= 3 && lc < strlen(key) && !strncmp(key, c->key, lc)
+                                                   ? 0
+                                                   : nc__cfg_edits(c->key, key);
+        if (sc < bs)
+            best = c, bs = sc;
     }
-    return cfg_error_key(parent, key, "missing required key (expected %s)", expected);
+    *score = bs;
+    return best;
+}
+
+static int missing(const struct nc_cfg_node *parent, const char *key, const char *msg, const struct nc_cfg_node *c,
+                   const char *meant)
+{
+    if (!c)
+        return key ? cfg_error_key(parent, key, "%s", msg) : nc_cfg_error(parent, "%s", msg);
+    char at[32] = "";
+    if (c->line > 0)
+        snprintf(at, sizeof at, " (line %d)", c->line);
+    return key ? cfg_error_key(parent, key, "%s; '%s'%s is not a key here: a misspelling of it?", msg, c->key, at)
+               : nc_cfg_error(parent, "%s; '%s'%s is not a key here: a misspelling of '%s'?", msg, c->key, at,
+                              meant ? meant : "?");
+}
+
+int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected)
+{
+    char msg[512];
+    size_t score;
+    snprintf(msg, sizeof msg, "missing required key (expected %s)", expected);
+    return missing(parent, key, msg, typo_of(parent, key, &score), key);
+}
+
+int nc_cfg_missing_any(const struct nc_cfg_node *map, const char *const *keys, const char *msg)
+{
+    const struct nc_cfg_node *best = NULL;
+    const char *meant = NULL;
+    size_t bs = (size_t)-1, score;
+    for (int i = 0; keys[i]; i++) {
+        const struct nc_cfg_node *c = typo_of(map, keys[i], &score);
+        if (c && score < bs)
+            best = c, bs = score, meant = keys[i];
+    }
+    return missing(map, NULL, msg, best, meant);
 }
 
 /* ---- loading ---------------------------------------------------------- */

@@ -77,6 +77,9 @@ void nc_cfg_resolve_path(const struct nc_cfg_node *n, const char *file, char *ou
  * missing key should have been). */
 int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected);
+/* map lacks every one of keys (NULL-terminated): the error msg on map, with
+ * the key no reader took that most likely misspells one of them. */
+int nc_cfg_missing_any(const struct nc_cfg_node *map, const char *const *keys, const char *msg);
 /* Dotted path of a node, e.g. "bodies[0].shape.radius_m". */
 void nc_cfg_path(const struct nc_cfg_node *node, char *buf, size_t len);
 /* Where node came from and its path, as errors name it: "FILE:LINE: path",

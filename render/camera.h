@@ -33,6 +33,11 @@ struct nc_camera {
      * (flip_rows) and/or left to right (flip_cols): a SUM file's pixel grid
      * with K22 < 0 or K11 < 0 (docs/sumfiles.md). Writers apply it. */
     int flip_rows, flip_cols;
+    /* The camera model's margin around the sensor's image (a PSF's half
+     * size, pixels on every side: nc_camsys_render_camera), 0 without one:
+     * the render keys its samples to the sensor's pixels, so a margin
+     * changes no sample of theirs. */
+    int margin_px;
     /* camera.sumfile: the SUM file's Sun direction (body-fixed, unit) and
      * picture time; from_sumfile 0 otherwise. */
     int from_sumfile;

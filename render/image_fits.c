@@ -181,6 +181,25 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
             fits_close_file(f, &status);
         return rc;
     }
+    long planes = naxes[2];
+    for (int k = 4; k <= naxis; k++) { /* the sizes of axes past the third */
+        char key[16];
+        long len = 1;
+        snprintf(key, sizeof key, "NAXIS%d", k);
+        if (!fits_read_key_lng(f, key, &len, NULL, &status))
+            planes *= len;
+        status = 0;
+    }
+    char order[FLEN_VALUE] = "";
+    if (fits_read_key_str(f, "ROWORDER", order, NULL, &status))
+        status = 0, order[0] = '\0'; /* files from elsewhere: top-down, as NavCam wrote them before */
+    if (naxis < 2 || planes != 1 || (order[0] && strcmp(order, "TOP-DOWN") && strcmp(order, "BOTTOM-UP"))) {
+        fits_close_file(f, &status);
+        if (naxis < 2 || planes != 1)
+            return nc_error(NC_EIMAGE, "%s: %d axes%s: an image here is one plane of 2 axes", path, naxis,
+                            planes != 1 ? ", more than one plane" : "");
+        return nc_error(NC_EIMAGE, "%s: ROWORDER '%s': expected 'TOP-DOWN' or 'BOTTOM-UP'", path, order);
+    }
     size_t n = (size_t)naxes[0] * (size_t)naxes[1];
     float *buf = malloc((n ? n : 1) * sizeof *buf);
     int anynul = 0;
@@ -195,9 +214,6 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
         fits_close_file(f, &status);
         return rc;
     }
-    char order[FLEN_VALUE] = "";
-    if (fits_read_key_str(f, "ROWORDER", order, NULL, &status))
-        status = 0; /* files from elsewhere: top-down, as NavCam wrote them before */
     fits_close_file(f, &status);
     *w = (int)naxes[0];
     *h = (int)naxes[1];

@@ -32,6 +32,11 @@ int nc_mesh_dem_tile(const float *h, int w, int rows, const struct nc_dem_tile_p
             const double e = (c - 0.5 * (w - 1)) * p->pixel_m[0], n = (0.5 * (rows - 1) - r) * p->pixel_m[1];
             const double z = isfinite(h[i]) ? p->height_offset_m + p->height_scale * h[i] : 0.0;
             double *v = out->v + 3 * i;
+            if (p->radius_m > 0 && !(p->radius_m + z > 0)) {
+                nc_mesh_free(out);
+                return nc_error(NC_ERANGE, "the DEM goes below the sphere's centre (%g m under a %g m radius, row %d, "
+                                "column %d)", -z, p->radius_m, r, c);
+            }
             if (p->radius_m > 0) { /* gnomonic: the tangent plane's point projected onto the sphere */
                 double d[3], len = 0;
                 for (int k = 0; k < 3; k++) {

@@ -140,6 +140,18 @@ static inline double hash01(uint64_t seed, uint64_t a, uint64_t b)
     return (double)(int32_t)(z >> 33) * 0x1.0p-31 + (double)(int32_t)((z >> 11) & 0x3fffff) * 0x1.0p-53;
 }
 
+/* Pixel (px, py)'s key p for the hashes: its index in the sensor's image
+ * (the camera's margin_px taken off), so that a camera model's margin
+ * changes no sample of the sensor's pixels; the margin's pixels apart
+ * (their index in the whole image, top bit set). */
+static inline uint64_t pixel_id(const struct nc_camera *c, int px, int py)
+{
+    const int m = c->margin_px, x = px - m, y = py - m, w = c->width_px - 2 * m, h = c->height_px - 2 * m;
+    if (x >= 0 && y >= 0 && x < w && y < h)
+        return (uint64_t)y * (uint64_t)w + (uint64_t)x;
+    return 1ull << 63 | ((uint64_t)py * (uint64_t)c->width_px + (uint64_t)px);
+}
+
 static uint64_t gcd64(uint64_t u, uint64_t v)
 {
     while (v) {
@@ -452,7 +464,6 @@ hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *sha
 static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, int sidx, int depth, double *r,
                        double *r_hard, struct tile_counts *cnt)
 {
-    const int W = j->s->camera.width_px;
     struct nc_ray16 shadow, centre;
     struct nc_photometry geo[NC_PACKET];
     int from[NC_PACKET], lit[NC_PACKET], any = 0; /* how many lit */
@@ -499,7 +510,7 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
                 /* Soft shadows: toward a point of the solar disk, uniform
                  * over it, from a stream of its own (pixel, sample, depth). */
                 int px = px0 + (i & 3), py = py0 + (i >> 2);
-                uint64_t pid = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                uint64_t pid = pixel_id(&j->s->camera, px, py);
                 double rr = j->sun_tan_radius * sqrt(hash01(disk_seed, pid, 2 * (uint64_t)sidx)),
                        th = 2.0 * M_PI * hash01(disk_seed, pid, 2 * (uint64_t)sidx + 1);
                 struct nc_vec3 e1 = j->sun_e1, e2 = j->sun_e2;
@@ -558,7 +569,7 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
                        struct tile_counts *cnt)
 {
     const struct nc_scene *sc = j->s;
-    const int W = sc->camera.width_px, B = j->bounces;
+    const int B = j->bounces;
     double beta[NC_PACKET], irr0[NC_PACKET], pdf[NC_PACKET], r[NC_PACKET], radius[NC_MAX_BODIES];
     uint64_t pid[NC_PACKET]; /* each lane's pixel, keying its random numbers */
     struct nc_vec3 w[NC_PACKET], orig[NC_PACKET], centre[NC_MAX_BODIES];
@@ -577,7 +588,7 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
             if (s->body[i] < 0)
                 continue;
             const uint64_t key = 4 * ((uint64_t)sidx * (uint64_t)B + (uint64_t)(k - 1));
-            pid[i] = (uint64_t)(py0 + (i >> 2)) * (uint64_t)W + (uint64_t)(px0 + (i & 3));
+            pid[i] = pixel_id(&sc->camera, px0 + (i & 3), py0 + (i >> 2));
             for (int b = 0; b < sc->nbodies; b++)
                 centre[b] = nc_v3_sub(j->body_rel[b], s->p[i]);
             struct nc_bounce_mix mix;
@@ -835,7 +846,7 @@ static void shade_tile(struct job *j, int tile)
     int one_g[TILE * TILE]; /* the sample plane `one` keeps: (0 <= g < N) */
     for (int k = 0; k < TILE * TILE && one; k++) {
         const int x = x0 + k % TILE, y = y0 + k / TILE;
-        one_g[k] = sample_of(s->render.seed, (uint64_t)y * (uint64_t)W + (uint64_t)x, ps->k, ps->N);
+        one_g[k] = sample_of(s->render.seed, pixel_id(c, x, y), ps->k, ps->N);
         if (mine[k / TILE / 4][k % TILE / 4] && x < W && y < H)
             one[(size_t)y * (size_t)W + (size_t)x] = 0.0f; /* where that sample hits nothing */
     }
@@ -892,7 +903,7 @@ static void shade_tile(struct job *j, int tile)
                 for (int i = 0; i < NC_PACKET; i++) {
                     const int px = x0 + bx + (i & 3), py = y0 + by + (i >> 2);
                     valid[i] = (px < W && py < H) ? -1 : 0;
-                    pid[i] = (uint64_t)py * (uint64_t)W + (uint64_t)px;
+                    pid[i] = pixel_id(c, px, py);
                     ip.px[i] = px;
                     ip.py[i] = py;
                     ip.rc[i] = &j->row[py < H ? py : H - 1];

@@ -57,9 +57,13 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const 
             (has_c = nc_cfg_double(map, "density_per_km2", 0, 1e15, &p.c_per_km2)) < 0 ||
             (has_s = nc_cfg_double(map, "saturation", 0, 1, &sat)) < 0)
             return has_n < 0 ? has_n : has_c < 0 ? has_c : has_s;
+        static const char *const selectors[] = {"count", "density_per_km2", "saturation", NULL};
+        if (has_n + has_c + has_s == 0)
+            return nc_cfg_missing_any(map, selectors, "give one of count (mean number), density_per_km2 (N(>1 m) "
+                                                      "per km^2) or saturation (fraction of geometric saturation)");
         if (has_n + has_c + has_s != 1)
             return nc_cfg_error(map, "give one of count (mean number), density_per_km2 (N(>1 m) per km^2) or "
-                                     "saturation (fraction of geometric saturation)");
+                                     "saturation (fraction of geometric saturation), not several");
         if (has_c || has_s)
             count = -1;
         if ((has_b = nc_cfg_double(map, "slope", 0.5, 6, &p.slope)) < 0)
@@ -202,15 +206,23 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b, i
         return nc_cfg_error(nc_cfg_get(item, "albedo_variation"),
                             "albedo_variation needs a mesh or asteroid shape (an albedo map serves the others)");
     /* default largest wavelength: a tenth of the radius of the sphere of
-     * the same area */
+     * the same area, and at least four times the shortest the mesh carries
+     * (twice its mean edge: a small tile) */
+    const double shortest_m = 2 * nc_mesh_mean_edge_m(&b->mesh);
     struct nc_albedo_var_params p = {.rms = 0.1, .largest_m = 0.1 * sqrt(nc_mesh_area_m2(&b->mesh) / (4 * M_PI)),
                                      .hurst = 0.5, .rocks_rms = -1, .seed = 1};
+    p.largest_m = fmax(p.largest_m, 4 * shortest_m);
+    int given;
     if ((rc = nc_cfg_double(map, "rms", 0, 2, &p.rms)) < 0 ||
-        (rc = nc_cfg_double(map, "largest_m", 1e-6, 1e9, &p.largest_m)) < 0 ||
+        (rc = given = nc_cfg_double(map, "largest_m", 1e-6, 1e9, &p.largest_m)) < 0 ||
         (rc = nc_cfg_double(map, "hurst", 0, 1, &p.hurst)) < 0 ||
         (rc = nc_cfg_double(map, "rocks_rms", 0, 2, &p.rocks_rms)) < 0 || (rc = nc_cfg_seed(map, "seed", &p.seed)) < 0 ||
         dry)
         return rc;
+    if (given && p.largest_m < shortest_m)
+        return nc_cfg_error(nc_cfg_get(map, "largest_m"), "%g m is below the shortest wavelength the mesh carries "
+                            "(twice its mean edge: %.4g m): raise it, or refine the mesh (shape.relief)",
+                            p.largest_m, shortest_m);
     if (p.rocks_rms < 0)
         p.rocks_rms = p.rms;
     double smallest_m = 0;

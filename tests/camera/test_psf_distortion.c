@@ -1,6 +1,6 @@
 /* test_psf_distortion.c - PSF kernels sum to 1 and conserve signal through
  * both the direct and the FFT path; the Airy pattern's first dark ring sits at
- * 1.22 lambda N; a point source lands where the kernel says; Brown-Conrady
+ * 1.22 lambda N and it is cut at its 12th, a circle; a point source lands where the kernel says; Brown-Conrady
  * project/unproject round trip within 1e-3 px; distorted camera rays match
  * the projection. */
 #include <math.h>
@@ -88,6 +88,14 @@ int main(void)
     CHECK(mini == 12, "Airy kernel's first minimum at %d px from the centre, expected 12 (1.22 lambda N = 12.2 px)", mini);
     printf("Airy lambda N = 10 px: kernel %dx%d, first dark ring on pixel %d (1.22 lambda N = 12.2 px)\n", a.size,
            a.size, mini);
+    /* Cut at the 12th dark ring (12.247 lambda N = 122.5 px), a circle: the
+     * kernel reaches pixel 122 along the axes, and its corners (173 px from
+     * the centre) are dark. */
+    CHECK(r == 123 && a.kernel[r * a.size + a.size - 2] > 0 && a.kernel[0] == 0 &&
+              a.kernel[(r - 90) * a.size + r - 90] == 0 && a.kernel[(r - 80) * a.size + r - 80] > 0,
+          "Airy kernel of lambda N = 10 px: half-width %d px (want 123), pixel 122 %g, corner %g, (90, 90) %g, "
+          "(80, 80) %g", r, a.kernel[r * a.size + a.size - 2], a.kernel[0], a.kernel[(r - 90) * a.size + r - 90],
+          a.kernel[(r - 80) * a.size + r - 80]);
 
     /* A user kernel image, asymmetric, through the direct path (5x5). */
     float k[25] = {0};

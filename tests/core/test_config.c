@@ -69,6 +69,19 @@ int main(void)
     expect_error("missing key", "  width_px: 64\n", "", NULL, 0, "camera.width_px", "missing required key");
     expect_error("missing key, misspelt", "  width_px: 64\n", "  widht_px: 64\n", NULL, 0,
                  "camera.width_px: missing required key", "'widht_px' (line 7) is not a key here: a misspelling");
+    expect_error("missing key, cut short", "  width_px: 64\n", "  wid: 64\n", NULL, 0,
+                 "camera.width_px: missing required key", "'wid' (line 7) is not a key here: a misspelling");
+    { /* the key cut short, not a valid key one edit further away */
+        const char *sets[] = {"bodies.0.shape={type: dem, file: x.fits, pixel_m: 1, on_sphere: {radius_m: 1e6, "
+                              "lat: 0, lon_deg: 0}}"};
+        expect_error("missing key beside a valid one", NULL, NULL, sets, 1, "on_sphere.lat_deg: missing required key",
+                     "'lat' is not a key here: a misspelling of it?");
+        const char *one_of[] = {
+            "bodies.0.shape={type: asteroid, radii_m: [280, 230, 200], craters: {saturaton: 0.05}}"};
+        expect_error("none of several keys, one misspelt", NULL, NULL, one_of, 1,
+                     "bodies[0].shape.craters: give one of",
+                     "'saturaton' is not a key here: a misspelling of 'saturation'?");
+    }
     expect_error("out of range", "A: 0.1}", "A: 1.5}", NULL, 0, "test.yaml:3: bodies[0].material.A",
                  "expected a number in [0, 1]");
     expect_error("unknown model", "model: lambert", "model: phong", NULL, 0, "bodies[0].material.model",

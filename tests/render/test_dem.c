@@ -68,6 +68,10 @@ static void check_tile(void)
     CHECK(rad_err < 1e-8 && fabs(lat - 30) < 1e-9 && fabs(lon - 45) < 1e-9, "centre at %g, %g", lat, lon);
     CHECK(fabs(de - sqrt(4 + pow(2 * (h[3 * W + 5] - h[3 * W + 4]), 2))) < 1e-3, "east neighbour %g m away", de);
     nc_mesh_free(&m);
+    /* heights below the sphere's centre are an error, as on a globe */
+    p.height_offset_m = -2 * R_MOON;
+    CHECK(nc_mesh_dem_tile(h, W, H, &p, &m) < 0 && nc_test_contains(nc_errmsg(), "below the sphere's centre"),
+          "a tile below the centre: %s", nc_errmsg());
 }
 
 /* A flat (height 0) tile on the Moon's sphere at 30 N 45 E, seen straight

@@ -1,5 +1,6 @@
 /* test_determinism.c - the same scene gives bit-identical frames for any
- * thread count, for repeated renders, and for a freshly built renderer. */
+ * thread count, for repeated renders, and for a freshly built renderer; a
+ * camera model's margin changes none of the sensor's pixels. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -49,6 +50,37 @@ static void check_cull(struct nc_scene *s, const struct nc_exposure *ex, const c
     nc_frame_free(&b);
     nc_renderer_free(&ra);
     nc_renderer_free(&rb);
+}
+
+/* A camera model's margin (a PSF's) changes no sample of the sensor's
+ * pixels: the same camera drawn m pixels wider on every side gives the
+ * frame's pixels at (x + m, y + m), up to the rounding of the shifted pixel
+ * coordinates (the samples were keyed to the drawn image's pixels once: a
+ * PSF made the limb's pixels differ by up to 38 %). */
+static void check_margin(struct nc_scene *s, const struct nc_frame *ref, const char *what)
+{
+    const int m = 5;
+    struct nc_scene wide = *s;
+    wide.camera.width_px += 2 * m;
+    wide.camera.height_px += 2 * m;
+    wide.camera.cx_px += m;
+    wide.camera.cy_px += m;
+    wide.camera.margin_px = m;
+    struct nc_frame f;
+    nc_test_render(&wide, 2, &f);
+    long differ = 0, far = 0, lit = 0;
+    for (int y = 0; y < ref->height_px; y++)
+        for (int x = 0; x < ref->width_px; x++) {
+            const float a = ref->radiance[y * ref->width_px + x], b = f.radiance[(y + m) * f.width_px + x + m];
+            lit += a > 0;
+            differ += a != b;
+            far += fabsf(a - b) > 1e-5f * fmaxf(a, b);
+        }
+    printf("%s: with a %d-pixel margin, %ld of %ld lit pixels differ (%ld by more than 1e-5)\n", what, m, differ, lit,
+           far);
+    CHECK(lit > 1000 && far == 0 && differ <= lit / 1000, "%s: a margin changed %ld pixels (%ld by more than 1e-5)",
+          what, differ, far);
+    nc_frame_free(&f);
 }
 
 /* The widest angle between two rays of any camera packet, rad. */
@@ -164,6 +196,16 @@ int main(void)
         nc_test_render(&s, threads[k], &f);
         CHECK(same(&ref, &f), "%d threads differ from 1 thread", threads[k]);
         nc_frame_free(&f);
+    }
+    check_margin(&s, &ref, "default scene");
+    {
+        struct nc_scene soft = s;
+        soft.render.soft_shadows = 1;
+        soft.render.bounces = 1;
+        struct nc_frame sref;
+        nc_test_render(&soft, 2, &sref);
+        check_margin(&soft, &sref, "soft shadows, 1 bounce");
+        nc_frame_free(&sref);
     }
     /* One renderer, two frames, the camera moved away and back in between. */
     struct nc_renderer r;

@@ -76,6 +76,26 @@ static void fits_rows(void)
                 for (int x = 0; x < FW; x++)
                     same &= rawdn[(k * FH + y) * FW + x] == dn[(k * FH + (up ? FH - 1 - y : y)) * FW + x];
         CHECK(same, "%s: a plane's rows are not in %s order", name, order[up]);
+        /* An image here is one plane; a row order NavCam cannot tell is an
+         * error, not a guess. */
+        back = NULL;
+        CHECK(nc_image_read(path, &back, &w, &h) < 0 && nc_test_contains(nc_errmsg(), "more than one plane"),
+              "%s: read as an image: %s", name, nc_errmsg());
+        free(back);
+        if (up) {
+            snprintf(name, sizeof name, "sideways.fits");
+            const char *side = nc_test_path(name);
+            CHECK(nc_image_write(side, img, FW, FH, NULL, 0, NULL) == 0, "%s: %s", name, nc_errmsg());
+            status = 0;
+            fits_open_image(&ff, side, READWRITE, &status);
+            fits_update_key_str(ff, "ROWORDER", "SIDEWAYS", NULL, &status);
+            fits_close_file(ff, &status);
+            back = NULL;
+            CHECK(status == 0 && nc_image_read(side, &back, &w, &h) < 0 &&
+                      nc_test_contains(nc_errmsg(), "ROWORDER 'SIDEWAYS': expected 'TOP-DOWN' or 'BOTTOM-UP'"),
+                  "%s: %s", name, nc_errmsg());
+            free(back);
+        }
     }
 }
 
