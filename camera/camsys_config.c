@@ -188,7 +188,8 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
             if (r->kind != NC_CFG_SEQ || r->nchild != 2 || !r->child[0]->value || !r->child[1]->value ||
                 ((a = strtod(r->child[0]->value, &e1)), *e1) || ((f = strtod(r->child[1]->value, &e2)), *e2) ||
                 !(a >= 0 && a < 90) || !(f >= 0 && f <= 10) || (i && a * M_PI / 180 <= o->vig_angle_rad[i - 1]))
-                return nc_cfg_error(r, "expected [field_angle_deg, factor] with increasing angles in 0..90");
+                return nc_cfg_error(r, "expected [field_angle_deg, factor] with increasing angles in 0..90 and a "
+                                       "factor in 0..10");
             r->child[0]->used = r->child[1]->used = 1;
             o->vig_angle_rad[i] = a * M_PI / 180;
             o->vig_factor[i] = f;

@@ -4,7 +4,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -107,93 +106,6 @@ void nc_cfg_where(const struct nc_cfg_node *node, char *buf, size_t len)
         snprintf(buf, len, "%s:%d: %s", origin, node->line, path);
     else
         snprintf(buf, len, "%s: %s", origin, path);
-}
-
-static int vcfg_error(const struct nc_cfg_node *node, const char *key, const char *fmt, va_list ap)
-{
-    char path[256], msg[512];
-    nc_cfg_path(node, path, sizeof path);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    const char *sep = key ? (node->parent ? "." : "") : "";
-    if (key && !node->parent)
-        path[0] = '\0';
-    if (node->line > 0)
-        return nc_error(NC_ECONFIG, "%s:%d: %s%s%s: %s", node->origin, node->line, path, sep, key ? key : "", msg);
-    return nc_error(NC_ECONFIG, "%s: %s%s%s: %s", node->origin ? node->origin : "config", path, sep, key ? key : "", msg);
-}
-
-int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int rc = vcfg_error(node, NULL, fmt, ap);
-    va_end(ap);
-    return rc;
-}
-
-static int cfg_error_key(const struct nc_cfg_node *parent, const char *key, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int rc = vcfg_error(parent, key, fmt, ap);
-    va_end(ap);
-    return rc;
-}
-
-/* The key of map parent that no reader took and that most likely misspells
- * key: key cut short (3 letters or more: 'lat' for 'lat_deg'), else one
- * within a third of key's letters in edits; *score says how close (lower is
- * closer). NULL if none. */
-static const struct nc_cfg_node *typo_of(const struct nc_cfg_node *parent, const char *key, size_t *score)
-{
-    const struct nc_cfg_node *best = NULL;
-    size_t bs = strlen(key) / 3 + 1;
-    for (size_t i = 0; parent && parent->kind == NC_CFG_MAP && i < parent->nchild; i++) {
-        const struct nc_cfg_node *c = parent->child[i];
-        if (c->used || !c->key)
-            continue;
-        const size_t lc = strlen(c->key), sc = lc >= 3 && lc < strlen(key) && !strncmp(key, c->key, lc)
-                                                   ? 0
-                                                   : nc__cfg_edits(c->key, key);
-        if (sc < bs)
-            best = c, bs = sc;
-    }
-    *score = bs;
-    return best;
-}
-
-static int missing(const struct nc_cfg_node *parent, const char *key, const char *msg, const struct nc_cfg_node *c,
-                   const char *meant)
-{
-    if (!c)
-        return key ? cfg_error_key(parent, key, "%s", msg) : nc_cfg_error(parent, "%s", msg);
-    char at[32] = "";
-    if (c->line > 0)
-        snprintf(at, sizeof at, " (line %d)", c->line);
-    return key ? cfg_error_key(parent, key, "%s; '%s'%s is not a key here: a misspelling of it?", msg, c->key, at)
-               : nc_cfg_error(parent, "%s; '%s'%s is not a key here: a misspelling of '%s'?", msg, c->key, at,
-                              meant ? meant : "?");
-}
-
-int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected)
-{
-    char msg[512];
-    size_t score;
-    snprintf(msg, sizeof msg, "missing required key (expected %s)", expected);
-    return missing(parent, key, msg, typo_of(parent, key, &score), key);
-}
-
-int nc_cfg_missing_any(const struct nc_cfg_node *map, const char *const *keys, const char *msg)
-{
-    const struct nc_cfg_node *best = NULL;
-    const char *meant = NULL;
-    size_t bs = (size_t)-1, score;
-    for (int i = 0; keys[i]; i++) {
-        const struct nc_cfg_node *c = typo_of(map, keys[i], &score);
-        if (c && score < bs)
-            best = c, bs = score, meant = keys[i];
-    }
-    return missing(map, NULL, msg, best, meant);
 }
 
 /* ---- loading ---------------------------------------------------------- */

@@ -1,0 +1,203 @@
+/* test_gige_control.c - `navcam serve`'s GigE Vision device and its
+ * clients (test_gige.c's rig): a client killed mid-stream: its stream port
+ * gets packets in the first second and none once its heartbeat ran out (the
+ * device stops the acquisition and closes the stream channel), then a new
+ * client streams and reads GevHeartbeatTimeout; clear errors for a missing
+ * interface, a taken port 3956, an invalid XML (also one named relative to
+ * a configuration file in another directory), a model name too long, a
+ * packet size off its step.
+ * Usage: test_gige_control NAVCAM TMPDIR
+ */
+#include <arpa/inet.h>
+#include <arv.h>
+#include <errno.h>
+#include <signal.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/time.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "gige_rig.h"
+#include "testutil.h"
+
+/* UDP packets arriving at 127.0.0.1:port within seconds. */
+static int packets_at(int port, double seconds)
+{
+    int fd = socket(AF_INET, SOCK_DGRAM, 0), n = 0;
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (fd < 0 || bind(fd, (struct sockaddr *)&sa, sizeof sa) < 0) {
+        CHECK(0, "bind 127.0.0.1:%d: %s", port, strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    struct timeval tv = {0, 100000};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    char buf[9000];
+    for (double t0 = now_s(); now_s() - t0 < seconds;)
+        n += recv(fd, buf, sizeof buf, 0) > 0;
+    close(fd);
+    return n;
+}
+
+static void test_client_killed(void)
+{
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/killed", tmp);
+    const char *extra[] = {"serve.mode=freerun", "outputs=[{driver: gige, pixel_format: Mono16}]"};
+    pid_t pid = serve(dir, extra, 2);
+    int fds[2];
+    CHECK(pipe(fds) == 0, "pipe");
+    pid_t child = fork();
+    if (child == 0) { /* a client that dies mid-stream, its stream's port told first */
+        ArvCamera *c = open_camera();
+        uint8_t *img = malloc((size_t)W * H * 2);
+        struct stream st = {0};
+        if (!c || start(c, &st) < 0 || next_frame(&st, 5, img, NULL) < 0)
+            _exit(1);
+        int port = (int)arv_device_get_integer_feature_value(arv_camera_get_device(c), "GevSCPHostPort", NULL);
+        if (write(fds[1], &port, sizeof port) != sizeof port)
+            _exit(1);
+        kill(getpid(), SIGKILL);
+    }
+    close(fds[1]);
+    int cst = 0, port = 0;
+    const int got_port = read(fds[0], &port, sizeof port) == sizeof port;
+    close(fds[0]);
+    waitpid(child, &cst, 0);
+    double t_kill = now_s();
+    CHECK(WIFSIGNALED(cst) && WTERMSIG(cst) == SIGKILL && got_port && port > 0,
+          "the first client did not stream before it was killed (port %d)", port);
+    /* No one talks to the device now: the stream goes on to the dead
+     * client's port until its 3 s heartbeat runs out, then the device
+     * stops the acquisition and closes the stream channel. */
+    int before = port > 0 ? packets_at(port, 1.0) : -1;
+    while (now_s() - t_kill < 4.0)
+        usleep(50000);
+    int after = port > 0 ? packets_at(port, 2.0) : -1;
+    printf("after a client was killed: %d packets to its port in the first second, %d from 4 to 6 s\n", before,
+           after);
+    CHECK(before > 0 && after == 0, "a killed client's port: %d packets in the first second, %d from 4 to 6 s (want "
+          "some, then none)", before, after);
+    double t0 = now_s();
+    ArvCamera *c = NULL;
+    struct stream st = {0};
+    int ok = 0;
+    uint8_t *img = malloc((size_t)W * H * 2);
+    while (!ok && now_s() - t0 < 12) {
+        c = open_camera();
+        if (c && start(c, &st) == 0 && next_frame(&st, 2, img, NULL) == 0 && next_frame(&st, 2, img, NULL) == 0)
+            ok = 1;
+        if (c && ok) {
+            GError *err = NULL;
+            gint64 hb = arv_device_get_integer_feature_value(arv_camera_get_device(c), "GevHeartbeatTimeout", &err);
+            CHECK(!err && hb == 3000, "GevHeartbeatTimeout %lld ms, want 3000 (%s)", (long long)hb,
+                  err ? err->message : "");
+            g_clear_error(&err);
+        }
+        if (c) {
+            finish(c, &st);
+            g_object_unref(c);
+        }
+        if (!ok)
+            usleep(500000);
+    }
+    printf("then a new client streamed after %.1f s more\n", now_s() - t0);
+    CHECK(ok, "no new client could stream after a client was killed");
+    free(img);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+}
+
+/* navcam serve with extra settings must fail (exit 1) with needle in stderr. */
+static void expect_fail(const char *name, const char *const *extra, int n, const char *needle)
+{
+    char dir[4096], log[4200];
+    snprintf(dir, sizeof dir, "%s/%s", tmp, name);
+    pid_t pid = serve(dir, extra, n);
+    int st = 0;
+    for (double t0 = now_s(); now_s() - t0 < 20 && waitpid(pid, &st, WNOHANG) == 0;)
+        usleep(50000);
+    if (kill(pid, 0) == 0) {
+        stop(pid);
+        st = 0;
+    }
+    snprintf(log, sizeof log, "%s/serve.log", dir);
+    size_t got;
+    char *text = nc_test_read(log, &got);
+    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 1 && text && strstr(text, needle), "%s: exit %d, stderr '%s', want '%s'",
+          name, WIFEXITED(st) ? WEXITSTATUS(st) : -1, text ? text : "", needle);
+    printf("%s: %s", name, text ? text : "");
+    free(text);
+}
+
+static void test_errors(void)
+{
+    const char *noif[] = {"outputs=[{driver: gige, interface: nosuch0}]"};
+    expect_fail("no_interface", noif, 1, "network interface 'nosuch0' not found");
+    char xml[4200], set[4300];
+    snprintf(xml, sizeof xml, "%s/bad.xml", tmp);
+    nc_test_write(xml, "<RegisterDescription><Integer Name=\"Width\"></RegisterDescription>");
+    snprintf(set, sizeof set, "outputs=[{driver: gige, xml: %s}]", xml);
+    const char *badxml[] = {set};
+    expect_fail("bad_xml", badxml, 1, "GenICam XML");
+    const char *model[] = {"outputs=[{driver: gige, model: A model name longer than thirty-one characters}]"};
+    expect_fail("long_model", model, 1, "outputs[0].model: expected at most 31 characters");
+    const char *packet[] = {"outputs=[{driver: gige, packet_size: 8190}]"};
+    expect_fail("packet_step", packet, 1, "outputs[0].packet_size: expected a multiple of 4");
+    /* An xml path relative to the configuration file, whose directory is
+     * not the one serve runs in. */
+    char cfgdir[4200], cfg[4300], rel[4300], log[4300];
+    snprintf(cfgdir, sizeof cfgdir, "%s/xmlrel", tmp);
+    mkdir(cfgdir, 0777);
+    snprintf(cfg, sizeof cfg, "%s/c.yaml", cfgdir);
+    snprintf(rel, sizeof rel, "%s/rel.xml", cfgdir);
+    nc_test_write(cfg, "base: builtin:default\noutputs:\n  - driver: gige\n    xml: rel.xml\n");
+    nc_test_write(rel, "<RegisterDescription></RegisterDescription>");
+    const char *argv[] = {navcam, "serve", cfg, "--max-seconds", "20", NULL};
+    snprintf(log, sizeof log, "%s/run", cfgdir);
+    int st = 0;
+    waitpid(nc_test_spawn(log, argv), &st, 0);
+    snprintf(log, sizeof log, "%s/run/serve.log", cfgdir);
+    size_t got;
+    char *text = nc_test_read(log, &got);
+    CHECK(text && strstr(text, rel) && strstr(text, "is invalid"), "xml relative to %s: '%s'", cfg, text ? text : "");
+    free(text);
+    /* Port 3956 taken by a first camera. */
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/first", tmp);
+    const char *gige[] = {"outputs=[{driver: gige}]"};
+    pid_t first = serve(dir, gige, 1);
+    ArvCamera *c = open_camera();
+    CHECK(c != NULL, "first camera");
+    if (c)
+        g_object_unref(c);
+    expect_fail("port_taken", gige, 1, "UDP port 3956 (GigE Vision control) on 127.0.0.1 (lo) is already in use");
+    CHECK(stop(first) == 0, "first serve did not exit cleanly");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 3) {
+        fprintf(stderr, "usage: test_gige_control NAVCAM TMPDIR\n");
+        return 2;
+    }
+    static char exe[4096], dir[4096];
+    mkdir(argv[2], 0777);
+    if (!realpath(argv[1], exe) || !realpath(argv[2], dir)) {
+        fprintf(stderr, "test_gige_control: %s or %s: %s\n", argv[1], argv[2], strerror(errno));
+        return 2;
+    }
+    navcam = exe; /* serve runs in its own directory */
+    tmp = dir;
+    signal(SIGPIPE, SIG_IGN);
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    test_client_killed();
+    test_errors();
+    return nc_test_end();
+}
