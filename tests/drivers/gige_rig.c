@@ -21,6 +21,25 @@
 const char *navcam, *tmp;
 unsigned long incomplete; /* buffers that arrived with missing packets */
 
+int rig_args(int argc, char **argv, const char *prog)
+{
+    static char exe[4096], dir[4096];
+    if (argc != 3) {
+        fprintf(stderr, "usage: %s NAVCAM TMPDIR\n", prog);
+        return -1;
+    }
+    mkdir(argv[2], 0777);
+    if (!realpath(argv[1], exe) || !realpath(argv[2], dir)) {
+        fprintf(stderr, "%s: %s or %s: %s\n", prog, argv[1], argv[2], strerror(errno));
+        return -1;
+    }
+    navcam = exe;
+    tmp = dir;
+    signal(SIGPIPE, SIG_IGN);
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    return 0;
+}
+
 double now_s(void)
 {
     struct timespec ts;

@@ -23,6 +23,10 @@ struct stream {
     size_t payload;
 };
 
+/* The tests' command line, NAVCAM TMPDIR, into navcam and tmp (absolute
+ * paths: serve runs in its own directory); SIGPIPE ignored, stdout line
+ * buffered. Returns 0, or -1 after a usage message. */
+int rig_args(int argc, char **argv, const char *prog);
 double now_s(void);
 /* Start `navcam serve` in dir with the common small, noise-free scene plus
  * extra --set arguments; stderr goes to dir/serve.log. */

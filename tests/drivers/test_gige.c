@@ -408,20 +408,8 @@ static void test_line0(void)
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        fprintf(stderr, "usage: test_gige NAVCAM TMPDIR\n");
+    if (rig_args(argc, argv, "test_gige") < 0)
         return 2;
-    }
-    static char exe[4096], dir[4096];
-    mkdir(argv[2], 0777);
-    if (!realpath(argv[1], exe) || !realpath(argv[2], dir)) {
-        fprintf(stderr, "test_gige: %s or %s: %s\n", argv[1], argv[2], strerror(errno));
-        return 2;
-    }
-    navcam = exe; /* serve runs in its own directory */
-    tmp = dir;
-    signal(SIGPIPE, SIG_IGN);
-    setvbuf(stdout, NULL, _IOLBF, 0);
     test_pixels();
     test_exposure_gain();
     test_next_exposure();
