@@ -339,6 +339,14 @@ int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top)
     return rc < 0 ? nc_error(rc, "out of memory") : 0;
 }
 
+/* YAML's null, which --set takes as "leave this key out". */
+static int is_null(const struct nc_cfg_node *v)
+{
+    return v->kind == NC_CFG_SCALAR && v->value &&
+           (!strcmp(v->value, "null") || !strcmp(v->value, "Null") || !strcmp(v->value, "NULL") ||
+            !strcmp(v->value, "~"));
+}
+
 int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)
 {
     char origin_buf[300];
@@ -401,6 +409,17 @@ int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)
         } else {
             node_free(value);
             return nc_error(NC_EUSAGE, "%s: cannot descend into '%s': its parent is a single value", origin, tok);
+        }
+        if (!next && is_null(value)) { /* KEY=null: the key (or list item) taken out */
+            node_free(value);
+            if (child) {
+                for (size_t i = 0, k = 0; i < cur->nchild; i++)
+                    if (cur->child[i] != child)
+                        cur->child[k++] = cur->child[i];
+                cur->nchild--;
+                node_free(child);
+            }
+            return 0;
         }
         if (!next) {
             if (child) {
