@@ -299,7 +299,7 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
     snprintf(rowtxt, sizeof rowtxt, "%ld", i);
     const struct nc_image_attr extra[] = {{"navcam:batch_row", rowtxt}};
     int rc;
-    if ((rc = nc_shot(r, &s, cs, sky, q, exposure, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
+    if ((rc = nc_shot(r, &s, cs, sky, q, exposure, row->t_s, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
         (rc = nc_commit_file(tmp, path)) < 0)
         return rc;
     int nrocks = -1, ncraters = -1;
@@ -390,6 +390,12 @@ int main(int argc, char **argv)
     if (argc - optind != 1 || !dir) {
         fprintf(stderr, "navcam batch: %s\nTry 'navcam batch --help'.\n",
                 !dir ? "missing -o DIR" : "give one trajectory (TRAJ.csv or builtin:approach)");
+        goto usage;
+    }
+    char dotext[16];
+    snprintf(dotext, sizeof dotext, "x.%s", ext);
+    if (nc_quantity_format_check(q, dotext) < 0) {
+        fprintf(stderr, "navcam batch: --format %s: %s\n", ext, nc_errmsg());
         goto usage;
     }
     struct nc_traj_row *rows = NULL;

@@ -37,7 +37,8 @@ static const char render_help[] =
     "                         range      distance camera-surface, m (0 = sky)\n"
     "                         rock_id    the boulder each pixel shows: its index in\n"
     "                                    its body's list (exact in float32 files up\n"
-    "                                    to 2^24), -1 for ground or sky\n"
+    "                                    to 2^24), -1 for ground or sky; FITS, TIFF\n"
+    "                                    or EXR (not PNG)\n"
     "                         electrons  noise-free photo-electrons through the optics\n"
     "                                    and PSF: the ground truth of a DN frame\n"
     "                         dn         the digitised frame: noise, full well, gain,\n"
@@ -45,10 +46,12 @@ static const char render_help[] =
     "  -e, --exposure T       exposure time in seconds (default: exposure.time_s)\n"
     "  -f, --frame N          frame number: keys the noise (default 0)\n"
     "  -s, --set KEY=VALUE    override any configuration key by its dotted path;\n"
-    "                         VALUE is YAML. Repeatable. Lists index by number:\n"
-    "                           --set camera.position_m=[0,0,-5000]\n"
+    "                         VALUE is YAML. Repeatable. Lists index by number;\n"
+    "                         KEY=null takes a key out:\n"
+    "                           --set camera.position_m=[0,-3000,0]\n"
     "                           --set bodies.0.material.w=0.07\n"
     "                           --set render.samples_per_pixel=16\n"
+    "                           --set optics.f_number=null --set optics.aperture_diameter_m=0.01\n"
     "  -j, --threads N        render threads (default: render.threads, else all\n"
     "                         cores); the image does not depend on N\n"
     "      --sumfile X.SUM    the camera and pose of an SPC SUM file: replaces the\n"
@@ -150,6 +153,11 @@ int main(int argc, char **argv)
         free(sets);
         return 2;
     }
+    if (nc_quantity_format_check(q, out) < 0) {
+        fprintf(stderr, "navcam render: %s: %s\n", out, nc_errmsg());
+        free(sets);
+        return 2;
+    }
     if (rows && (!nc_image_is_fits(out) || nc_image_fits_row_order_ok(rows) < 0)) {
         fprintf(stderr, "navcam render: --fits-rows: %s\n",
                 !nc_image_is_fits(out) ? "applies to .fits output only" : nc_errmsg());
@@ -193,7 +201,7 @@ int main(int argc, char **argv)
     }
     struct nc_shot_info info;
     const struct nc_image_attr *extra = rows ? &row_attr : NULL;
-    rc = nc_shot(&r, &scene, &cs, &sky, q, exposure, frame_no, out, extra, rows ? 1 : 0, &info);
+    rc = nc_shot(&r, &scene, &cs, &sky, q, exposure, 0, frame_no, out, extra, rows ? 1 : 0, &info);
     double t2 = t1 + info.render_ms + info.stars_ms, scale = info.preview_scale;
     const int tsamples = info.time_samples;
     const char *chosen = info.quality, *sunwarn = info.sun_warning;

@@ -28,6 +28,7 @@ static const char main_help[] =
     "  brdf --model NAME ...        evaluate a reflectance model (CSV in, CSV out)\n"
     "  bench accuracy [-o DIR]      error against time of the render methods (CSV, chart)\n"
     "  stars index STARS.DAT -o IX  NavCam's star index from a catalogue (stars in frames)\n"
+    "  stars info IX                an index's stars by magnitude, and its load time\n"
     "  compare REAL RENDER          a real image against a render: errors, NCC, limb IoU, shift\n"
     "  texture IMAGE...             texture statistics: FAST corners, spectrum slope, gradients\n"
     "  batch TRAJ.csv -o DIR        render a trajectory to a dataset (resumable, shardable)\n"

@@ -119,7 +119,7 @@ static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc
 }
 
 int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsys *cs, struct nc_sky *sky,
-            enum nc_quantity q, double exposure, uint64_t frame_no, const char *out,
+            enum nc_quantity q, double exposure, double t_sim_s, uint64_t frame_no, const char *out,
             const struct nc_image_attr *extra_in, int nextra_in, struct nc_shot_info *info)
 {
     memset(info, 0, sizeof *info);
@@ -157,7 +157,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     /* Stars (the `stars` section), drawn before the camera model's PSF. */
     char starinfo[120] = "";
     double ts0 = now_ms();
-    if (rc >= 0 && sky->on && (rc = nc_sky_draw(sky, r, cs, &drawn, 0, exposure, &f, &info->stars)) >= 0)
+    if (rc >= 0 && sky->on && (rc = nc_sky_draw(sky, r, cs, &drawn, t_sim_s, exposure, &f, &info->stars)) >= 0)
         snprintf(starinfo, sizeof starinfo, "limit_mag=%.2f drawn=%ld hidden=%ld", info->stars.limit_mag,
                  info->stars.drawn, info->stars.hidden);
     /* The Sun: drawn when its disk reaches the frame; a warning in or near it. */

@@ -36,10 +36,11 @@ int nc_shot_setup(const char *path, const char *const *sets, int nsets, struct n
 void nc_frame_flip(struct nc_frame *f, int rows, int cols);
 
 /* Render scene (its quality settings may be changed by render.quality auto:
- * they are recorded in the file) to path as quantity q; sky may be off.
- * extra attributes go into the file too. */
+ * they are recorded in the file) to path as quantity q; sky may be off (on,
+ * its stars move by their proper motion to t_sim_s after simulation time
+ * 0). extra attributes go into the file too. */
 int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsys *cs, struct nc_sky *sky,
-            enum nc_quantity q, double exposure_s, uint64_t frame_no, const char *path,
+            enum nc_quantity q, double exposure_s, double t_sim_s, uint64_t frame_no, const char *path,
             const struct nc_image_attr *extra, int nextra, struct nc_shot_info *info);
 
 /* The geometry planes (render.h, enum nc_geom_plane) of scene at pixel

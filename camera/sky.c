@@ -107,9 +107,16 @@ int nc_sky_prepare(struct nc_sky *sky, const struct nc_camsys *cs, const struct 
     const double hc = NC_PLANCK_J_S * NC_LIGHT_M_S, f_m = geom->fx_px * cs->sensor.pixel_pitch_m;
     const double area = M_PI * f_m * f_m / (4 * o->f_number * o->f_number);
     sky->aperture_m2 = area;
-    sky->g_max_m = 0;
-    for (int k = 0; k < NC_STAR_TEMPS; k++)
-        sky->g_max_m = fmax(sky->g_max_m, o->star_g_m[k]);
+    /* over the colours stars are drawn with (B-V clamped to -0.4..2.0):
+     * band_g is linear between the table's rows, so its largest value on
+     * that range is at an end or at a row within it */
+    const double t_red = nc_star_teff_k(2.0), t_blue = nc_star_teff_k(-0.4);
+    sky->g_max_m = fmax(band_g(o, t_red), band_g(o, t_blue));
+    for (int k = 0; k < NC_STAR_TEMPS; k++) {
+        const double t_k = NC_STAR_T_MIN * pow(NC_STAR_T_MAX / NC_STAR_T_MIN, (double)k / (NC_STAR_TEMPS - 1));
+        if (t_k > t_red && t_k < t_blue)
+            sky->g_max_m = fmax(sky->g_max_m, o->star_g_m[k]);
+    }
     for (size_t i = 0; i < n; i++) {
         const double ph = nc_star_band_photons(o, sky->cat.star[i].v_mag, sky->cat.star[i].b_v);
         sky->e_w_m2[i] = ph * hc / o->wavelength_m / o->band_fraction;
@@ -124,7 +131,8 @@ double nc_sky_limit_mag(const struct nc_sky *sky, const struct nc_camsys *cs, do
         return sky->limit_mag;
     const struct nc_sensor *sn = &cs->sensor;
     const double e0 = V0_PHOTONS_S_M2_M * sky->g_max_m * sky->aperture_m2 * cs->optics.transmission * sn->qe * exposure_s;
-    const double noise = sqrt(sn->read_noise_e * sn->read_noise_e + sn->dark_current_e_s * exposure_s);
+    const double dark_e_s = sn->dark_current_e_s * exp2((sn->temperature_k - sn->dark_ref_temp_k) / sn->dark_doubling_k);
+    const double noise = sqrt(sn->read_noise_e * sn->read_noise_e + dark_e_s * exposure_s);
     const double thr = fmax(0.1 * noise, 0.05 / nc_camsys_dn_per_e(cs));
     return e0 > 0 ? 2.5 * log10(e0 / thr) : -30;
 }

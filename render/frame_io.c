@@ -28,6 +28,15 @@ int nc_quantity_parse(const char *name, enum nc_quantity *q)
     return nc_error(NC_EUSAGE, "unknown quantity '%s' (expected radiance, iof, range, rock_id, electrons or dn)", name);
 }
 
+int nc_quantity_format_check(enum nc_quantity q, const char *path)
+{
+    int is_float = 1;
+    if (q == NC_Q_ROCK_ID && nc_image_format_ok(path, &is_float) && !is_float)
+        return nc_error(NC_EUSAGE, "rock_id needs FITS, TIFF or EXR: a PNG holds no -1 (ground, sky, no rock), "
+                                   "nor every index exactly");
+    return 0;
+}
+
 int nc_frame_meta(const struct nc_scene *s, enum nc_quantity q, struct nc_image_attr *attrs, char (*v)[200], int max)
 {
     const struct nc_camera *c = &s->camera;

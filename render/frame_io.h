@@ -17,6 +17,9 @@ enum nc_quantity { NC_Q_RADIANCE, NC_Q_IOF, NC_Q_RANGE, NC_Q_ROCK_ID, NC_Q_ELECT
 extern const char *const nc_quantity_names[]; /* NULL-terminated, enum order */
 const char *nc_quantity_units(enum nc_quantity q);
 int nc_quantity_parse(const char *name, enum nc_quantity *q);
+/* Whether a file at path (its extension) can hold quantity q: rock_id
+ * needs a float format (a PNG's 16 unsigned bits hold no -1). */
+int nc_quantity_format_check(enum nc_quantity q, const char *path);
 
 /* The scene's metadata (pose, Sun, intrinsics, version, quantity and units):
  * fills attrs (up to max, each value stored in text[i]) and returns the count. */

@@ -124,6 +124,49 @@ assert d['relative_error']['p95'] < 0.02 and d['limb_iou'] > 0.99, d
 print('SUM-like rows, body moved: p95 %.4f, IoU %.4f' % (d['relative_error']['p95'], d['limb_iou']))" ||
   fail "SUM-like rows with bodies[0] moved and turned: the camera did not move with it"
 
+# Stars move with the row's time: proper motion to epoch_jyear + t_s. Sirius
+# (-546.0, -1223.1 mas/yr) 100 years on is 133.9 arcsec away: 13.39 px of
+# 10 arcsec, the camera still.
+printf '064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1            , alp CMa, Sirius\n' > stars.dat
+"$navcam" stars index stars.dat -o stars.ncs > /dev/null || fail "stars index"
+python3 - <<'PY'
+import math
+a, d = math.radians(101.287166667), math.radians(-16.716111111)
+z = [math.cos(d) * math.cos(a), math.cos(d) * math.sin(a), math.sin(d)]
+x = [z[1], -z[0], 0.0]; n = math.hypot(x[0], x[1]); x = [v / n for v in x]
+y = [z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]]
+m = [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]]
+w = math.sqrt(1 + m[0][0] + m[1][1] + m[2][2]) / 2
+q = (w, (m[2][1] - m[1][2]) / (4 * w), (m[0][2] - m[2][0]) / (4 * w), (m[1][0] - m[0][1]) / (4 * w))
+with open("sirius.csv", "w") as f:
+    for t in (0, 100 * 365.25 * 86400):
+        f.write("%d,1e7,0,0,%.15f,%.15f,%.15f,%.15f,1,0,0\n" % ((t,) + q))
+PY
+"$navcam" batch sirius.csv -o sirius -q electrons -e 0.01 --no-geometry --set 'stars={catalogue: stars.ncs}' \
+  --set camera.width_px=64 --set camera.height_px=64 --set camera.fx_px=20626.5 --set camera.fy_px=20626.5 \
+  --set camera.cx_px=31.5 --set camera.cy_px=31.5 --set camera.focal_length_m=null --set camera.pixel_pitch_m=null \
+  --set sensor.pixel_pitch_m=5.5e-6 --set 'optics.psf={type: none}' > /dev/null 2>&1 || fail "batch with stars"
+python3 - <<'PY' || fail "stars in navcam batch did not move with the row's time"
+import math, struct
+def centroid(path):
+    b = open(path, "rb").read()
+    i = 0; h = {}
+    while True:
+        c = b[i:i + 80].decode(); i += 80
+        if c[8:10] == "= ": h[c[:8].strip()] = c[10:].split("/")[0].strip()
+        if c.startswith("END "): break
+    i = (i + 2879) // 2880 * 2880
+    w, n = int(h["NAXIS1"]), int(h["NAXIS2"])
+    v = struct.unpack(">%df" % (w * n), b[i:i + 4 * w * n])
+    s = sum(v); sx = sum((k % w) * e for k, e in enumerate(v)); sy = sum((k // w) * e for k, e in enumerate(v))
+    return s, sx / s, sy / s
+s0, x0, y0 = centroid("sirius/frame_000000.fits")
+s1, x1, y1 = centroid("sirius/frame_000001.fits")
+moved = math.hypot(x1 - x0, y1 - y0)
+print("stars in batch: Sirius moved %.3f px in 100 years (13.39 expected)" % moved)
+assert s0 > 0 and abs(s1 / s0 - 1) < 1e-3 and abs(moved - 13.39) < 0.05, (s0, s1, moved)
+PY
+
 # Errors: bad shard, bad row.
 "$navcam" batch traj.csv -o x --shard 3/3 2> err.txt && fail "--shard 3/3 accepted"
 grep -q "0 <= K < N" err.txt || fail "shard error: $(cat err.txt)"

@@ -118,6 +118,8 @@ expect 2 "--sun 0,0,0: a zero vector" -- "$navcam" pose send -P 0,-6000,0 -S 0,0
 expect 2 "--exposure -1: not within 0 to 3600 s" -- "$navcam" pose send -P 0,-6000,0 -e -1
 expect 2 "--port 99999: not a port" -- "$navcam" pose send -P 0,-6000,0 -p 99999
 expect 2 "unsupported output format" -- "$navcam" render -o "$tmp/x.bmp"
+expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" render -q rock_id -o "$tmp/x.png"
+expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" batch builtin:approach -o "$tmp/rocks" -q rock_id -F png
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
 expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 0
 expect 0 "bodies:" -- "$navcam" scene

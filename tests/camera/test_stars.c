@@ -217,6 +217,37 @@ int main(void)
     free(e1);
     free(e4);
 
+    /* 5b. limit_mag auto, by its definition: the faintest V whose star of
+     * the most favourable colour (B-V within -0.4..2.0) gives 0.1 of the
+     * noise of read noise and the dark current at the sensor's temperature
+     * over the exposure. */
+    for (int k = 0; k < 2; k++) {
+        const double temp_k = k ? 303.15 : 273.15;
+        char tset[64];
+        snprintf(tset, sizeof tset, "sensor.temperature_k=%.17g", temp_k);
+        const char *sets[] = {"sensor.read_noise_e=4", "sensor.dark_current_e_s=20", "sensor.dark_ref_temp_k=293.15",
+                              "sensor.dark_doubling_k=6", tset, "stars.limit_mag=auto", "sensor.gain_e_per_dn=1"};
+        const char *path = nc_test_path("scene.yaml"); /* the last shot's */
+        struct nc_scene sc;
+        struct nc_camsys cs;
+        struct nc_sky sky;
+        CHECK(nc_setup_load(path, sets, 7, &sc, &cs) >= 0 && nc_sky_load(path, sets, 7, &sky) >= 0 &&
+                  nc_sky_prepare(&sky, &cs, &sc.camera) >= 0,
+              "limit_mag auto: %s", nc_errmsg());
+        double best = 0;
+        for (int i = 0; i <= 24000; i++)
+            best = fmax(best, nc_star_band_photons(&cs.optics, 0, -0.4 + 1e-4 * i));
+        const double f_m = sc.camera.fx_px * cs.sensor.pixel_pitch_m, t = 0.5;
+        const double e0 = best * M_PI * f_m * f_m / (4 * 8.0 * 8.0) * 0.9 * 0.6 * t;
+        const double noise = sqrt(16 + 20 * exp2((temp_k - 293.15) / 6) * t);
+        const double lim = 2.5 * log10(e0 / (0.1 * noise)), got = nc_sky_limit_mag(&sky, &cs, t);
+        printf("limit_mag auto at %.2f K, 0.5 s: V %.4f (the definition: %.4f)\n", temp_k, got, lim);
+        CHECK(fabs(got - lim) < 0.002, "limit_mag auto at %.2f K: %.4f, the definition gives %.4f", temp_k, got, lim);
+        nc_sky_free(&sky);
+        nc_camsys_free(&cs);
+        nc_scene_free(&sc);
+    }
+
     /* 6. The Sun, 1 deg off the boresight of a 3.7 deg field (its disk
      * about 9 px in radius), then 5 and 30 deg off, then behind a body. */
     const double offs[] = {1, 5, 30, 1};
