@@ -232,6 +232,8 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
     fprintf(f, "\"width_px\": %d, \"height_px\": %d, ", c->width_px, c->height_px);
     v[0] = c->fx_px, v[1] = c->fy_px, v[2] = c->cx_px, v[3] = c->cy_px;
     json_vec(f, "fx_fy_cx_cy_px", v, 4, ", ");
+    const double k[5] = {c->k1, c->k2, c->k3, c->p1, c->p2}; /* Brown-Conrady, OpenCV's order; 0 without */
+    json_vec(f, "distortion_k1_k2_k3_p1_p2", k, 5, ", ");
     fprintf(f, "\"mirrored_rows\": %d, \"mirrored_columns\": %d},\n", c->flip_rows, c->flip_cols);
     struct nc_vec3 sd;
     double irr;
@@ -252,10 +254,14 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
         json_vec(f, "attitude_q", v, 4, "}");
         fprintf(f, "%s", b + 1 < s->nbodies ? ", " : "],\n");
     }
-    fprintf(f, " \"render\": {\"samples_per_pixel\": %d, \"seed\": %llu, \"bounces\": %d, \"soft_shadows\": %d, "
-               "\"quality\": \"%s\"}}\n",
-            s->render.samples_per_pixel, (unsigned long long)s->render.seed, s->render.bounces, s->render.soft_shadows,
-            quality[0] ? quality : "manual");
+    /* the keys and types of the emulator's frame records (docs/emulator.md) */
+    fprintf(f, " \"render\": {\"quality\": \"%s\", \"samples_per_pixel\": %d, \"bounces\": %d, \"soft_shadows\": %s, "
+               "\"seed\": %llu",
+            quality[0] ? "auto" : "manual", s->render.samples_per_pixel, s->render.bounces,
+            s->render.soft_shadows ? "true" : "false", (unsigned long long)s->render.seed);
+    if (quality[0])
+        fprintf(f, ", \"quality_choice\": \"%s\"", quality);
+    fprintf(f, "}}\n");
     return commit(f, 0, tmp, dir, name);
 }
 

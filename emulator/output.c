@@ -88,6 +88,8 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
                  r->sun_in_field ? "sun in field" : "sun near field", r->sun_off_axis_deg, r->sun_edge_deg,
                  r->sun_hidden ? "true" : "false");
     }
+    /* the Sun as the frame used it: a direction is made a unit vector */
+    const struct nc_vec3 sun = p->sun_is_position ? p->sun : nc_v3_unit(p->sun);
     int n = snprintf(
         buf, len,
         "{\"frame\": %llu, \"request_sequence\": %u, \"trigger_source\": \"%s\", "
@@ -104,7 +106,7 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
         (long long)r->exposure_start_sim_ns, (long long)r->exposure_end_sim_ns, mono, (long long)p->t_ns,
         quality_names[r->pose_quality], (long long)r->pose_gap_ns, p->cam_position_m.x, p->cam_position_m.y,
         p->cam_position_m.z, p->cam_attitude_q.w, p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z,
-        p->sun.x, p->sun.y, p->sun.z, p->sun_is_position ? "true" : "false", p->has_body ? "true" : "false",
+        sun.x, sun.y, sun.z, p->sun_is_position ? "true" : "false", p->has_body ? "true" : "false",
         p->body_position_m.x, p->body_position_m.y, p->body_position_m.z, p->body_attitude_q.w, p->body_attitude_q.x,
         p->body_attitude_q.y, p->body_attitude_q.z, r->exposure_s, r->gain_db, r->time_samples, r->lod_error_m, r->boulder_min_m,
         r->boulder_mesh_px, r->rock_fold_theta_bar_deg, r->quality_auto ? "auto" : "manual", r->samples_per_pixel, r->bounces,

@@ -29,7 +29,7 @@ static const char *const fits_keys[][2] = {
     {"Software", "CREATOR"},
     {"navcam:version", "NCVERSN"},
     {"navcam:quantity", "QUANTITY"},
-    {"navcam:units", "BUNIT"},
+    {"navcam:units", "NCUNITS"}, /* and BUNIT, in FITS units (fits_unit) */
     {"navcam:camera_position_m", "CAMPOS"},
     {"navcam:camera_attitude_q", "CAMQUAT"},
     {"navcam:quaternion_convention", "QCONVENT"},
@@ -62,6 +62,14 @@ static const char *const fits_keys[][2] = {
     {"navcam:stars", "STARS"},
     {"navcam:sun_view", "SUNVIEW"},
 };
+
+/* NavCam's units (nc_quantity_units) as FITS units (FITS 4.0, 4.3) that
+ * unit parsers take: electrons and DN by the names astropy reads, the
+ * dimensionless quantities (I/F, a rock's index) as none. */
+static const char *fits_unit(const char *u)
+{
+    return !strcmp(u, "e-") ? "electron" : !strcmp(u, "DN") ? "adu" : !strncmp(u, "1 (", 3) ? "" : u;
+}
 
 /* 1 when attrs ask for the archive row order (row 1 at the bottom). */
 static int bottom_up(const struct nc_image_attr *attrs, int nattrs)
@@ -132,6 +140,9 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
         fits_key(attrs[i].name, key, sizeof key);
         if (!strcmp(attrs[i].name, "navcam:fits_row_order"))
             continue; /* written below, in the keyword's own spelling */
+        if (!strcmp(attrs[i].name, "navcam:units"))
+            fits_write_key_str(f, "BUNIT", fits_unit(attrs[i].value), "physical unit of the data (NCUNITS: NavCam's)",
+                               &status);
         /* Numbers as FITS numbers (EXPTIME, ADCBITS, ...), the rest as strings. */
         double v = strtod(attrs[i].value, &end);
         if (up && !strcmp(key, "CRPIX2")) /* the WCS of top-down rows, turned: FITS row p2 becomes h + 1 - p2 */
@@ -151,7 +162,11 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
     fits_write_comment(f, up ? "Row 1 is the bottom image row (y = height - 1): +Y up, as FITS viewers show it."
                              : "Row 1 is the top image row (y = 0, +Y down).",
                        &status);
-    fits_write_comment(f, "Pixel coordinates in the NavCam keywords (INTRINS) run from the top row down.", &status);
+    for (int i = 0; i < nattrs; i++)
+        if (!strcmp(attrs[i].name, "navcam:intrinsics_fx_fy_cx_cy_px")) {
+            fits_write_comment(f, "Pixel coordinates in INTRINS run from the top row down.", &status);
+            break;
+        }
     fits_write_comment(f, "Each NavCam metadata card carries its attribute name as its comment.", &status);
     if (status || fits_write_img(f, dtype, 1, (LONGLONG)w * h * depth, flipped ? flipped : (void *)px, &status))
         goto fail;

@@ -293,23 +293,24 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
 
 /* ---- the Sun ------------------------------------------------------------------- */
 
-/* Angle from the boresight of the frame's edge along image direction (ux, uy). */
-static double edge_angle(const struct nc_camera *c, double ux, double uy)
+/* Angle from the boresight of the edge of the frame less m pixels on every
+ * side along image direction (ux, uy). */
+static double edge_angle(const struct nc_camera *c, int m, double ux, double uy)
 {
-    const double cx = c->cx_px, cy = c->cy_px, n = hypot(ux, uy);
+    const double cx = c->cx_px - m, cy = c->cy_px - m, n = hypot(ux, uy);
     if (!(n > 0))
         return 0;
     ux /= n, uy /= n;
     double t = INFINITY; /* from the principal point to the border */
     if (ux > 0)
-        t = fmin(t, (c->width_px - 0.5 - cx) / ux);
+        t = fmin(t, (c->width_px - 2 * m - 0.5 - cx) / ux);
     if (ux < 0)
         t = fmin(t, (-0.5 - cx) / ux);
     if (uy > 0)
-        t = fmin(t, (c->height_px - 0.5 - cy) / uy);
+        t = fmin(t, (c->height_px - 2 * m - 0.5 - cy) / uy);
     if (uy < 0)
         t = fmin(t, (-0.5 - cy) / uy);
-    const struct nc_vec3 d = nc_v3_unit(nc_camera_dir(c, cx + t * ux, cy + t * uy));
+    const struct nc_vec3 d = nc_v3_unit(nc_camera_dir(c, cx + m + t * ux, cy + m + t * uy));
     return acos(fmin(1, d.z));
 }
 
@@ -326,17 +327,22 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
     const double off = acos(fmax(-1, fmin(1, d.z)));
     v->off_axis_deg = off * 180 / M_PI;
     /* the field's edge along the Sun's azimuth (behind the camera: the
-     * widest half-angle) */
-    double half = 0;
-    if (d.x != 0 || d.y != 0)
-        half = edge_angle(c, d.x * c->fx_px, d.y * c->fy_px);
-    if (d.z <= 0 || !(half > 0))
-        for (int k = 0; k < 4; k++)
-            half = fmax(half, edge_angle(c, k & 1 ? 1 : -1, k & 2 ? 1 : -1));
-    v->edge_deg = (off - theta - half) * 180 / M_PI;
+     * widest half-angle): the sensor's, for what is reported, and the drawn
+     * image's with the camera model's margin, for what is drawn (the PSF
+     * spreads a disk in the margin into the edge pixels) */
+    double half[2] = {0, 0};
+    for (int w = 0; w < 2; w++) {
+        const int m = w ? 0 : c->margin_px;
+        if (d.x != 0 || d.y != 0)
+            half[w] = edge_angle(c, m, d.x * c->fx_px, d.y * c->fy_px);
+        if (d.z <= 0 || !(half[w] > 0))
+            for (int k = 0; k < 4; k++)
+                half[w] = fmax(half[w], edge_angle(c, m, k & 1 ? 1 : -1, k & 2 ? 1 : -1));
+    }
+    v->edge_deg = (off - theta - half[0]) * 180 / M_PI;
     v->in_field = v->edge_deg < 0;
     v->near_field = !v->in_field && v->edge_deg < near_deg;
-    if (!v->in_field)
+    if (!(off - theta - half[1] < 0))
         return 0;
     /* The disk's pixels: around its projected centre, or the whole frame
      * when the centre does not project (a disk wider than the field). */
