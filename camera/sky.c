@@ -62,6 +62,7 @@ int nc_sky_from_config(struct nc_cfg *cfg, struct nc_sky *sky)
         return nc_cfg_error(nc_cfg_get(m, "observer_velocity_m_s"), "expected a speed below 1 %% of light's");
     if ((rc = nc_cfg_check_unused_in(cfg, m)) < 0) /* its one reader: a typo is not a default */
         return rc;
+    nc_cfg_where(m, sky->where, sizeof sky->where);
     if ((rc = nc_star_cat_load(sky->path, &sky->cat)) < 0) {
         char why[512];
         snprintf(why, sizeof why, "%s", nc_errmsg());
@@ -87,11 +88,11 @@ int nc_sky_prepare(struct nc_sky *sky, const struct nc_camsys *cs, const struct 
         return 0;
     const struct nc_optics *o = &cs->optics;
     if (!o->star_band)
-        return nc_error(NC_ECONFIG, "stars: the camera's passband needs its shape (optics.passband {from_m, to_m} "
-                                    "or optics.passband_table), not only band_fraction and wavelength_m");
+        return nc_error(NC_ECONFIG, "%s: the camera's passband needs its shape (optics.passband {from_m, to_m} "
+                                    "or optics.passband_table), not only band_fraction and wavelength_m", sky->where);
     if (!(cs->sensor.pixel_pitch_m > 0 && geom->fx_px > 0))
-        return nc_error(NC_ECONFIG, "stars: their light needs the aperture's area: give camera.focal_length_m with "
-                                    "camera.pixel_pitch_m (or sensor.pixel_pitch_m) and optics.f_number");
+        return nc_error(NC_ECONFIG, "%s: their light needs the aperture's area: give camera.focal_length_m with "
+                                    "camera.pixel_pitch_m (or sensor.pixel_pitch_m) and optics.f_number", sky->where);
     const size_t n = sky->cat.n;
     free(sky->e_w_m2);
     free(sky->e_per_s);

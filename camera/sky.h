@@ -25,6 +25,7 @@ struct nc_sky {
     int on;
     struct nc_star_cat cat;
     char path[1024];
+    char where[320];           /* the stars section's file, line and path, for later errors */
     int limit_auto;            /* limit_mag: auto */
     double limit_mag;          /* when not auto */
     double epoch_jyear;        /* at simulation time 0 */
