@@ -211,7 +211,9 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
             const char *file;
             if ((rc = nc_cfg_string(psf, "file", &file)) <= 0)
                 return rc ? rc : nc_cfg_missing(psf, "file", "a kernel image (odd width and height)");
-            if ((rc = nc_psf_image(file, &o->psf)) < 0) {
+            char path[4096]; /* relative to the configuration file, as every file there */
+            nc_cfg_resolve_path(nc_cfg_get(psf, "file"), file, path, sizeof path);
+            if ((rc = nc_psf_image(path, &o->psf)) < 0) {
                 char why[600];
                 snprintf(why, sizeof why, "%s", nc_errmsg());
                 return nc_cfg_error(nc_cfg_get(psf, "file"), "%s", why);

@@ -293,6 +293,14 @@ static void set_origin(struct nc_cfg_node *n, const char *origin)
 
 /* Move top's node n over base's node b: maps merge key by key, anything
  * else replaces. Moved nodes are taken out of top. */
+/* YAML's null, which --set and a file laid over another take as "leave this key out". */
+static int is_null(const struct nc_cfg_node *v)
+{
+    return v->kind == NC_CFG_SCALAR && v->value &&
+           (!strcmp(v->value, "null") || !strcmp(v->value, "Null") || !strcmp(v->value, "NULL") ||
+            !strcmp(v->value, "~"));
+}
+
 static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
 {
     for (size_t i = 0; i < n->nchild; i++) {
@@ -301,6 +309,17 @@ static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
             int rc = overlay_node(old, c);
             if (rc < 0)
                 return rc;
+            continue;
+        }
+        if (is_null(c)) { /* key: null takes the base's key out */
+            if (old) {
+                size_t k = 0;
+                for (size_t j = 0; j < b->nchild; j++)
+                    if (b->child[j] != old)
+                        b->child[k++] = b->child[j];
+                b->nchild = k;
+                node_free(old);
+            }
             continue;
         }
         if (old) { /* replace in place, keeping the base's key order */
@@ -337,14 +356,6 @@ int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top)
     int rc = overlay_node(base->root, top->root);
     nc_cfg_free(top); /* what was not moved (emptied maps) */
     return rc < 0 ? nc_error(rc, "out of memory") : 0;
-}
-
-/* YAML's null, which --set takes as "leave this key out". */
-static int is_null(const struct nc_cfg_node *v)
-{
-    return v->kind == NC_CFG_SCALAR && v->value &&
-           (!strcmp(v->value, "null") || !strcmp(v->value, "Null") || !strcmp(v->value, "NULL") ||
-            !strcmp(v->value, "~"));
 }
 
 int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)

@@ -1,6 +1,7 @@
 /* serve_config.c - the emulator's configuration: the `serve:` section, the
  * trigger sources and the `outputs:` list (serve_internal.h). Reads and
  * opens; starts nothing. */
+#include <arpa/inet.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -131,6 +132,9 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
         e->drop_oldest = d;
         e->no_pose_scene = np == 0;
         e->stale_render = st;
+        struct in_addr ip;
+        if (bind && inet_pton(AF_INET, bind, &ip) != 1)
+            return nc_cfg_error(nc_cfg_get(sv, "bind"), "'%s' is not an IPv4 address (a name is not looked up)", bind);
         if (bind)
             snprintf(e->bind, sizeof e->bind, "%s", bind);
         if ((rc = int_key(sv, "queue_frames", 1, 1024, &e->queue_frames)) < 0 ||

@@ -167,7 +167,7 @@ int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
     struct nc_cfg_node *am;
     if ((rc = nc_cfg_map(map, "albedo_map", &am)) < 0)
         return rc;
-    if (rc && (rc = nc_albedo_map_from_config(am, &m->albedo_map)) < 0)
+    if (rc && (rc = nc_albedo_map_from_config(am, NULL)) < 0) /* the keys: the image comes with the build */
         return rc;
     if ((rc = nc_material_finish(m)) < 0) {
         snprintf(why, sizeof why, "%s", nc_errmsg());
@@ -184,6 +184,12 @@ int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
                     where, m->p[0], m->p[0] / 8);
     }
     return 0;
+}
+
+int nc_material_load_albedo_map(struct nc_cfg_node *map, struct nc_material *m)
+{
+    struct nc_cfg_node *am = map ? nc_cfg_get(map, "albedo_map") : NULL;
+    return am && !m->albedo_map ? nc_albedo_map_from_config(am, &m->albedo_map) : 0;
 }
 
 double nc_material_geometric_albedo(const struct nc_material *m)

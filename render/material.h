@@ -81,8 +81,10 @@ int nc_material_set(struct nc_material *m, const char *key, double value);
 /* All required parameters set, cross-checks pass; computes derived constants. */
 int nc_material_finish(struct nc_material *m);
 /* Read a material map: model or preset, the model's parameter keys, and an
- * optional albedo_map. */
+ * optional albedo_map's keys (its image is read by
+ * nc_material_load_albedo_map, with the body's build). */
 int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m);
+int nc_material_load_albedo_map(struct nc_cfg_node *map, struct nc_material *m);
 void nc_material_free(struct nc_material *m);
 
 /* Rocks too small to trace, folded into the reflectance as macroscopic

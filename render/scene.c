@@ -176,7 +176,9 @@ static int body_read(struct nc_cfg *cfg, struct nc_cfg_node *item, int index, st
 static int body_build(struct nc_cfg_node *item, struct nc_body *b)
 {
     struct nc_cfg_node *sh = nc_cfg_get(item, "shape");
-    int rc = shape_from_config(sh, b, 0);
+    int rc = nc_material_load_albedo_map(nc_cfg_get(item, "material"), &b->material);
+    if (rc >= 0)
+        rc = shape_from_config(sh, b, 0);
     return rc < 0 ? rc : nc__scene_detail_from_config(item, sh, b, 0);
 }
 

@@ -119,6 +119,8 @@ expect 2 "--exposure -1: not within 0 to 3600 s" -- "$navcam" pose send -P 0,-60
 expect 2 "--port 99999: not a port" -- "$navcam" pose send -P 0,-6000,0 -p 99999
 expect 2 "unsupported output format" -- "$navcam" render -o "$tmp/x.bmp"
 expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" render -q rock_id -o "$tmp/x.png"
+expect 1 "--set serve.bind=localhost: serve.bind: 'localhost' is not an IPv4 address" -- \
+  "$navcam" serve --set serve.bind=localhost --max-frames 1
 expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" batch builtin:approach -o "$tmp/rocks" -q rock_id -F png
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
 expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 0

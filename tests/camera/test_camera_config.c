@@ -19,6 +19,7 @@
 #include "camera/camsys.h"
 #include "camera/load.h"
 #include "core/error.h"
+#include "render/image_io.h"
 #include "testutil.h"
 
 static const char base_yaml[] =
@@ -199,11 +200,27 @@ static void one_pixel_pitch(void)
     nc_camsys_free(&cs);
 }
 
+/* A PSF kernel file named relative to the configuration file is found
+ * beside it, wherever the program runs. */
+static void psf_file_beside_the_config(void)
+{
+    const float k[9] = {0, 1, 0, 1, 4, 1, 0, 1, 0};
+    CHECK(nc_image_write(nc_test_path("kern.fits"), k, 3, 3, NULL, 0, NULL) == 0, "%s", nc_errmsg());
+    struct nc_camera g;
+    struct nc_camsys cs;
+    const char *rel = "camera: {width_px: 64, height_px: 48, focal_length_m: 0.025, pixel_pitch_m: 5.5e-6}\n"
+                      "optics: {f_number: 4, psf: {type: image, file: kern.fits}}\n";
+    CHECK(load(rel, NULL, 0, &g, &cs) == 0 && cs.optics.psf.size == 3 && fabs(cs.optics.psf.kernel[4] - 0.5) < 1e-12,
+          "a kernel beside the configuration file: %s", nc_errmsg());
+    nc_camsys_free(&cs);
+}
+
 int main(void)
 {
     flat_to_the_edge();
     dark_current_at_temperature();
     passband_from_edges();
     one_pixel_pitch();
+    psf_file_beside_the_config();
     return nc_test_end();
 }

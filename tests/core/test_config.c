@@ -80,6 +80,13 @@ int main(void)
         const char *item[] = {"camera.width_px=~"};
         expect_error("a required key set to null", NULL, NULL, item, 1, "camera.width_px", "missing required key");
     }
+    { /* an albedo map's image is read with the body's build: a mistake in a
+       * later body's keys is reported first */
+        const char *sets[] = {"bodies.0.material.albedo_map={file: missing.fits}",
+                              "bodies.1={shape: {type: sphere, radius_m: 5}, material: {model: lambert, A: 0.1}, zz: 1}"};
+        expect_error("albedo map read after every body's keys", NULL, NULL, sets, 2, "bodies[1].zz: unknown key",
+                     NULL);
+    }
     expect_error("missing key, cut short", "  width_px: 64\n", "  wid: 64\n", NULL, 0,
                  "camera.width_px: missing required key", "'wid' (line 7) is not a key here: a misspelling");
     { /* the key cut short, not a valid key one edit further away */
@@ -264,6 +271,17 @@ int main(void)
     nc_test_write(path, "base: builtin:default\ncamera:\n  width_px: 64\n  height_px: forty\n");
     rc = nc_scene_load(path, NULL, 0, &s);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:4: camera.height_px"), "overlay error: %s", nc_errmsg());
+    /* key: null in the file laid over takes the base's key out: the look-at
+     * camera of the default scene becomes one given by its attitude */
+    nc_test_write(path, "base: builtin:default\ncamera:\n  look_at_m: null\n  up: ~\n  attitude_q: [1, 0, 0, 0]\n");
+    nc_cfg_init(&cfg);
+    rc = nc_cfg_load_scene(&cfg, path, NULL, 0);
+    if (rc >= 0)
+        rc = nc_scene_read(&cfg, &s);
+    CHECK(rc == 0 && s.camera.attitude_q.w == 1 && s.camera.attitude_q.x == 0, "overlay with null: %s", nc_errmsg());
+    if (rc == 0)
+        nc_scene_free(&s);
+    nc_cfg_free(&cfg);
     nc_test_write(path, "base: builtin:nothing\n");
     rc = nc_scene_load(path, NULL, 0, &s);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:1: base: unknown base"), "bad base: %s", nc_errmsg());
