@@ -124,6 +124,19 @@ double nc_imgcmp_ncc(const float *a, const float *b, const unsigned char *mask, 
     return cab / sqrt(va * vb);
 }
 
+/* Whether the finite pixels of img take more than one value. */
+static int varies(const float *img, int w, int h)
+{
+    const float *first = NULL;
+    for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
+        if (isfinite(img[i])) {
+            if (first && img[i] != *first)
+                return 1;
+            first = first ? first : img + i;
+        }
+    return 0;
+}
+
 /* The render moved by (tx, ty) against real: keep it if it correlates best. */
 struct search {
     const float *real, *render;
@@ -158,8 +171,17 @@ int nc_imgcmp_register(const float *real, const float *render, int w, int h, int
                 consider(&s, cx + step * (k % 3 - 1), cy + step * (k / 3 - 1));
     }
     free(s.moved);
-    if (!(s.best > -2))
+    if (!(s.best > -2)) {
+        const char *flat = varies(real, w, h) ? varies(render, w, h) ? NULL : "the render" : "the real image";
+        if (flat)
+            return nc_error(NC_ERANGE, "registration: %s is constant over its finite pixels: nothing to correlate",
+                            flat);
         return nc_error(NC_ERANGE, "registration: the images do not overlap at any shift within %d px", radius_px);
+    }
+    if (fabs(s.bx) > radius_px - 0.5 || fabs(s.by) > radius_px - 0.5)
+        return nc_error(NC_ERANGE, "registration: the best shift (%g, %g) px lies at the edge of the search (+-%d "
+                                   "px): the images may be farther apart; search wider (--register)",
+                        s.bx, s.by, radius_px);
     *dx = s.bx;
     *dy = s.by;
     return 0;
@@ -234,8 +256,8 @@ int nc_imgcmp(const float *real, const float *render, int w, int h, enum nc_imgc
     out->limb_iou = uni ? (double)inter / (double)uni : NAN;
     out->foreground_px = m;
     if (m < 2) {
-        rc = nc_error(NC_ERANGE, "the real image has %zu foreground pixels above Otsu's threshold %g: nothing to "
-                                 "compare", m, out->threshold_real);
+        rc = nc_error(NC_ERANGE, "the real image has %zu foreground pixels (above Otsu's threshold %g, positive, "
+                                 "and finite in both images): nothing to compare", m, out->threshold_real);
         goto done;
     }
     if (fit == NC_FIT_SCALE) {

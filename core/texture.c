@@ -50,7 +50,17 @@ static int fast_score(const uint8_t *p, int w, int t)
     return best > t ? best - 1 : -1;
 }
 
-long nc_texture_fast(const uint8_t *img, int w, int h, int t, const uint8_t *region, uint8_t *mask)
+/* The pixel at v and its circle all valid. */
+static int circle_valid(const uint8_t *v, int w)
+{
+    int ok = v[0] != 0;
+    for (int k = 0; k < 16; k++)
+        ok &= v[circle[k][1] * w + circle[k][0]] != 0;
+    return ok;
+}
+
+long nc_texture_fast(const uint8_t *img, int w, int h, int t, const uint8_t *region, const uint8_t *valid,
+                     uint8_t *mask)
 {
     memset(mask, 0, (size_t)w * (size_t)h);
     if (w < 7 || h < 7)
@@ -61,7 +71,7 @@ long nc_texture_fast(const uint8_t *img, int w, int h, int t, const uint8_t *reg
     for (int y = 3; y < h - 3; y++)
         for (int x = 3; x < w - 3; x++) {
             const size_t o = (size_t)y * (size_t)w + (size_t)x;
-            const int s = fast_score(img + o, w, t);
+            const int s = !valid || circle_valid(valid + o, w) ? fast_score(img + o, w, t) : -1;
             score[o] = s < 0 ? 0 : s;
             mask[o] = s >= 0; /* a corner, before suppression */
         }
@@ -202,7 +212,9 @@ int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_o
         const double v = isfinite(img[i]) ? floor((img[i] - out->lo) * k + 0.5) : 0.0;
         u8[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
     }
-    const long corners = nc_texture_fast(u8, w, h, o->threshold, region, mask);
+    for (size_t i = 0; i < n; i++) /* the finite pixels: filled's bytes, before the spectrum needs it */
+        ((uint8_t *)filled)[i] = isfinite(img[i]) != 0;
+    const long corners = nc_texture_fast(u8, w, h, o->threshold, region, (const uint8_t *)filled, mask);
     if (corners < 0) {
         rc = (int)corners;
         goto done;

@@ -59,8 +59,11 @@ int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_o
  * A pixel p is a corner when 9 contiguous pixels of the circle are all
  * brighter than I_p + t or all darker than I_p - t; its score is the
  * largest t for which it still is one; a corner is kept when its score
- * exceeds those of its 8 neighbours (0 for a neighbour that is no corner). */
-long nc_texture_fast(const uint8_t *img, int w, int h, int t, const uint8_t *region, uint8_t *mask);
+ * exceeds those of its 8 neighbours (0 for a neighbour that is no corner).
+ * With valid (may be NULL), a pixel is tested only when it and its 16
+ * circle pixels are valid (non-zero): a missing pixel makes no corner. */
+long nc_texture_fast(const uint8_t *img, int w, int h, int t, const uint8_t *region, const uint8_t *valid,
+                     uint8_t *mask);
 
 /* The slope beta of P(f) ~ f^-beta of img (w x h, finite values) over
  * [f_lo, f_hi) cycles per pixel: the mean removed, a 2-D Hann window, the

@@ -44,11 +44,11 @@ static void check_fast(void)
      * with non-maximum suppression, on this image (built the same way in
      * numpy): 2250 corners at threshold 10 (1125 with x < 100), 1806 at 20
      * (905). Independent code, the same rules: the counts must agree exactly. */
-    long n10 = nc_texture_fast(img, GW, GH, 10, NULL, mask), n20 = nc_texture_fast(img, GW, GH, 20, NULL, mask);
+    long n10 = nc_texture_fast(img, GW, GH, 10, NULL, NULL, mask), n20 = nc_texture_fast(img, GW, GH, 20, NULL, NULL, mask);
     for (int i = 0; i < GW * GH; i++)
         left[i] = i % GW < GW / 2;
-    long l10 = nc_texture_fast(img, GW, GH, 10, left, mask);
-    long l20 = nc_texture_fast(img, GW, GH, 20, left, mask), in_left = 0, off = 0;
+    long l10 = nc_texture_fast(img, GW, GH, 10, left, NULL, mask);
+    long l20 = nc_texture_fast(img, GW, GH, 20, left, NULL, mask), in_left = 0, off = 0;
     for (int i = 0; i < GW * GH; i++)
         in_left += mask[i] && left[i], off += mask[i] && !left[i];
     printf("FAST on the golden image: %ld corners at threshold 10 (%ld left), %ld at 20 (%ld left)\n", n10, l10, n20,
@@ -61,18 +61,26 @@ static void check_fast(void)
      * pixels tie in score with their neighbours, and OpenCV keeps none. */
     memset(img, 10, sizeof img);
     img[40 * GW + 60] = 200;
-    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, mask) == 1 && mask[40 * GW + 60], "a bright pixel is one corner");
+    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, NULL, mask) == 1 && mask[40 * GW + 60], "a bright pixel is one corner");
     for (int y = 20; y < 40; y++)
         memset(img + y * GW + 20, 200, 20);
-    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, mask) == 1, "a square's corners tie with their neighbours");
+    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, NULL, mask) == 1, "a square's corners tie with their neighbours");
     /* No corner on a constant image or a ramp gentler than the threshold. */
     for (int i = 0; i < GW * GH; i++)
         img[i] = (uint8_t)(i % GW);
-    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, mask) == 0, "a ramp of 1 per pixel has no corner");
+    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, NULL, mask) == 0, "a ramp of 1 per pixel has no corner");
     /* Nor within 3 pixels of the border. */
     memset(img, 10, sizeof img);
     img[2 * GW + 60] = 200;
-    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, mask) == 0, "a pixel 2 from the border is never a corner");
+    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, NULL, mask) == 0, "a pixel 2 from the border is never a corner");
+    /* A pixel whose circle holds a missing one is not tested: a missing
+     * pixel (0 in the 8-bit image) beside a dark ground makes no corner. */
+    static uint8_t valid[GW * GH];
+    memset(img, 100, sizeof img);
+    memset(valid, 1, sizeof valid);
+    img[40 * GW + 60] = 0, valid[40 * GW + 60] = 0;
+    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, NULL, mask) == 1, "a dark pixel is a corner");
+    CHECK(nc_texture_fast(img, GW, GH, 10, NULL, valid, mask) == 0, "a missing pixel made a corner");
 }
 
 /* A periodic n x n field whose power falls as f^-beta (random phases). */
