@@ -281,11 +281,13 @@ static const char *const formats[] = {"Mono8", "Mono12", "Mono16", NULL};
 static const struct nc_param gige_params[] = {
     NC_P_STRING("interface", "lo", "network interface the camera lives on (its IPv4 address)"),
     NC_P_STRING("serial", "NAVCAM0001", "serial number, 1 to 15 characters"),
-    NC_P_STRING("model", "NavCam emulator", "model name the device reports"),
-    NC_P_STRING("xml", NULL, "a GenICam description file to serve instead of NavCam's own (relative to the config file)"),
+    NC_P_STRING("model", "NavCam emulator", "model name the device reports (DeviceModelName, at most 31 characters)"),
+    NC_P_STRING("xml", NULL, "a GenICam description file to serve instead of NavCam's own (relative to the config "
+                             "file)"),
     NC_P_ENUM("pixel_format", "Mono16", formats, "initial pixel format (clients may change it)"),
     NC_P_DOUBLE("poll_hz", "1000", 1, 10000, "Hz", "how often client-written settings are read"),
-    NC_P_INT("packet_size", NULL, 576, 65000, "bytes", "GVSP packet size (default 8192 on lo, 1400 elsewhere)"),
+    NC_P_INT("packet_size", NULL, 576, 65000, "bytes",
+             "GVSP packet size, a multiple of 4 (default 8192 on lo, 1400 elsewhere)"),
     NC_P_INT("metadata_row", "0", 0, 1, "", "1: append a row with the frame's metadata"),
     NC_P_END,
 };
