@@ -360,7 +360,8 @@ static void test_write_order(void)
     /* GenApi's schema orders a number's elements: Unit before
      * Representation (strict GenICam readers refuse the file otherwise). */
     size_t len = 0;
-    const char *xml = arv_device_get_genicam_xml(d, &len);
+    const char *raw = arv_device_get_genicam_xml(d, &len);
+    char *xml = raw ? g_strndup(raw, len) : NULL; /* its bytes, not a string */
     int misordered = 0, units = 0;
     for (const char *p = xml; p && (p = strstr(p, "<Representation>")); p++) {
         const char *end = strstr(p, "</Integer>"), *endf = strstr(p, "</Float>"), *u = strstr(p, "<Unit>");
@@ -371,6 +372,7 @@ static void test_write_order(void)
         units++;
     CHECK(xml && units >= 10 && misordered == 0, "GenICam XML: %d of %d Units after their Representation",
           misordered, units);
+    g_free(xml);
     free(img);
     g_object_unref(c);
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
