@@ -3,8 +3,10 @@
 
 #include <fcntl.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -154,8 +156,14 @@ int nc_test_spawn(const char *dir, const char *const *argv)
     char log[4200];
     snprintf(log, sizeof log, "%s/serve.log", dir);
     mkdir(dir, 0777);
+    const pid_t parent = getpid();
     pid_t pid = fork();
     if (pid == 0) {
+        /* a test that crashes takes its server with it (else it would hold
+         * its ports for the next test) */
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        if (getppid() != parent)
+            _exit(127);
         int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644), nul = open("/dev/null", O_WRONLY);
         if (chdir(dir) < 0 || fd < 0 || nul < 0)
             _exit(127);
