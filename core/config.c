@@ -293,6 +293,19 @@ static void set_origin(struct nc_cfg_node *n, const char *origin)
 
 /* Move top's node n over base's node b: maps merge key by key, anything
  * else replaces. Moved nodes are taken out of top. */
+/* Child c (NULL: none) out of parent, freed; the others keep their order. */
+static void node_remove(struct nc_cfg_node *parent, struct nc_cfg_node *c)
+{
+    if (!c)
+        return;
+    size_t k = 0;
+    for (size_t i = 0; i < parent->nchild; i++)
+        if (parent->child[i] != c)
+            parent->child[k++] = parent->child[i];
+    parent->nchild = k;
+    node_free(c);
+}
+
 /* YAML's null, which --set and a file laid over another take as "leave this key out". */
 static int is_null(const struct nc_cfg_node *v)
 {
@@ -312,14 +325,7 @@ static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
             continue;
         }
         if (is_null(c)) { /* key: null takes the base's key out */
-            if (old) {
-                size_t k = 0;
-                for (size_t j = 0; j < b->nchild; j++)
-                    if (b->child[j] != old)
-                        b->child[k++] = b->child[j];
-                b->nchild = k;
-                node_free(old);
-            }
+            node_remove(b, old);
             continue;
         }
         if (old) { /* replace in place, keeping the base's key order */
@@ -423,13 +429,7 @@ int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)
         }
         if (!next && is_null(value)) { /* KEY=null: the key (or list item) taken out */
             node_free(value);
-            if (child) {
-                for (size_t i = 0, k = 0; i < cur->nchild; i++)
-                    if (cur->child[i] != child)
-                        cur->child[k++] = cur->child[i];
-                cur->nchild--;
-                node_free(child);
-            }
+            node_remove(cur, child);
             return 0;
         }
         if (!next) {
