@@ -46,6 +46,11 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
     auto out = ImageOutput::create(path);
     if (!out)
         return fail(NC_EIMAGE, err, elen, "%s: %s", path, OIIO::geterror().c_str());
+    // OpenImageIO deflates a float TIFF with the floating-point predictor
+    // (3), which some readers cannot undo (Python's tifffile without
+    // imagecodecs); deflate alone is read everywhere.
+    if (type == NC__PX_FLOAT && !std::strcmp(out->format_name(), "tiff"))
+        spec.attribute("tiff:Predictor", 1);
     if (!out->open(path, spec))
         return fail(NC_EIMAGE, err, elen, "%s: open for writing: %s", path, out->geterror().c_str());
     if (!out->write_image(td, px)) {

@@ -135,6 +135,29 @@ for q in radiance iof range; do
   done
 done
 
+# A float TIFF is deflated without the floating-point predictor (3), which
+# Python's tifffile cannot undo without imagecodecs; its strips inflate with
+# zlib alone to the image's 4-byte floats.
+python3 - "$tmp/radiance.tif" <<'PY' && ok || bad "radiance.tif: predictor or strips"
+import struct, sys, zlib
+b = open(sys.argv[1], 'rb').read()
+assert b[:4] == b'II*\0'
+ifd = struct.unpack_from('<I', b, 4)[0]
+tags = {}
+for i in range(struct.unpack_from('<H', b, ifd)[0]):
+    tag, typ, n, v = struct.unpack_from('<HHII', b, ifd + 2 + 12 * i)
+    short = struct.unpack_from('<H', b, ifd + 2 + 12 * i + 8)[0]
+    tags[tag] = (typ, n, short if typ == 3 and n == 1 else v)
+def vals(tag):
+    typ, n, v = tags[tag]
+    if n == 1:
+        return [v]
+    return list(struct.unpack_from('<%d%s' % (n, 'H' if typ == 3 else 'I'), b, v))
+assert tags[259][2] == 8 and tags[339][2] == 3 and tags.get(317, (3, 1, 1))[2] == 1, tags
+raw = b''.join(zlib.decompress(b[o:o + c]) for o, c in zip(vals(273), vals(279)))
+assert len(raw) == 4 * tags[256][2] * tags[257][2]
+PY
+
 # A scene file plus overrides; the printed scene is itself a valid scene.
 "$navcam" scene > "$tmp/scene.yaml"
 expect 0 "wrote" -- "$navcam" render "$tmp/scene.yaml" -o "$tmp/s.exr" "${small[@]}" \
