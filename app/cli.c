@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -24,6 +25,31 @@ int nc_cli_fail(void)
 {
     fprintf(stderr, "%s: %s\n", name, nc_errmsg());
     return 1;
+}
+
+int nc_cli_long(const char *opt, const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    const long v = strtol(s, &end, 10);
+    if (end == s || *end || errno || v < lo || v > hi) {
+        fprintf(stderr, "%s: --%s expects %ld..%ld, got '%s'\n", name, opt, lo, hi, s);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    const double v = strtod(s, &end);
+    if (end == s || *end || !(v >= lo && v <= hi)) {
+        fprintf(stderr, "%s: --%s expects %g..%g, got '%s'\n", name, opt, lo, hi, s);
+        return -1;
+    }
+    *out = v;
+    return 0;
 }
 
 int nc_cli_gnuplot(const char *dir, const char *script)

@@ -12,6 +12,11 @@ void nc_cli_init(const char *command);
 /* Prints "navcam CMD: <last error>" and returns 1 (the exit status). */
 int nc_cli_fail(void);
 
+/* A number option's value: the whole of s a number in [lo, hi], else
+ * "navcam CMD: --opt expects lo..hi, got 's'" on stderr and -1. */
+int nc_cli_long(const char *opt, const char *s, long lo, long hi, long *out);
+int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out);
+
 /* Where a command writes its results: *f is the file path (opened for
  * writing), or standard output when path is NULL; 0 or a negative error
  * code. Closing reports a failed write (0 or a negative error code);

@@ -53,12 +53,9 @@ static const char bench_help[] =
 
 static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
 {
-    char *end;
-    long v = strtol(s, &end, 10);
-    if (*end || v < lo || v > hi) {
-        fprintf(stderr, "navcam bench: --%s expects %d..%d, got '%s'\n", opt, lo, hi, s);
+    long v;
+    if (nc_cli_long(opt, s, lo, hi, &v) < 0)
         return -1;
-    }
     *out = (int)v;
     return 0;
 }

@@ -29,15 +29,23 @@ static const char pose_help[] =
     "      --tcp              over TCP, waiting for the FRAME answer when capturing\n"
     "  -H, --host ADDR        numeric IPv4 address (default 127.0.0.1)\n"
     "  -p, --port N           1 to 65535 (default 5750 for UDP, 5751 for TCP)\n"
-    "Values the protocol refuses (docs/protocol.md) are refused here, naming the option.\n";
+    "Values the protocol refuses (docs/protocol.md) are refused here, naming the option.\n"
+    "Exit status: 0 sent (and, with --tcp --capture, the frame delivered), 1 not\n"
+    "sent or no answer, 2 a bad option, 3 the frame dropped (the answer's status).\n";
 
-static int parse_vec(const char *s, double *v, int n)
+/* n numbers X,Y,...; -1 when s is not that, with *why "not finite" for a
+ * NaN or infinity among them. */
+static int parse_vec(const char *s, double *v, int n, const char **why)
 {
     char *end;
     for (int i = 0; i < n; i++) {
         v[i] = strtod(s, &end);
-        if (end == s || !isfinite(v[i]))
+        if (end == s)
             return -1;
+        if (!isfinite(v[i])) {
+            *why = "not finite";
+            return -1;
+        }
         s = end + (*end == ',');
     }
     return *end ? -1 : 0;
@@ -65,12 +73,13 @@ int main(int argc, char **argv)
     int tcp = 0, port = 0, c, have_pos = 0;
     const char *host = "127.0.0.1";
     optind = 1;
+    argv[1] = "navcam pose send"; /* getopt's messages begin with it */
     const char *why = NULL; /* what is wrong with the option's value */
     while ((c = getopt_long(argc - 1, argv + 1, "P:A:S:t:ce:g:H:p:h", opts, NULL)) != -1) {
         switch (c) {
-        case 'P': have_pos = parse_vec(optarg, pos, 3) == 0; if (!have_pos) goto bad; break;
+        case 'P': have_pos = parse_vec(optarg, pos, 3, &why) == 0; if (!have_pos) goto bad; break;
         case 'A':
-            if (parse_vec(optarg, att, 4) < 0)
+            if (parse_vec(optarg, att, 4, &why) < 0)
                 goto bad;
             why = "not a unit quaternion within 1e-6";
             if (fabs(sqrt(att[0] * att[0] + att[1] * att[1] + att[2] * att[2] + att[3] * att[3]) - 1) >
@@ -78,20 +87,20 @@ int main(int argc, char **argv)
                 goto bad;
             break;
         case 'S':
-            if (parse_vec(optarg, sun, 3) < 0 || (why = "a zero vector", !(sun[0] || sun[1] || sun[2])))
+            if (parse_vec(optarg, sun, 3, &why) < 0 || (why = "a zero vector", !(sun[0] || sun[1] || sun[2])))
                 goto bad;
             break;
-        case 't': if (parse_vec(optarg, &t, 1) < 0 || (why = "beyond +-9.2e9 s", !(fabs(t) < 9.2e9))) goto bad; break;
+        case 't': if (parse_vec(optarg, &t, 1, &why) < 0 || (why = "beyond +-9.2e9 s", !(fabs(t) < 9.2e9))) goto bad; break;
         case 'c': m.flags |= NC_MSG_CAPTURE; break;
         case 'R': m.type = NC_MSG_TRIGGER; m.flags |= NC_MSG_CAPTURE; break;
         case 'e':
-            if (parse_vec(optarg, &v, 1) < 0 ||
+            if (parse_vec(optarg, &v, 1, &why) < 0 ||
                 (why = "not within 0 to 3600 s", !(v >= 0 && v <= NC_PROTO_EXPOSURE_MAX_S)))
                 goto bad;
             m.exposure_s = v, m.flags |= NC_MSG_EXPOSURE;
             break;
         case 'g':
-            if (parse_vec(optarg, &v, 1) < 0 ||
+            if (parse_vec(optarg, &v, 1, &why) < 0 ||
                 (why = "not within -60 to 60 dB", !(v >= -NC_PROTO_GAIN_MAX_DB && v <= NC_PROTO_GAIN_MAX_DB)))
                 goto bad;
             m.gain_db = v, m.flags |= NC_MSG_GAIN;
@@ -99,7 +108,8 @@ int main(int argc, char **argv)
         case 'C': tcp = 1; break;
         case 'H': host = optarg; break;
         case 'p':
-            if (parse_vec(optarg, &v, 1) < 0 || (why = "not a port, 1 to 65535", !(v >= 1 && v <= 65535 && v == floor(v))))
+            if (parse_vec(optarg, &v, 1, &why) < 0 ||
+                (why = "not a port, 1 to 65535", !(v >= 1 && v <= 65535 && v == floor(v))))
                 goto bad;
             port = (int)v;
             break;
@@ -127,8 +137,13 @@ int main(int argc, char **argv)
         uint64_t frame;
         uint32_t status;
         rc = nc_client_wait_frame(cl, (uint32_t)seq, 60000, &frame, &status) < 0;
-        if (!rc)
-            printf("frame %llu %s\n", (unsigned long long)frame, status == NC_FRAME_DELIVERED ? "delivered" : "dropped");
+        if (!rc && status == NC_FRAME_DELIVERED)
+            printf("frame %llu delivered\n", (unsigned long long)frame);
+        else if (!rc) { /* the reason is in the server's statistics */
+            printf("dropped (status %u)\n", status);
+            nc_client_close(cl);
+            return 3;
+        }
     }
     if (rc)
         fprintf(stderr, "navcam pose send: %s\n", nc_errmsg());

@@ -36,7 +36,31 @@ static const char replay_help[] =
     "  -H, --host ADDR       numeric IPv4 address (default 127.0.0.1)\n"
     "  -p, --port N          default 5751 (TCP, lock-step) or 5750 (UDP)\n"
     "  -T, --timeout-ms N    lock-step wait per frame (default 60000)\n"
+    "  -w, --wait S          lock-step: while nothing listens on the port yet (a server\n"
+    "                        still building its scene), try again for up to S seconds\n"
+    "                        (default 30; 0: fail at once). Free-run poses go by UDP,\n"
+    "                        which has no connection: those sent before the server\n"
+    "                        listens are lost\n"
     "  -h, --help            this help\n";
+
+/* A TCP connection refused (a server still starting) is tried again every
+ * 0.1 s for up to wait_s seconds. */
+static int connect_waiting(const char *host, int port, int tcp, double wait_s, struct nc_client **cl)
+{
+    struct timespec t0, now, pause = {0, 100000000};
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (int said = 0;; said = 1) {
+        int rc = nc_client_connect(host, port, tcp, cl);
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        const double el = (now.tv_sec - t0.tv_sec) + (now.tv_nsec - t0.tv_nsec) * 1e-9;
+        if (rc != -ECONNREFUSED || el + 0.1 > wait_s)
+            return rc;
+        if (!said)
+            fprintf(stderr, "navcam replay: nothing listens on TCP %s:%d yet; trying for up to %g s (--wait)\n", host,
+                    port, wait_s);
+        nanosleep(&pause, NULL);
+    }
+}
 
 int main(int argc, char **argv)
 {
@@ -44,23 +68,29 @@ int main(int argc, char **argv)
     static const struct option opts[] = {
         {"lockstep", no_argument, NULL, 'l'},        {"speed", required_argument, NULL, 'x'},
         {"host", required_argument, NULL, 'H'},      {"port", required_argument, NULL, 'p'},
-        {"timeout-ms", required_argument, NULL, 'T'}, {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+        {"timeout-ms", required_argument, NULL, 'T'}, {"wait", required_argument, NULL, 'w'},
+        {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0},
     };
-    int lockstep = 0, port = 0, timeout_ms = 60000, c;
-    double speed = 1;
+    int lockstep = 0, c, bad = 0;
+    long port = 0, timeout_ms = 60000;
+    double speed = 1, wait_s = 30;
     const char *host = "127.0.0.1";
     optind = 1;
-    while ((c = getopt_long(argc, argv, "lx:H:p:T:h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "lx:H:p:T:w:h", opts, NULL)) != -1 && !bad) {
         switch (c) {
         case 'l': lockstep = 1; break;
-        case 'x': speed = atof(optarg); break;
+        case 'x': bad = nc_cli_double("speed", optarg, 0, 1e6, &speed); break;
         case 'H': host = optarg; break;
-        case 'p': port = atoi(optarg); break;
-        case 'T': timeout_ms = atoi(optarg); break;
+        case 'p': bad = nc_cli_long("port", optarg, 1, 65535, &port); break;
+        case 'T': bad = nc_cli_long("timeout-ms", optarg, 1, 86400000, &timeout_ms); break;
+        case 'w': bad = nc_cli_double("wait", optarg, 0, 3600, &wait_s); break;
         case 'h': fputs(replay_help, stdout); return 0;
-        default: fputs("Try 'navcam replay --help'.\n", stderr); return 2;
+        default: bad = 1; break;
         }
+    }
+    if (bad) {
+        fputs("Try 'navcam replay --help'.\n", stderr);
+        return 2;
     }
     if (optind != argc - 1) {
         fprintf(stderr, "navcam replay: give one trajectory (a CSV file or builtin:approach)\n");
@@ -73,7 +103,7 @@ int main(int argc, char **argv)
         return 1;
     }
     struct nc_client *cl;
-    if (nc_client_connect(host, port ? port : lockstep ? 5751 : 5750, lockstep, &cl) < 0) {
+    if (connect_waiting(host, port ? (int)port : lockstep ? 5751 : 5750, lockstep, wait_s, &cl) < 0) {
         fprintf(stderr, "navcam replay: %s\n", nc_errmsg());
         free(rows);
         return 1;

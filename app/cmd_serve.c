@@ -1,6 +1,7 @@
 /* cmd_serve.c - `navcam serve`: argument parsing, the signal handlers, and
  * the drivers this build has handed to the emulator (emulator/serve.h). */
 #include <getopt.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -100,21 +101,28 @@ int main(int argc, char **argv)
     };
     const char **sets = calloc((size_t)argc + 1, sizeof *sets);
     struct nc_serve_options o = {0};
-    int c;
+    int c, bad = 0;
+    long threads = 0;
     if (!sets)
         return 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "s:n:t:j:h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "s:n:t:j:h", opts, NULL)) != -1 && !bad) {
         switch (c) {
         case 's': sets[o.nsets++] = optarg; break;
-        case 'n': o.max_frames = atol(optarg); break;
-        case 't': o.max_seconds = atof(optarg); break;
+        case 'n': bad = nc_cli_long("max-frames", optarg, 1, LONG_MAX, &o.max_frames); break;
+        case 't': bad = nc_cli_double("max-seconds", optarg, 1e-3, 1e9, &o.max_seconds); break;
         case 'J': o.stats_json_path = optarg; break;
-        case 'j': o.threads = atoi(optarg); break;
+        case 'j': bad = nc_cli_long("threads", optarg, 1, 1024, &threads); break;
         case 'h': serve_usage(); free(sets); return 0;
         case 'D': driver_docs(); free(sets); return 0;
-        default: fputs("Try 'navcam serve --help'.\n", stderr); free(sets); return 2;
+        default: bad = 1; break;
         }
+    }
+    o.threads = (int)threads;
+    if (bad) {
+        fputs("Try 'navcam serve --help'.\n", stderr);
+        free(sets);
+        return 2;
     }
     if (optind < argc)
         o.scene_path = argv[optind++];

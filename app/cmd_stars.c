@@ -52,6 +52,10 @@ int main(int argc, char **argv)
         fputs(stars_help, stdout);
         return 0;
     }
+    if (!strcmp(verb, "info") && argc == 3 && (!strcmp(argv[2], "-h") || !strcmp(argv[2], "--help"))) {
+        fputs(stars_help, stdout);
+        return 0;
+    }
     if (!strcmp(verb, "info") && argc == 3)
         return info(argv[2]);
     if (strcmp(verb, "index") != 0) {

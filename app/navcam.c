@@ -92,7 +92,12 @@ int main(int argc, char **argv)
                     cmd, cmd);
             return 127;
         }
-        execv(path, argv + 1); /* argv[0] of the command is its name */
+        /* argv[0] of the command is "navcam COMMAND", which getopt's
+         * messages then begin with */
+        char prog[96];
+        snprintf(prog, sizeof prog, "navcam %s", cmd);
+        argv[1] = prog;
+        execv(path, argv + 1);
         fprintf(stderr, "navcam: %s: %s\n", path, strerror(errno));
         return 126;
     }

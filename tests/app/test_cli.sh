@@ -117,6 +117,29 @@ expect 2 "--attitude 0,0,0,0: not a unit quaternion" -- "$navcam" pose send -P 0
 expect 2 "--sun 0,0,0: a zero vector" -- "$navcam" pose send -P 0,-6000,0 -S 0,0,0
 expect 2 "--exposure -1: not within 0 to 3600 s" -- "$navcam" pose send -P 0,-6000,0 -e -1
 expect 2 "--port 99999: not a port" -- "$navcam" pose send -P 0,-6000,0 -p 99999
+expect 2 "--position nan,0,0: not finite" -- "$navcam" pose send -P nan,0,0
+expect 2 "navcam pose send: unrecognized option '--bogus'" -- "$navcam" pose send --bogus
+expect 2 "navcam render: unrecognized option '--bogus'" -- "$navcam" render --bogus
+expect 0 "navcam stars info INDEX" -- "$navcam" stars info --help
+# Number options: the whole argument a number in range, else exit 2 naming it.
+expect 2 "navcam replay: --speed expects 0..1e+06, got 'abc'" -- "$navcam" replay builtin:approach --speed abc
+expect 2 "navcam replay: --port expects 1..65535, got '99999'" -- "$navcam" replay builtin:approach -p 99999
+expect 2 "navcam replay: --timeout-ms expects 1..86400000, got '-5'" -- "$navcam" replay builtin:approach -T -5
+expect 2 "navcam serve: --threads expects 1..1024, got '0'" -- "$navcam" serve -j 0
+expect 2 "navcam serve: --max-frames expects 1.." -- "$navcam" serve -n 2x
+# replay --lockstep started before the server: it waits (--wait) until the
+# server listens, then streams; the README's tour runs its two lines so.
+port=$((20000 + RANDOM % 20000))
+"$navcam" replay builtin:approach --lockstep -p "$port" --wait 60 > "$tmp/early.out" 2> "$tmp/early.err" &
+early=$!
+for _ in $(seq 100); do grep -q "trying for up to 60 s" "$tmp/early.err" && break; sleep 0.1; done
+"$navcam" serve --set serve.mode=lockstep --set serve.tcp_port=$port --set serve.udp_port=$((port + 1)) "${small[@]}" \
+  --set "outputs=[{driver: null}]" > /dev/null 2>&1 &
+srv=$!
+if wait "$early" && grep -q "8 frames delivered" "$tmp/early.out"; then ok
+else bad "replay before serve: $(cat "$tmp/early.out" "$tmp/early.err")"; fi
+kill "$srv" 2> /dev/null
+wait "$srv" 2> /dev/null
 expect 2 "unsupported output format" -- "$navcam" render -o "$tmp/x.bmp"
 expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" render -q rock_id -o "$tmp/x.png"
 expect 1 "--set serve.bind=localhost: serve.bind: 'localhost' is not an IPv4 address" -- \
