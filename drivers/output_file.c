@@ -3,6 +3,7 @@
  * frame's metadata (options: file_params below). */
 #include <errno.h>
 #include <libgen.h>
+#include <limits.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -24,7 +25,7 @@ static const char *const fits_orders[] = {"top_down", "bottom_up", NULL};
 
 static const struct nc_param file_params[] = {
     NC_P_STRING("directory", "out", "where the files go (made if missing, with its parents)"),
-    NC_P_STRING("pattern", "frame_%06llu.png", "file name with one %llu-style conversion for the frame number; the extension picks the format "
+    NC_P_STRING("pattern", "frame_%06llu.png", "file name with one conversion %llu, %06llu or the like (flags - and 0, width up to 99) for the frame number, no other %; the extension picks the format "
      "(.png, .tif, .fits, .exr)"),
     NC_P_ENUM("fits_row_order", "top_down", fits_orders,
               "for .fits patterns: top_down (row 1 is the top image row) or bottom_up (row 1 at the bottom, as FITS "
@@ -32,6 +33,20 @@ static const struct nc_param file_params[] = {
     NC_P_STRING_OR_EMPTY("sidecar", "frames.jsonl", "JSON-lines file with every frame's metadata, in the directory (empty: none)"),
     NC_P_END,
 };
+
+/* 1 when pattern holds exactly one conversion, %[-0][width]llu, and no
+ * other '%': it is handed to snprintf with the frame number, so any other
+ * conversion (%s, %n) would read or write what is not there. */
+static int pattern_ok(const char *pattern)
+{
+    const char *pc = strchr(pattern, '%');
+    if (!pc || strchr(pc + 1, '%'))
+        return 0;
+    const char *p = pc + 1;
+    p += strspn(p, "-0");
+    const size_t width = strspn(p, "0123456789");
+    return width <= 2 && !strncmp(p + width, "llu", 3);
+}
 
 static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
 {
@@ -43,12 +58,15 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         (rc = nc_param_string(opts, file_params, "sidecar", &sidecar)) < 0 ||
         (rc = nc_param_enum(opts, file_params, "fits_row_order", &f->bottom_up)) < 0)
         return rc;
-    /* The pattern must format exactly one unsigned long long. */
-    const char *pc = strchr(pattern, '%');
-    if (!pc || strstr(pc + 1, "%") || !strstr(pc, "llu") || strchr(pattern, '/'))
+    /* The pattern must format exactly one unsigned long long, into a name
+     * a directory can hold for every frame number. */
+    if (!pattern_ok(pattern) || strchr(pattern, '/'))
         return nc_cfg_error(nc_cfg_get(opts, "pattern"),
-                            "expected a file name with one %%llu-style conversion, e.g. frame_%%06llu.png");
+                            "expected a file name with one %%llu conversion (flags - or 0, a width of at most 99), "
+                            "no other %% and no '/', e.g. frame_%%06llu.png");
     char probe[512];
+    if (snprintf(probe, sizeof probe, pattern, ~0ULL) > NAME_MAX)
+        return nc_cfg_error(nc_cfg_get(opts, "pattern"), "makes file names longer than %d bytes", NAME_MAX);
     snprintf(probe, sizeof probe, pattern, 0ULL);
     if (!nc_image_format_ok(probe, NULL))
         return nc_cfg_error(nc_cfg_get(opts, "pattern"), "unsupported image format (use .png, .tif, .fits or .exr)");

@@ -47,7 +47,9 @@ enum nc__drop_reason {
     NC__DROP_OUTPUT_BUSY,
     NC__DROP_SHUTDOWN,
     NC__DROP_IGNORED,
-    NC__DROP_REJECTED, /* a capture whose message the timeline refused (time went backwards) */
+    NC__DROP_REJECTED,       /* a capture whose message the timeline refused (time went backwards) */
+    NC__DROP_RENDER_ERROR,   /* the render or the camera model failed (logged) */
+    NC__DROP_OUTPUT_FAILED,  /* a frame made, but no output took it (each output's failures counted) */
     NC__DROP_COUNT
 };
 extern const char *const nc__serve_drop_names[];

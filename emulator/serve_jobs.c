@@ -13,8 +13,9 @@
 #include "core/log.h"
 #include "emulator/serve_internal.h"
 
-const char *const nc__serve_drop_names[] = {"queue_full", "overrun",         "stale_pose",      "no_pose",
-                                            "output_busy", "shutdown",       "ignored_request", "rejected_request"};
+const char *const nc__serve_drop_names[] = {
+    "queue_full", "overrun", "stale_pose", "no_pose", "output_busy", "shutdown", "ignored_request", "rejected_request",
+    "render_error", "output_failed"};
 
 void nc__serve_flush_client(struct nc__emu *e, struct nc__client *c)
 {

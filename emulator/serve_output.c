@@ -58,10 +58,17 @@ void *nc__serve_output_thread(void *arg)
         /* Latency: pose received (lock-step) or exposure end (triggered) ->
          * frame handed to the outputs. */
         int64_t handed = nc_mono_ns();
+        int took = 0;
         for (int i = 0; i < e->nout; i++) {
             int rc = nc_output_submit(&e->out[i], &sl->rec);
+            took += rc >= 0;
             if (rc < 0 && rc != -EAGAIN) /* busy (no free buffer): counted, not logged */
                 report_failure(e, i, sl->rec.frame);
+        }
+        if (e->nout > 0 && !took) { /* made, and lost on the way out */
+            nc__serve_drop(e, &sl->job, NC__DROP_OUTPUT_FAILED);
+            release(e);
+            continue;
         }
         pthread_mutex_lock(&e->stat_lock);
         e->lat_ms[e->nlat % NC_SERVE_LAT_SAMPLES] = (handed - sl->job.ready_mono_ns) * 1e-6;

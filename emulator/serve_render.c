@@ -180,7 +180,9 @@ static void finish_frame(struct stage *st, const struct staged *x)
     int64_t t1 = nc_mono_ns();
     struct nc_camsys cs = e->cs; /* per-frame gain */
     cs.sensor.analog_gain_db = j->gain_db;
-    uint64_t frame = e->next_frame++;
+    /* The frame's number (which keys its noise) is taken only by a frame
+     * made: a failed render leaves no gap in the numbers. */
+    uint64_t frame = e->next_frame;
     int rc = x->rc;
     if (rc >= 0)
         rc = nc_camsys_electrons(&cs, st->f[x->buf].radiance, j->exposure_s, st->el);
@@ -188,17 +190,19 @@ static void finish_frame(struct stage *st, const struct staged *x)
         rc = nc_camsys_digitise(&cs, st->el, j->exposure_s, frame, sl->dn);
     int64_t t2 = nc_mono_ns();
     if (rc < 0) {
-        nc_log_error("emulator/render", "frame %llu: %s", (unsigned long long)frame, nc_errmsg());
+        nc_log_error("emulator/render", "request %u at t_sim %.9f s: %s", j->sequence, j->trigger_sim_ns * 1e-9,
+                     nc_errmsg());
         if (e->mode != NC__MODE_LOCKSTEP) {
-            nc__serve_drop(e, j, NC__DROP_OUTPUT_BUSY);
+            nc__serve_drop(e, j, NC__DROP_RENDER_ERROR);
             return;
         }
         sl->job = *j; /* the slot is ours: answer in order */
         sl->dropped = 1;
-        sl->why = NC__DROP_OUTPUT_BUSY;
+        sl->why = NC__DROP_RENDER_ERROR;
         fill_slot(e);
         return;
     }
+    e->next_frame++;
     int64_t exp_ns = (int64_t)llround(j->exposure_s * 1e9);
     int64_t start_sim = j->mid_sim_ns - (int64_t)llround(0.5 * j->exposure_s * 1e9);
     int64_t start_mono = j->trigger_mono_ns + (start_sim - j->trigger_sim_ns);

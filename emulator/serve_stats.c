@@ -36,10 +36,12 @@ static struct percentiles percentiles(struct nc__emu *e)
     }
     pthread_mutex_unlock(&e->stat_lock);
     if (n && a) {
-        size_t i99 = (size_t)(0.99 * (n - 1));
+        /* nearest rank: the smallest sample with at least q of them at or
+         * below it (so p50 <= p99 for any n; with 2 samples, the two) */
+        const size_t i50 = (size_t)ceil(0.5 * n) - 1, i99 = (size_t)ceil(0.99 * n) - 1;
         for (int k = 0; k < Q_COUNT; k++) {
             qsort(a + k * n, n, sizeof *a, cmpd);
-            p.p50[k] = a[k * n + n / 2];
+            p.p50[k] = a[k * n + i50];
             p.p99[k] = a[k * n + i99];
         }
     }

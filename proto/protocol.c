@@ -141,7 +141,11 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
     if (type != NC_MSG_POSE && type != NC_MSG_TRIGGER && type != NC_MSG_FRAME)
         return NC_REJECT_BAD_TYPE;
     uint32_t flags = nc_le_get_u32(buf + 16);
-    if (flags & ~NC_MSG_KNOWN_FLAGS)
+    /* Bits no version-1 message has, a pose's blocks on another type, or
+     * a reserved word not 0 (a sender that wrote its flags there, say):
+     * what the sender meant cannot be known. */
+    const uint32_t pose_only = NC_MSG_SUN_POSITION | NC_MSG_BODY_POSE | NC_MSG_CAMERA_RATES | NC_MSG_BODY_RATES;
+    if ((flags & ~NC_MSG_KNOWN_FLAGS) || (type != NC_MSG_POSE && (flags & pose_only)) || nc_le_get_u32(buf + 20))
         return NC_REJECT_BAD_FLAGS;
     size_t want = nc_msg_size((enum nc_msg_type)type, flags);
     if (nc_le_get_u32(buf + 8) != want)

@@ -117,6 +117,10 @@ expect 2 "--attitude 0,0,0,0: not a unit quaternion" -- "$navcam" pose send -P 0
 expect 2 "--sun 0,0,0: a zero vector" -- "$navcam" pose send -P 0,-6000,0 -S 0,0,0
 expect 2 "--exposure -1: not within 0 to 3600 s" -- "$navcam" pose send -P 0,-6000,0 -e -1
 expect 2 "--port 99999: not a port" -- "$navcam" pose send -P 0,-6000,0 -p 99999
+expect 1 "outputs[0].pattern: expected a file name with one %llu conversion" -- "$navcam" serve \
+  --set "outputs=[{driver: file, pattern: 'x%s_llu.png'}]"
+expect 1 "outputs[0].pattern: makes file names longer than 255 bytes" -- "$navcam" serve \
+  --set "outputs=[{driver: file, pattern: 'f_%099llu_$(printf 'x%.0s' $(seq 160)).png'}]"
 expect 2 "--position nan,0,0: not finite" -- "$navcam" pose send -P nan,0,0
 expect 2 "navcam pose send: unrecognized option '--bogus'" -- "$navcam" pose send --bogus
 expect 2 "navcam render: unrecognized option '--bogus'" -- "$navcam" render --bogus

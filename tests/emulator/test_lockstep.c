@@ -5,7 +5,9 @@
  * concurrent clients within serve.max_clients are all served; a client
  * beyond the limit is told why; a client that reads none of its answers
  * does not hold up another; at shutdown every capture still queued is
- * answered "dropped", after the frames before it.
+ * answered "dropped", after the frames before it; a failed render and a
+ * frame no output took are drops with their reasons, and a failed render
+ * leaves no gap in the frame numbers.
  * Usage: test_lockstep NAVCAM TMPDIR */
 #include <errno.h>
 #include <signal.h>
@@ -229,6 +231,65 @@ static void shutdown_answers_everything(void)
     nc_client_close(c);
 }
 
+/* One answer: its status, and its frame number in *frame. */
+static uint32_t one_answer(struct nc_client *c, uint64_t *frame)
+{
+    uint32_t seq, status = 99;
+    if (nc_client_next_frame(c, 60000, &seq, frame, &status) < 0)
+        CHECK(0, "no answer: %s", nc_client_errmsg());
+    return status;
+}
+
+static void failures_are_drops(void)
+{
+    char files[4200], opt[4400];
+    snprintf(files, sizeof files, "%s/lost/files", tmp);
+    snprintf(opt, sizeof opt, "outputs=[{driver: file, directory: %s, sidecar: ''}]", files);
+    char cmd[9000];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", files); /* a file left by an earlier run */
+    CHECK(system(cmd) == 0, "%s", cmd);
+    pid_t pid = serve("lost", opt);
+    struct nc_client *c = connect_to();
+    if (!c) {
+        CHECK(0, "no connection");
+        finish(pid);
+        return;
+    }
+    uint64_t f0 = 0, f1 = 0, f2 = 0;
+    capture(c, 1);
+    uint32_t s0 = one_answer(c, &f0);
+    /* Camera rates no render can follow: the render fails. */
+    struct nc_pose_msg m = {.type = NC_MSG_POSE, .flags = NC_MSG_CAPTURE | NC_MSG_CAMERA_RATES | NC_MSG_EXPOSURE,
+                            .sim_time_ns = 2000000000, .cam_position_m = {0, -3000, 0},
+                            .cam_attitude_q = {0.70710678118654752, -0.70710678118654752, 0, 0}, .sun = {1, 0, 0},
+                            .cam_velocity_m_s = {1e300, 0, 0}, .cam_angular_velocity_rad_s = {1e300, 0, 0},
+                            .exposure_s = 0.01};
+    nc_client_send(c, &m);
+    uint32_t s1 = one_answer(c, &f1);
+    capture(c, 3);
+    uint32_t s2 = one_answer(c, &f2);
+    CHECK(s0 == NC_FRAME_DELIVERED && s1 == NC_FRAME_DROPPED && s2 == NC_FRAME_DELIVERED && f2 == f0 + 1,
+          "render error: statuses %u %u %u, frames %llu then %llu (no gap)", s0, s1, s2, (unsigned long long)f0,
+          (unsigned long long)f2);
+    /* The output's directory gone (a file in its place): the frame is made
+     * and lost on the way out. */
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && touch '%s'", files, files);
+    CHECK(system(cmd) == 0, "%s", cmd);
+    capture(c, 4);
+    uint32_t s3 = one_answer(c, &f0);
+    CHECK(s3 == NC_FRAME_DROPPED, "a frame no output took: status %u", s3);
+    nc_client_close(c);
+    CHECK(finish(pid) == 0, "serve did not exit cleanly");
+    char log[4200];
+    snprintf(log, sizeof log, "%s/lost/serve.log", tmp);
+    size_t n;
+    char *text = nc_test_read(log, &n);
+    CHECK(text && nc_test_contains(text, "render_error 1") && nc_test_contains(text, "output_failed 1") &&
+              nc_test_contains(text, "output_busy 0") && nc_test_contains(text, "frames 2 "),
+          "drop reasons in the statistics:\n%s", text ? text : "(none)");
+    free(text);
+}
+
 /* UDP is fire and forget: with nothing listening, every send still
  * succeeds (the port-unreachable an earlier datagram met is not this
  * one's failure). */
@@ -258,5 +319,6 @@ int main(int argc, char **argv)
     fifty_clients_and_a_slow_one();
     refused_beyond_the_limit();
     shutdown_answers_everything();
+    failures_are_drops();
     return nc_test_end();
 }

@@ -64,6 +64,12 @@ int main(void)
               out.exposure_s == 0.001,
           "trigger message (%zu bytes)", tn);
 
+    /* A pose's block flags on a trigger: the length agrees with them (the
+     * trigger has no blocks) but they cannot mean anything. */
+    buf[16] |= NC_MSG_BODY_POSE;
+    reseal(buf, tn);
+    CHECK(nc_msg_decode(buf, tn, &out) == NC_REJECT_BAD_FLAGS, "a trigger flagged BODY_POSE is rejected");
+
     /* The minimal pose message of docs/protocol.md, byte for byte. */
     struct nc_pose_msg ex = {.type = NC_MSG_POSE, .sequence = 1, .flags = NC_MSG_CAPTURE, .sim_time_ns = 1000000000};
     ex.cam_position_m = nc_v3(0, -6000, 0);
@@ -99,6 +105,7 @@ int main(void)
     EXPECT(BAD_LENGTH, n, t[8] += 8, reseal(t, n));
     EXPECT(BAD_LENGTH, n + 8, memset(t + n, 0, 8));
     EXPECT(BAD_FLAGS, n, t[18] = 0x40, reseal(t, n));
+    EXPECT(BAD_FLAGS, n, t[20] = 0x12, reseal(t, n)); /* flags written into the reserved word */
     EXPECT(BAD_CRC, n, t[40] ^= 0x10);
     EXPECT(NOT_FINITE, n, put_f64(t + 32, NAN), reseal(t, n));
     EXPECT(NOT_FINITE, n, put_f64(t + 88, INFINITY), reseal(t, n));
