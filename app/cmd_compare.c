@@ -186,8 +186,6 @@ int main(int argc, char **argv)
         goto done;
     }
     nc_image_flip(real, sizeof *real, w, h, flip & 2, flip & 1);
-    if (dir && (rc = nc_mkdirs(dir)) < 0)
-        goto done;
     size_t n = (size_t)w * (size_t)h;
     if (!(rel = malloc(n * sizeof *rel)) || !(moved = malloc(n * sizeof *moved))) {
         rc = nc_error(-ENOMEM, "out of memory");
@@ -214,7 +212,8 @@ int main(int argc, char **argv)
     if ((rc = nc_texture_measure(real, w, h, &to, &tex[0])) < 0 ||
         (rc = nc_texture_measure(moved, w, h, &to, &tex[1])) < 0)
         goto done;
-    if (dir && (rc = plots(dir, rel, w, h, &res)) < 0)
+    /* made only now: a comparison that fails leaves no empty directory */
+    if (dir && ((rc = nc_mkdirs(dir)) < 0 || (rc = plots(dir, rel, w, h, &res)) < 0))
         goto done;
     FILE *out;
     if ((rc = nc_cli_out_open(json, &out)) < 0)

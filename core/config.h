@@ -52,6 +52,9 @@ int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top);
 struct nc_cfg_node *nc__cfg_find(struct nc_cfg_node *map, const char *key);
 /* Edit distance of two keys, two swapped neighbours counting one (config_read.c). */
 size_t nc__cfg_edits(const char *a, const char *b);
+/* The one of names[0..n-1] nearest key within a third of its letters'
+ * edits (a typo; none for one- or two-letter keys), else NULL. */
+const char *nc__cfg_nearest(const char *key, const char *const *names, size_t n);
 /* Child of a map by key, or NULL. Marks it used. */
 struct nc_cfg_node *nc_cfg_get(struct nc_cfg_node *map, const char *key);
 /* Readers: return 1 when the key was present and valid, 0 when absent

@@ -311,6 +311,18 @@ int nc_cfg_missing_any(const struct nc_cfg_node *map, const char *const *keys, c
 /* Edit distance of two keys (a few dozen characters): insertions,
  * deletions, substitutions and swaps of two neighbours (hurts: hurst)
  * count one each, as optimal string alignment. */
+const char *nc__cfg_nearest(const char *key, const char *const *names, size_t n)
+{
+    const char *best = NULL;
+    size_t bd = strlen(key) / 3;
+    for (size_t i = 0; i < n; i++) {
+        const size_t d = nc__cfg_edits(key, names[i]);
+        if (d <= bd && (!best || d < bd))
+            best = names[i], bd = d;
+    }
+    return best;
+}
+
 size_t nc__cfg_edits(const char *a, const char *b)
 {
     size_t la = strlen(a), lb = strlen(b), r0[65], r1[65], r2[65], *prev = r0, *row = r1, *back = r2;
@@ -381,13 +393,7 @@ int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
     /* The nearest key this section takes (a typo), else where the key is read
      * (a key in the wrong section), then every key this section takes. */
     char hint[1536] = "", where[512];
-    const char *best = NULL;
-    size_t bd = strlen(u->key) / 3; /* a third of its letters: none for one- or two-letter keys */
-    for (size_t i = 0; i < p->nasked; i++) {
-        const size_t d = nc__cfg_edits(u->key, p->asked[i]);
-        if (d <= bd && (!best || d < bd))
-            best = p->asked[i], bd = d;
-    }
+    const char *best = nc__cfg_nearest(u->key, (const char *const *)p->asked, p->nasked);
     for (size_t i = 0; i < p->nasked && !best; i++) { /* the key without its unit, or cut short */
         const char *a = p->asked[i], *k = u->key;
         const size_t la = strlen(a), lk = strlen(k);

@@ -34,10 +34,18 @@ int nc_params_check(const struct nc_cfg_node *map, const struct nc_param *const 
         const struct nc_param *p = NULL;
         for (int t = 0; t < ntables && !p; t++)
             p = find(tables[t], c->key);
-        if (!p) {
-            char keys[512];
+        if (!p) { /* the nearest key within a third of its letters' edits, as for any section */
+            char keys[512], hint[96] = "";
             key_list(tables, ntables, keys, sizeof keys);
-            return nc_cfg_error(c, "unknown key for %s (it takes: %s)", what, keys);
+            const char *names[64];
+            size_t n = 0;
+            for (int t = 0; t < ntables; t++)
+                for (const struct nc_param *q = tables[t]; q && q->key && n < 64; q++)
+                    names[n++] = q->key;
+            const char *best = nc__cfg_nearest(c->key, names, n);
+            if (best)
+                snprintf(hint, sizeof hint, "; did you mean '%s'?", best);
+            return nc_cfg_error(c, "unknown key for %s%s (it takes: %s)", what, hint, keys);
         }
         if (p->type == NC_PARAM_MAP && c->kind == NC_CFG_MAP) {
             const struct nc_param *sub[1] = {p->sub};

@@ -298,7 +298,7 @@ static const struct nc_param v4l2_params[] = {
     NC_P_ENUM("y16_align", "msb", aligns, "where Y16 puts the ADC's bits in each 16-bit word"),
     NC_P_ENUM("io", "auto", ios, "write() for v4l2loopback, mmap streaming elsewhere (auto)"),
     NC_P_DOUBLE("frame_rate_hz", NULL, 1e-3, 1000, "Hz", "frame interval announced to readers (default serve.frame_rate_hz)"),
-    NC_P_DOUBLE("reopen_interval_s", "1", 0, 3600, "s", "how often a lost device is looked for again"),
+    NC_P_DOUBLE("reopen_interval_s", "1", 0, 3600, "s", "how often a lost device is looked for again (0: never)"),
     NC_P_INT("reopen_limit", "0", 0, 1000000000, "", "give up after this many attempts (0: never)"),
     NC_P_END,
 };

@@ -43,13 +43,22 @@ static const void *select_driver(const void *const *list, struct nc_cfg_node *op
     }
     const void *drv = find(list, name);
     if (!drv) {
-        char names[256] = "";
+        char names[256] = "", hint[96] = "";
+        const char *all[32];
+        size_t n = 0;
         if (builtin)
-            snprintf(names, sizeof names, "%s", builtin);
-        for (int i = 0; list && list[i]; i++)
+            snprintf(names, sizeof names, "%s", builtin), all[n++] = builtin;
+        for (int i = 0; list && list[i]; i++) {
             snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", names[0] ? ", " : "",
                      driver_name(list[i]));
-        *rc = nc_cfg_error(nc_cfg_get(opts, "driver"), "unknown %s '%s' (this build has: %s)", kind, name, names);
+            if (n < 32)
+                all[n++] = driver_name(list[i]);
+        }
+        const char *best = nc__cfg_nearest(name, all, n);
+        if (best)
+            snprintf(hint, sizeof hint, "; did you mean '%s'?", best);
+        *rc = nc_cfg_error(nc_cfg_get(opts, "driver"), "unknown %s '%s'%s (this build has: %s)", kind, name, hint,
+                           names);
     }
     return drv;
 }

@@ -41,7 +41,7 @@ diff -u "$src/docs/drivers.md" "$tmp/drivers.md" > "$tmp/drivers.diff" && ok ||
   bad "docs/drivers.md differs from \`navcam serve --driver-docs\` (run make docs): $(head -20 "$tmp/drivers.diff")"
 # Unknown driver keys: file, line, key and what the driver takes, before any device is touched.
 printf 'base: builtin:default\noutputs:\n  - driver: file\n    patern: f_%%06llu.png\n' > "$tmp/outs.yaml"
-expect 1 "outs.yaml:4: outputs[0].patern: unknown key for output driver 'file' (it takes: driver, directory, pattern, fits_row_order, sidecar)" -- \
+expect 1 "outs.yaml:4: outputs[0].patern: unknown key for output driver 'file'; did you mean 'pattern'? (it takes: driver, directory, pattern, fits_row_order, sidecar)" -- \
   "$navcam" serve "$tmp/outs.yaml"
 expect 1 "serve.trigger.strobe.levle: unknown key for trigger driver 'gpio'" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: gpio, line: X, strobe: {line: Y, levle: low}}"
@@ -71,7 +71,7 @@ loaded() { LD_DEBUG=files "$@" 2>&1 >/dev/null | grep -c 'file=.*\(OpenImageIO\|
 [ "$(loaded "$navcam" render -o "$tmp/lazy.png" "${small[@]}" --set render.samples=4)" = 0 ] && ok ||
   bad "a PNG render's configuration error loads OpenImageIO"
 expect 0 "wrote $tmp/lazy.png" -- "$navcam" render -o "$tmp/lazy.png" "${small[@]}"
-expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9' (this build has: software, timer, gpio, usb)" -- \
+expect 1 "serve.trigger.driver: unknown trigger driver 'gpio9'; did you mean 'gpio'? (this build has: software, timer, gpio, usb)" -- \
   "$navcam" serve --set serve.mode=trigger --set "serve.trigger={driver: gpio9}"
 # The serve section, the trigger's and the outputs' keys and values are
 # checked before the scene is built: no scene line comes before the error.
@@ -121,6 +121,7 @@ expect 1 "outputs[0].pattern: expected a file name with one %llu conversion" -- 
   --set "outputs=[{driver: file, pattern: 'x%s_llu.png'}]"
 expect 1 "outputs[0].pattern: makes file names longer than 255 bytes" -- "$navcam" serve \
   --set "outputs=[{driver: file, pattern: 'f_%099llu_$(printf 'x%.0s' $(seq 160)).png'}]"
+expect 1 "unknown output driver 'nul'; did you mean 'null'?" -- "$navcam" serve --set "outputs=[{driver: nul}]"
 expect 2 "--position nan,0,0: not finite" -- "$navcam" pose send -P nan,0,0
 expect 2 "navcam pose send: unrecognized option '--bogus'" -- "$navcam" pose send --bogus
 expect 2 "navcam render: unrecognized option '--bogus'" -- "$navcam" render --bogus

@@ -45,7 +45,7 @@ static void test_tables(void)
     /* Unknown keys: file, line, path, and the keys that exist. */
     CHECK(load(&cfg, "rate_hz: 5\nrat_hz: 4\n") == 0, "load");
     int rc = nc_params_check(cfg.root, tables, 1, "driver 'x'");
-    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "t.yaml:2: rat_hz: unknown key for driver 'x'") &&
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "t.yaml:2: rat_hz: unknown key for driver 'x'; did you mean 'rate_hz'?") &&
               nc_test_contains(nc_errmsg(), "rate_hz, count, name"),
           "unknown key: %s", nc_errmsg());
     nc_cfg_free(&cfg);

@@ -54,8 +54,10 @@ static void report(const char *label, const struct stats *st)
     printf("%s: %d pixels, worst range error %.2e, worst radiance error %.2e, black %d\n", label, st->n,
            st->worst_range, st->worst_L, st->black);
     CHECK(st->n > 10000, "%s: only %d pixels checked", label, st->n);
-    CHECK(st->worst_range < 1e-3, "%s: range error %.3g", label, st->worst_range);
-    CHECK(st->worst_L < 1e-3, "%s: radiance error %.3g", label, st->worst_L);
+    /* relative, against the exact answer in double precision: float32
+     * radiance rounds at 6e-8; measured up to 1.7e-7 (range, mesh patch) */
+    CHECK(st->worst_range < 5e-7, "%s: range error %.3g", label, st->worst_range);
+    CHECK(st->worst_L < 5e-7, "%s: radiance error %.3g", label, st->worst_L);
     CHECK(st->black == 0, "%s: %d lit pixels rendered black (self-shadowing acne)", label, st->black);
 }
 
