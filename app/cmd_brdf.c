@@ -67,6 +67,10 @@ static void describe_models(char *buf, size_t len)
                                 nc_brdf_presets[i].model, nc_brdf_presets[i].keys, nc_brdf_presets[i].source);
 }
 
+/* The column header goes out with the first row, so that a run refused at
+ * its first geometry prints nothing on stdout. */
+static int header = 1;
+
 static int print_brdf_row(const struct nc_material *m, double i, double e, double g, const char *where)
 {
     double out[4];
@@ -74,11 +78,15 @@ static int print_brdf_row(const struct nc_material *m, double i, double e, doubl
         fprintf(stderr, "navcam brdf: %s: %s\n", where, nc_errmsg());
         return -1;
     }
+    if (header)
+        puts("i_deg,e_deg,g_deg,r,brdf,radf,reff");
+    header = 0;
     printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", i, e, g, out[0], out[1], out[2], out[3]);
     return 0;
 }
 
-/* Three comma-separated numbers, nothing else. */
+/* Three comma-separated numbers, nothing else: 0, or -1 - k for the field
+ * k (0 i, 1 e, 2 g) where it goes wrong. */
 static int parse_geometry(const char *s, double v[3])
 {
     const char *p = s;
@@ -88,20 +96,22 @@ static int parse_geometry(const char *s, double v[3])
             p++;
         v[k] = strtod(p, &end);
         if (end == p || !isfinite(v[k]))
-            return -1;
+            return -1 - k;
         p = end;
         while (*p == ' ' || *p == '\t')
             p++;
         if (k < 2) {
             if (*p != ',')
-                return -1;
+                return -1 - k;
             p++;
         }
     }
     while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
         p++;
-    return *p ? -1 : 0;
+    return *p ? -3 : 0;
 }
+
+static const char *const field_names[] = {"i", "e", "g"};
 
 int main(int argc, char **argv)
 {
@@ -114,7 +124,7 @@ int main(int argc, char **argv)
     };
     const char *model = NULL, *preset = NULL, *geometry = NULL;
     const char **params = calloc((size_t)argc + 1, sizeof *params);
-    int nparams = 0, header = 1, c, rc = 2;
+    int nparams = 0, c, rc = 2;
     char models[4096];
     struct nc_material m;
     memset(&m, 0, sizeof m);
@@ -171,12 +181,12 @@ int main(int argc, char **argv)
     }
     if (nc_material_finish(&m) < 0)
         goto fail;
-    if (header)
-        puts("i_deg,e_deg,g_deg,r,brdf,radf,reff");
     if (geometry) {
         double v[3];
-        if (parse_geometry(geometry, v) < 0) {
-            fprintf(stderr, "navcam brdf: --geometry expects I,E,G in degrees, got '%s'\n", geometry);
+        const int bad = parse_geometry(geometry, v);
+        if (bad < 0) {
+            fprintf(stderr, "navcam brdf: --geometry expects I,E,G in degrees, got '%s' (field %s)\n", geometry,
+                    field_names[-1 - bad]);
             goto out;
         }
         rc = print_brdf_row(&m, v[0], v[1], v[2], "--geometry") < 0 ? 1 : 0;
@@ -193,11 +203,13 @@ int main(int argc, char **argv)
         snprintf(where, sizeof where, "stdin:%ld", lineno);
         if (line[strspn(line, " \t\r\n")] == '\0')
             continue; /* blank */
-        if (parse_geometry(line, v) < 0) {
-            if (lineno == 1 && !strpbrk(line, "0123456789"))
+        const int bad = parse_geometry(line, v);
+        if (bad < 0) {
+            if (lineno == 1 && strpbrk(line, "ie") && !strpbrk(line, "0123456789"))
                 continue; /* the optional header */
             line[strcspn(line, "\r\n")] = '\0';
-            fprintf(stderr, "navcam brdf: %s: expected \"i,e,g\" in degrees, got \"%s\"\n", where, line);
+            fprintf(stderr, "navcam brdf: %s: expected \"i,e,g\" in degrees, got \"%s\" (field %s)\n", where, line,
+                    field_names[-1 - bad]);
             rc = 1;
             break;
         }

@@ -50,7 +50,7 @@ const struct nc_brdf_model nc_brdf_lambert = {
 /* ---- Lommel-Seeliger: r = w/(4 pi) mu0/(mu0 + mu) ------------------------ */
 
 static const struct nc_brdf_param ls_params[] = {
-    {"w", NAN, 0.0, 1.0, "1", "single-scattering albedo"},
+    {"w", NAN, 0.0, 1.0, "1", "the law's albedo factor (a sphere's geometric albedo is w/8; not a single-scattering albedo)"},
 };
 
 static void ls_eval(const double *p, const double *c, size_t n, const struct nc_photometry *geo, double *r)
@@ -61,7 +61,7 @@ static void ls_eval(const double *p, const double *c, size_t n, const struct nc_
 
 const struct nc_brdf_model nc_brdf_lommel_seeliger = {
     .name = "lommel_seeliger",
-    .description = "Lommel-Seeliger single scattering: r = w/(4 pi) mu0/(mu0 + mu)",
+    .description = "Lommel-Seeliger: r = w/(4 pi) mu0/(mu0 + mu)",
     .params = ls_params,
     .nparams = 1,
     .albedo_param = 0,

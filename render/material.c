@@ -218,7 +218,9 @@ int nc_material_eval_deg(const struct nc_material *m, double i, double e, double
         return nc_error(NC_ERANGE, "angles must be within 0..180 deg (got i = %g, e = %g, g = %g)", i, e, g);
     double gmin = fabs(i - e), gmax = fmin(i + e, 360.0 - i - e);
     if (g < gmin - tol || g > gmax + tol)
-        return nc_error(NC_ERANGE, "phase angle g = %g deg cannot occur with i = %g and e = %g (it must be within %g..%g)",
+        return nc_error(NC_ERANGE,
+                        "phase angle g = %.10g deg cannot occur with i = %.10g and e = %.10g (it must be within "
+                        "%.10g..%.10g, give or take 1e-6 deg)",
                         g, i, e, gmin, gmax);
     out[0] = out[1] = out[2] = out[3] = 0.0;
     if (i >= 90 || e >= 90)

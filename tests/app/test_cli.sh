@@ -226,7 +226,14 @@ out=$(printf 'i,e,g\n30,30,0\n\n60,0,60\n' | "$navcam" brdf --preset moon --no-h
 [ "$(printf '%s\n' "$out" | wc -l)" -eq 2 ] && ok || bad "brdf stdin: want 2 rows, got: $out"
 expect 1 "stdin:3: phase angle g = 100 deg cannot occur with i = 10 and e = 20" -- \
   sh -c "printf '30,30,0\n0,0,0\n10,20,100\n' | '$navcam' brdf --model lambert --param A=0.1"
-expect 1 "stdin:2: expected \"i,e,g\"" -- sh -c "printf '30,30,0\n30;30;0\n' | '$navcam' brdf --model lambert --param A=0.1"
+expect 1 "stdin:2: expected \"i,e,g\" in degrees, got \"30;30;0\" (field i)" -- \
+  sh -c "printf '30,30,0\n30;30;0\n' | '$navcam' brdf --model lambert --param A=0.1"
+expect 1 "(field e)" -- sh -c "printf '30,x,0\n' | '$navcam' brdf --model lambert --param A=0.1"
+# a run refused at its first geometry prints no header
+out=$("$navcam" brdf --preset moon --geometry 30,20,50.0000015 2> /dev/null)
+[ -z "$out" ] && ok || bad "brdf: a refused geometry printed '$out'"
+expect 1 "phase angle g = 50.0000015 deg cannot occur with i = 30 and e = 20 (it must be within 10..50, give or take 1e-6" \
+  -- "$navcam" brdf --preset moon --geometry 30,20,50.0000015
 expect 1 "parameter w must be in [0, 1], got 1.5" -- "$navcam" brdf --model hapke --param w=1.5 --geometry 0,0,0
 expect 1 "theta_bar must be in [0, 60]" -- "$navcam" brdf --model hapke --param w=0.5 --param theta_bar=70 --geometry 0,0,0
 expect 1 "phi must be in [0, 0.752]" -- "$navcam" brdf --model hapke --param w=0.5 --param phi=0.8 --geometry 0,0,0

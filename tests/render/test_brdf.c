@@ -315,8 +315,9 @@ static void albedo(void)
      * multiple scattering as isotropic (w -> 1 with strongly backscattering
      * particles), and the porosity factor K multiplies the whole expression.
      * Measured and reported (docs/reflectance.md), not hidden: */
-    const char *beyond[] = {"w=1 b=0.9 c=1 B_S0=1 h_S=0.02", "w=0.9 b=0.9 c=1 B_S0=1 h_S=0.02 phi=0.5", "w=1 phi=0.752"};
-    for (int k = 0; k < 3; k++) {
+    const char *beyond[] = {"w=1 b=0.9 c=1 B_S0=1 h_S=0.02", "w=0.9 b=0.9 c=1 B_S0=1 h_S=0.02 phi=0.5", "w=1 phi=0.752",
+                            "w=0.95 b=0.9 c=1 B_S0=1 h_S=0.05 B_C0=1 h_C=0.05"};
+    for (int k = 0; k < 4; k++) {
         struct nc_material x = make("hapke", beyond[k]);
         double xat = 0, xa = max_albedo(&x, &xat);
         CHECK(isfinite(xa), "%s: albedo not finite", beyond[k]);
