@@ -72,6 +72,19 @@ static int finish(pid_t pid)
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
 }
 
+/* A server (serve) and a client connected to it; NULL (the server
+ * stopped, the failure counted) when no connection came. */
+static struct nc_client *serve_one(const char *name, const char *extra, pid_t *pid)
+{
+    *pid = serve(name, extra);
+    struct nc_client *c = connect_to();
+    if (!c) {
+        CHECK(0, "%s: no connection: %s", name, nc_client_errmsg());
+        finish(*pid);
+    }
+    return c;
+}
+
 static long capture(struct nc_client *c, double t_s)
 {
     struct nc_pose_msg m = {.type = NC_MSG_POSE, .flags = NC_MSG_CAPTURE, .sim_time_ns = (int64_t)(t_s * 1e9),
@@ -106,13 +119,10 @@ static int answers(struct nc_client *c, uint32_t first, int n, const char *what)
 
 static void twenty_back_to_back(void)
 {
-    pid_t pid = serve("twenty", NULL);
-    struct nc_client *c = connect_to();
-    CHECK(c != NULL, "no connection: %s", nc_client_errmsg());
-    if (!c) {
-        finish(pid);
+    pid_t pid;
+    struct nc_client *c = serve_one("twenty", NULL, &pid);
+    if (!c)
         return;
-    }
     double t0 = now_s();
     for (int i = 0; i < 20; i++)
         capture(c, i * 0.1);
@@ -197,13 +207,10 @@ static void refused_beyond_the_limit(void)
 
 static void shutdown_answers_everything(void)
 {
-    pid_t pid = serve("shutdown", NULL);
-    struct nc_client *c = connect_to();
-    if (!c) {
-        CHECK(0, "no connection");
-        finish(pid);
+    pid_t pid;
+    struct nc_client *c = serve_one("shutdown", NULL, &pid);
+    if (!c)
         return;
-    }
     for (int i = 0; i < 20; i++)
         capture(c, i * 0.1);
     uint32_t seq, status;
@@ -248,13 +255,10 @@ static void failures_are_drops(void)
     char cmd[9000];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", files); /* a file left by an earlier run */
     CHECK(system(cmd) == 0, "%s", cmd);
-    pid_t pid = serve("lost", opt);
-    struct nc_client *c = connect_to();
-    if (!c) {
-        CHECK(0, "no connection");
-        finish(pid);
+    pid_t pid;
+    struct nc_client *c = serve_one("lost", opt, &pid);
+    if (!c)
         return;
-    }
     uint64_t f0 = 0, f1 = 0, f2 = 0;
     capture(c, 1);
     uint32_t s0 = one_answer(c, &f0);
