@@ -226,9 +226,13 @@ int main(int argc, char **argv)
         nc_rt_get_stats(r.rt, &st);
         for (int i = 0; i < scene.nbodies; i++)
             if (scene.body[i].boulders.n) {
-                printf("  boulders of '%s': %zu of %zu traced, %.3g m and larger (%g px)", scene.body[i].name,
-                       st.boulders_traced[i], scene.body[i].boulders.n, st.boulder_min_m[i],
-                       nc_scene_boulder_min_px(&scene, i));
+                if (st.boulder_min_m[i] > 0)
+                    printf("  boulders of '%s': %zu of %zu traced, %.3g m and larger (%g px)", scene.body[i].name,
+                           st.boulders_traced[i], scene.body[i].boulders.n, st.boulder_min_m[i],
+                           nc_scene_boulder_min_px(&scene, i));
+                else
+                    printf("  boulders of '%s': all %zu traced (%g px)", scene.body[i].name, scene.body[i].boulders.n,
+                           nc_scene_boulder_min_px(&scene, i));
                 int k = nc_material_roughness_param(&scene.body[i].material);
                 if (r.fold_theta_bar_deg[i] >= 0)
                     printf("; the rest (cover %.3g) folded into the reflectance: theta_bar %.3g -> %.3g deg\n",

@@ -29,7 +29,7 @@ struct nc_frame_record {
     double exposure_s, gain_db;
     int time_samples;            /* motion-smear time samples */
     double lod_error_m;          /* error bound of the meshes' levels of detail used, m (0: full meshes) */
-    double boulder_min_m;        /* smallest boulder diameter traced, m (0: every rock, or none) */
+    double boulder_min_m;        /* the boulder cut, m: rocks this size and larger traced (0: every rock, or none) */
     double boulder_mesh_px;      /* rocks of this many pixels or more traced as detailed surfaces (0: none) */
     double rock_fold_theta_bar_deg; /* roughness the rocks not traced were folded into, deg (-1: none) */
     int samples_per_pixel, bounces, soft_shadows, quality_auto; /* the render settings used (auto: its choice) */

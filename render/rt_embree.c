@@ -539,7 +539,9 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             nc__rt_rocks_cut(&b->rocks, nc_scene_boulder_min_px(s, i) * px_m);
             nc__rt_rocks_place(&b->rocks, &R, b->origin_rel);
             nc__rt_rocks_mesh_px(&b->rocks, s->render.boulder_mesh_px, 1 / fmax(s->camera.fx_px, s->camera.fy_px));
-            rt->stats.boulder_min_m[i] = b->rocks.min_d_m;
+            /* recorded as 0 when the cut leaves no rock out (it lies below
+             * the smallest): every rock traced */
+            rt->stats.boulder_min_m[i] = b->rocks.traced < src->boulders.n ? b->rocks.min_d_m : 0;
             /* recorded where a rock can have its detailed surface: the
              * largest spans the pixels asked for at the nearest possible range */
             const int can_mesh = b->rocks.mesh_k2 > 0 && b->rocks.traced &&

@@ -261,6 +261,19 @@ static void check_cut(void)
     size_t n = (size_t)fb.width_px * fb.height_px;
     CHECK(traced[2] == 0 && !memcmp(f[2].radiance, fb.radiance, n * sizeof *fb.radiance),
           "every rock cut: the frame differs from the bare body's");
+    /* a cut below the smallest rock leaves none out: recorded as 0 */
+    struct nc_scene low;
+    const char *low_sets[2] = {sets[0][0], "render.boulder_min_px=0.01"};
+    nc_test_scene(nc_test_asteroid_yaml, low_sets, 2, &low);
+    struct nc_rt *lrt;
+    CHECK(nc_rt_create(&low, 2, &lrt) == 0, "%s", nc_errmsg());
+    struct nc_rt_stats lst;
+    nc_rt_get_stats(lrt, &lst);
+    CHECK(lst.boulders_traced[0] == bf->n && nc_rt_boulder_min_m(lrt) == 0,
+          "a cut of 0.01 px (%.3g m) traces %zu of %zu and records %.3g m, want every rock and 0", 0.01 * px_m,
+          lst.boulders_traced[0], bf->n, nc_rt_boulder_min_m(lrt));
+    nc_rt_destroy(lrt);
+    nc_scene_free(&low);
     /* A Lambert body cannot fold the rocks left out into its reflectance
      * (it has no roughness): without the small rocks' shadows it is
      * brighter, by less than the area they cover (about 0.375 D^-0.9 of
