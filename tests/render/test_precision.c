@@ -2,7 +2,7 @@
  * float precision artefacts, because geometry is stored relative to an anchor
  * near the camera. In body-fixed float coordinates a Moon-radius position is
  * quantised to 0.125 m, which would put 10% errors on a 1 m range; here range
- * and radiance must match the exact double-precision answer to 1e-3.
+ * and radiance must match the exact double-precision answer to 5e-7.
  *  A: exact analytic sphere of the Moon's radius.
  *  B: a triangle mesh patch (given in km) lying on z = -R_moon.
  *  C: the same patch seen from about one Moon radius beyond the body's

@@ -1,8 +1,12 @@
 /* test_sphere.c - a sphere and a rotated triaxial ellipsoid seen by a pinhole
  * camera at finite distance agree per pixel with the exact ray-quadric image
- * computed here independently in double precision, at phase angles 0..150 deg:
+ * computed here in double precision (its own pinhole and rotations; the
+ * reflectance through the model's interface, which test_brdf checks against
+ * independent formulas), at phase angles 0..140 deg at the boresight:
  * Lambert, and Hapke (where emission and phase angles matter too, so every
- * hit's i, e and g must be right). */
+ * hit's i, e and g must be right). The sphere is `type: sphere`, the
+ * ellipsoid `type: ellipsoid`, turned, with the Sun turned into its frame so
+ * that the phase is the one named. */
 #include <math.h>
 #include <stdio.h>
 
@@ -10,7 +14,7 @@
 
 static const char yaml[] =
     "bodies:\n"
-    "  - shape: {type: ellipsoid, radii_m: [1000, 1000, 1000]}\n"
+    "  - shape: {type: sphere, radius_m: 1000}\n"
     "    material: {model: lambert, A: 0.3}\n"
     "sun: {direction: [0, 0, -1], distance_au: 1.0}\n"
     "camera:\n"
@@ -23,16 +27,32 @@ static const char yaml[] =
     "  position_m: [0, 0, -4000]\n"
     "  attitude_q: [1, 0, 0, 0]\n";
 
+/* The body's semi-axes, m (set per case in main). */
+static double radii[3];
+
+/* v turned by the unit quaternion q = [w, x, y, z] (or by its inverse),
+ * written out here from v' = v + 2w (u x v) + 2 u x (u x v), u = (x, y, z),
+ * so that the reference shares no code with the renderer's rotations. */
+static struct nc_vec3 turn(struct nc_quat q, int inverse, struct nc_vec3 v)
+{
+    const double w = q.w, ux = inverse ? -q.x : q.x, uy = inverse ? -q.y : q.y, uz = inverse ? -q.z : q.z;
+    const double cx = uy * v.z - uz * v.y, cy = uz * v.x - ux * v.z, cz = ux * v.y - uy * v.x;
+    return nc_v3(v.x + 2 * (w * cx + uy * cz - uz * cy), v.y + 2 * (w * cy + uz * cx - ux * cz),
+                 v.z + 2 * (w * cz + ux * cy - uy * cx));
+}
+
 /* Exact reference: ray from camera through pixel (x, y) against the ellipsoid
- * with semi-axes r; returns radiance or -1 for a miss, and mu (cos emission). */
+ * with semi-axes radii; returns radiance or -1 for a miss, and mu (cos
+ * emission). The pinhole as docs/config.md states it: pixel centres at
+ * whole coordinates, x right, y down, z along the boresight. */
 static double exact(const struct nc_scene *s, double x, double y, double *mu_out)
 {
     const struct nc_camera *c = &s->camera;
-    const double *r = &s->body[0].radii_m.x;
+    const double *r = radii;
     /* Work in the body frame: the Sun is given there. */
-    struct nc_quat qb_inv = nc_quat_conj(s->body[0].attitude_q);
-    struct nc_vec3 d = nc_quat_rotate(qb_inv, nc_v3_unit(nc_quat_rotate(c->attitude_q, nc_camera_dir(c, x, y))));
-    struct nc_vec3 o = nc_quat_rotate(qb_inv, nc_v3_sub(c->position_m, s->body[0].position_m));
+    struct nc_vec3 dc = nc_v3((x - c->cx_px) / c->fx_px, (y - c->cy_px) / c->fy_px, 1.0);
+    struct nc_vec3 d = turn(s->body[0].attitude_q, 1, nc_v3_unit(turn(c->attitude_q, 0, dc)));
+    struct nc_vec3 o = turn(s->body[0].attitude_q, 1, nc_v3_sub(c->position_m, s->body[0].position_m));
     double op[3] = {o.x / r[0], o.y / r[1], o.z / r[2]}, dp[3] = {d.x / r[0], d.y / r[1], d.z / r[2]};
     double A = 0, B = 0, C = -1;
     for (int k = 0; k < 3; k++) {
@@ -84,29 +104,41 @@ static void compare(const char *label, const struct nc_scene *s)
             compared++;
             lit++;
         }
-    CHECK(lit > 100, "%s: only %d lit pixels compared", label, lit);
-    CHECK(worst < 1e-3, "%s: worst relative error %.3g over %d pixels", label, worst, compared);
+    CHECK(lit > 50, "%s: only %d lit pixels compared", label, lit);
+    /* the float32 image rounds at 6e-8 */
+    CHECK(worst < 2e-7, "%s: worst relative error %.3g over %d pixels", label, worst, compared);
     CHECK(bad_hit == 0, "%s: %d pixels disagree on hit/miss or shadow", label, bad_hit);
     printf("%-34s lit pixels %5d  worst rel. error %.2e\n", label, lit, worst);
     nc_frame_free(&f);
 }
 
+/* the rotated body's attitude (body -> scene), as set below */
+static const struct nc_quat body_q = {0.9238795325112867, 0.0, 0.3826834323650898, 0.0};
+
 int main(void)
 {
-    const double phases_deg[] = {0, 30, 90, 150};
+    const double phases_deg[] = {0, 30, 90, 140};
     for (int shape = 0; shape < 4; shape++)
         for (size_t k = 0; k < sizeof phases_deg / sizeof phases_deg[0]; k++) {
             double g = phases_deg[k] * M_PI / 180;
             char sun[128], label[64];
-            /* The Sun turns about the body y axis away from the camera direction (-z). */
-            snprintf(sun, sizeof sun, "sun.direction=[%.17g, 0, %.17g]", sin(g), -cos(g));
+            /* The Sun turns about the scene's y axis away from the camera
+             * direction (-z), by the phase angle at the boresight. The Sun
+             * is given in the body frame: for the rotated body, that
+             * direction turned into it. */
+            struct nc_vec3 sun_scene = nc_v3(sin(g), 0, -cos(g)), sb = sun_scene;
+            if (shape == 1 || shape == 3)
+                sb = turn(body_q, 1, sun_scene);
+            snprintf(sun, sizeof sun, "sun.direction=[%.17g, %.17g, %.17g]", sb.x, sb.y, sb.z);
             const char *sets[5] = {sun};
             int nsets = 1;
             if (shape >= 2) /* a model in which e and g matter: Hapke, rough, with opposition surge */
                 sets[nsets++] = shape == 2 ? "bodies.0.material={preset: comet_67p}"
                                            : "bodies.0.material={preset: moon, B_C0: 0.5, h_C: 0.02}";
+            radii[0] = radii[1] = radii[2] = 1000;
             if (shape == 1 || shape == 3) {
-                sets[nsets++] = "bodies.0.shape.radii_m=[1300, 800, 600]";
+                sets[nsets++] = "bodies.0.shape={type: ellipsoid, radii_m: [1300, 800, 600]}";
+                radii[0] = 1300, radii[1] = 800, radii[2] = 600;
                 /* A rotated body and an off-axis camera pose. */
                 sets[nsets++] = "bodies.0.attitude_q=[0.9238795325112867, 0.0, 0.3826834323650898, 0.0]";
                 sets[nsets++] = "camera.attitude_q=[0.99984769515639127, 0.0, 0.0, 0.017452406437283512]";
