@@ -273,6 +273,7 @@ struct surf {
     int body[NC_PACKET];      /* -1: none (a miss, or a float hit the exact shape refutes) */
     int outside[NC_PACKET];   /* the ray came from the outer side of the surface */
     double t[NC_PACKET];      /* ray parameter, m */
+    double scale[NC_PACKET];  /* the float error's scale there, m: t, or more for a refined mesh hit */
     struct nc_vec3 p[NC_PACKET];    /* position relative to the camera, scene frame, m */
     struct nc_vec3 n[NC_PACKET];    /* unit normal, turned to face the ray's origin */
     struct nc_vec3 d[NC_PACKET];    /* the ray's unit direction */
@@ -311,14 +312,13 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
 {
     for (int i = 0; i < NC_PACKET; i++) {
         const struct nc_vec3 d = dir[i];
-        const double t = hit->t[i];
+        const double t = s->t[i];
         struct nc_vec3 nrm = nc_v3(un[0][i], un[1][i], un[2][i]);
         const int outside = nc_v3_dot(nrm, d) <= 0;
         const double flip = outside ? 1.0 : -1.0; /* as nc_v3_scale(nrm, -1.0) */
         nrm = nc_v3(nrm.x * flip, nrm.y * flip, nrm.z * flip);
         s->body[i] = hit->body[i];
         s->outside[i] = outside;
-        s->t[i] = t;
         s->p[i] = nc_v3_add(orig[i], nc_v3_scale(d, t));
         s->n[i] = nrm;
         s->d[i] = d;
@@ -335,6 +335,10 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
     const struct nc_scene *sc = j->s;
     double un[3][NC_PACKET];
     unit_normals(hit, un);
+    for (int i = 0; i < NC_PACKET; i++)
+        s->t[i] = s->scale[i] = hit->t[i];
+    if (nc_rt_refine_on(j->rt))
+        nc_rt_refine_mesh16(j->rt, hit, orig, dir, s->t, s->scale);
     if (j->plain) {
         plain_lanes(j, hit, orig, dir, (const double(*)[NC_PACKET])un, s);
         return;
@@ -344,7 +348,7 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
         if (hit->body[i] < 0)
             continue;
         struct nc_vec3 d = dir[i], nrm;
-        double t = hit->t[i];
+        double t = s->t[i];
         int exact = nc_rt_refine(j->rt, hit->body[i], orig[i], d, &t, &nrm);
         if (exact < 0) { /* the float trace grazed a limb the exact shape misses */
             s->body[i] = -1;
@@ -352,6 +356,8 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
         }
         if (exact == 0)
             nrm = nc_v3(un[0][i], un[1][i], un[2][i]);
+        else /* an analytic body's exact hit */
+            s->scale[i] = t;
         s->outside[i] = nc_v3_dot(nrm, d) <= 0;
         if (!s->outside[i]) /* back face: inconsistent winding, or the ray from inside */
             nrm = nc_v3_scale(nrm, -1.0);
@@ -436,7 +442,7 @@ hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *sha
     int any = 0;
     for (int i = 0; i < NC_PACKET; i++) {
         const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i], p = s->p[i];
-        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->t[i];
+        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->scale[i];
         const int on = (s->body[i] >= 0) & (mu0 > 0) & (mu > 0);
         geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, d), s->factor[i]};
         shadow->ox[i] = (float)(p.x + eps * nrm.x);
@@ -490,7 +496,7 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
             /* Offset the origin off the surface by a few float ulps of the
              * camera-relative coordinates (a bounce's t can be far shorter than
              * the point's distance from the camera); tnear stays 0. */
-            double eps = 4e-6 * (depth ? fmax(s->t[i], nc_v3_norm(s->p[i])) : s->t[i]);
+            double eps = 4e-6 * (depth ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : s->scale[i]);
             struct nc_vec3 p = s->p[i];
             shadow.ox[i] = (float)(p.x + eps * nrm.x);
             shadow.oy[i] = (float)(p.y + eps * nrm.y);

@@ -30,6 +30,8 @@ struct nc_hit16 {
     int body[NC_PACKET];                   /* body index, -1 for a miss */
     float albedo[NC_PACKET];               /* factor on the albedo there (albedo_var.h; 1: none) */
     int32_t rock[NC_PACKET];               /* the boulder hit (its index in the body's list), -1: none */
+    uint32_t prim[NC_PACKET];              /* the body's own triangle hit, in its level's list (set where
+                                              nc_rt_refine_on: nc_rt_refine_mesh16 reads it) */
 };
 
 struct nc_rt_stats {
@@ -96,6 +98,18 @@ int nc_rt_block_listed(const struct nc_rt *rt, int px0, int py0);
  * the limb that is not there, to be treated as a miss. */
 int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct nc_vec3 d, double *t,
                  struct nc_vec3 *n);
+/* Whether some mesh body is close enough this frame for its float geometry
+ * to matter (its anchor near the camera): then nc_rt_refine_mesh16 serves. */
+int nc_rt_refine_on(const struct nc_rt *rt);
+/* For the lanes of hit on such a body's own triangles (not rocks) nearer
+ * than 64 times its longest edge, where the float vertices (coordinates up
+ * to an edge from the anchor) would err by more than 6e-8 of the range:
+ * t[i] recomputed in double precision from the mesh's double vertices, for
+ * the camera-relative ray orig[i] + t dir[i] (dir unit), and scale[i] (the
+ * float error's scale, m: t[i] on entry) set to t plus that edge. Lanes not
+ * refined keep t[i] and scale[i]. */
+void nc_rt_refine_mesh16(const struct nc_rt *rt, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
+                         const struct nc_vec3 *dir, double *t, double *scale);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
 /* Shadow rays that need no full trace: from[i] >= 0 says ray i leaves the

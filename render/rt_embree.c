@@ -60,6 +60,8 @@ struct rt_body {
     double cull_radius_m; /* the bounding sphere padded for float rays, at the last update */
     struct nc_vec3 anchor_m; /* body frame; geometry is stored relative to it */
     int anchored;
+    int refine;                             /* a mesh anchored near the camera: nc_rt_refine_mesh16 */
+    double max_edge_m[NC_LOD_MAX_LEVELS];   /* each level's longest edge, m (0: not measured yet) */
     unsigned anchor_gen;
     /* Analytic ellipsoid in anchor-relative coordinates. */
     double centre[3], radii[3];
@@ -77,6 +79,7 @@ struct nc_rt {
      * the bins, need only test the rocks (rt_rocks.h). */
     RTCScene solo;
     int rocks_on;
+    int refine_on; /* some body's refine, at the last update */
     struct rt_body body[NC_MAX_BODIES];
     int nbodies;
     /* Instance ID -> body (the body's own, or a tile of its rocks) and the
@@ -384,6 +387,18 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
     return 0;
 }
 
+/* The longest edge of nt triangles tri of mesh m, m. */
+static double longest_edge(const struct nc_mesh *m, const unsigned *tri, size_t nt)
+{
+    double e2 = 0;
+    for (size_t k = 0; k < 3 * nt; k++) {
+        const double *a = m->v + 3 * (size_t)tri[k], *b = m->v + 3 * (size_t)tri[k % 3 == 2 ? k - 2 : k + 1];
+        const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+        e2 = fmax(e2, dx * dx + dy * dy + dz * dz);
+    }
+    return sqrt(e2);
+}
+
 static void reanchor(struct rt_body *b, struct nc_vec3 a)
 {
     b->anchor_m = a;
@@ -467,6 +482,7 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
     const struct nc_vec3 cam = s->camera.position_m;
     int rc;
     rt->rocks_on = 0;
+    rt->refine_on = 0;
     for (int i = 0; i < rt->nbodies; i++) {
         struct rt_body *b = &rt->body[i];
         const struct nc_body *src = &s->body[i];
@@ -502,6 +518,10 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             reanchor(b, a);
             rt->stats.reanchors++;
         }
+        /* anchored at the origin, every vertex carries at most 6e-8 R of
+         * every range (above); near the camera, an edge's length can exceed
+         * the range */
+        b->refine = !b->analytic && (a.x != 0 || a.y != 0 || a.z != 0);
         /* Level of detail: the coarsest whose surface error stays within
          * render.lod_error_px pixels at the nearest possible range (the
          * bounding sphere; the finest pixel axis). A function of the pose. */
@@ -514,6 +534,9 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             rtcSetGeometryInstancedScene(b->inst, b->scene[k]);
             b->level = k;
         }
+        if (b->refine && b->max_edge_m[k] == 0)
+            b->max_edge_m[k] = longest_edge(&b->src->mesh, b->tri[k], b->nt[k]);
+        rt->refine_on |= b->refine;
         rt->stats.lod_level[i] = k;
         rt->stats.lod_triangles[i] = b->nt[k];
         rt->stats.lod_error_m[i] = b->error_m[k];
@@ -694,6 +717,7 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
     }
     put_surface(b, (int)rt->geom_to_body[inst], t, x, y, z, alb, hit, i);
     hit->rock[i] = rock;
+    hit->prim[i] = prim;
 }
 
 static void put_miss(struct nc_hit16 *hit, int i)
@@ -846,6 +870,8 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
                 const struct rt_body *b = &rt->body[bi];
                 if (!b->vnormal && !b->src->albedo_vertex) { /* put_hit's steps for a flat, uniform facet */
                     put_surface(b, bi, t[q][i], ct->ng[0], ct->ng[1], ct->ng[2], 1.0f, h, i);
+                    if (b->refine)
+                        nc__bins_which(&rt->bins, slot[q][i], &h->prim[i]);
                     continue;
                 }
                 float u = 0, v = 0;
@@ -859,6 +885,40 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
         else if (rt->rocks_on)
             for (int q = 0; q < m; q++)
                 rocks_over(rt, &ray[q0 + q], &hit[q0 + q]);
+    }
+}
+
+int nc_rt_refine_on(const struct nc_rt *rt) { return rt->refine_on; }
+
+void nc_rt_refine_mesh16(const struct nc_rt *rt, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
+                         const struct nc_vec3 *dir, double *t, double *scale)
+{
+    for (int i = 0; i < NC_PACKET; i++) {
+        const int bi = hit->body[i];
+        if (bi < 0 || hit->rock[i] >= 0)
+            continue;
+        const struct rt_body *b = &rt->body[bi];
+        const double edge = b->max_edge_m[b->level];
+        if (!b->refine || !(t[i] < 64 * edge))
+            continue;
+        /* body frame: o = R^T (origin - origin_rel), d' = R^T d; the plane
+         * through the triangle's double vertices, taken relative to its
+         * first vertex (no cancellation between a Moon's radius and a metre) */
+        const unsigned *tr = b->tri[b->level] + 3 * (size_t)hit->prim[i];
+        const double *v0 = b->src->mesh.v + 3 * (size_t)tr[0], *v1 = b->src->mesh.v + 3 * (size_t)tr[1],
+                     *v2 = b->src->mesh.v + 3 * (size_t)tr[2];
+        const struct nc_vec3 o = nc_mat_tmul_v(&b->R, nc_v3_sub(orig[i], b->origin_rel)),
+                             d = nc_mat_tmul_v(&b->R, dir[i]);
+        const struct nc_vec3 e1 = nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]),
+                             e2 = nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]),
+                             w = nc_v3(v0[0] - o.x, v0[1] - o.y, v0[2] - o.z), n = nc_v3_cross(e1, e2);
+        const double nd = nc_v3_dot(n, d), tt = nc_v3_dot(n, w) / nd;
+        /* a plane seen edge-on, or a float hit on another triangle than
+         * the double ray meets (at an edge): the float answer stands */
+        if (!(fabs(tt - t[i]) <= 1e-4 * t[i] + 1e-3 * edge) || !(tt > 0))
+            continue;
+        t[i] = tt;
+        scale[i] = tt + edge;
     }
 }
 

@@ -7,7 +7,12 @@
  *  B: a triangle mesh patch (given in km) lying on z = -R_moon.
  *  C: the same patch seen from about one Moon radius beyond the body's
  *     bounding sphere, on either side of the point where the mesh's anchor
- *     becomes the body's origin (render/rt_embree.c): range within 2e-7. */
+ *     becomes the body's origin (render/rt_embree.c): range within 2e-7.
+ *  D: a patch of the same 100 m facets tangent to the sphere off every axis,
+ *     the camera 1 m and 1.3 m above it: its float vertices, up to an edge
+ *     from the anchor, alone would err by 3e-6 of the range and shadow a
+ *     lit pixel (false self-shadowing); the hits are recomputed in double
+ *     from the mesh's vertices (nc_rt_refine_mesh16). */
 #include <math.h>
 #include <string.h>
 #include <stdio.h>
@@ -151,6 +156,53 @@ int main(void)
                     : "mesh patch, camera 1.01 R beyond its bounding sphere (anchor at the body's origin)",
                &st);
         CHECK(st.worst_range < 2e-7, "far mesh: range error %.3g", st.worst_range);
+        nc_frame_free(&f);
+        nc_scene_free(&s);
+    }
+
+    /* D: tangent at u, off every axis; t1, t2 along the patch. */
+    const struct nc_vec3 u = nc_v3_unit(nc_v3(1, 2, 3)), t1 = nc_v3_unit(nc_v3_cross(u, nc_v3(0, 0, 1))),
+                         t2 = nc_v3_cross(u, t1), sun = nc_v3_unit(nc_v3_add(nc_v3_scale(u, 0.6), nc_v3_scale(t2, 0.8)));
+    const char *tilted = nc_test_path("moon_patch_tilted.obj");
+    fo = fopen(tilted, "w");
+    for (int j = 0; j <= N; j++)
+        for (int i = 0; i <= N; i++) {
+            struct nc_vec3 v = nc_v3_add(nc_v3_scale(u, R_MOON), nc_v3_add(nc_v3_scale(t1, -1000 + 2000.0 * i / N),
+                                                                            nc_v3_scale(t2, -1000 + 2000.0 * j / N)));
+            fprintf(fo, "v %.17g %.17g %.17g\n", v.x / 1000, v.y / 1000, v.z / 1000);
+        }
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            int a = j * (N + 1) + i + 1, b = a + 1, cc = a + N + 1, dd = cc + 1;
+            fprintf(fo, "f %d %d %d\nf %d %d %d\n", a, b, dd, a, dd, cc);
+        }
+    fclose(fo);
+    snprintf(shape, sizeof shape, "bodies.0.shape={type: mesh, file: '%s', unit: km}", tilted);
+    for (int k = 0; k < 2; k++) {
+        const double h = k ? 1.3 : 1.0;
+        const struct nc_vec3 cam = nc_v3_scale(u, R_MOON + h), at = nc_v3_add(nc_v3_scale(u, R_MOON), nc_v3_scale(t1, 3));
+        char pos[200], look[200], up[200], sd[200];
+        snprintf(pos, sizeof pos, "camera.position_m=[%.17g, %.17g, %.17g]", cam.x, cam.y, cam.z);
+        snprintf(look, sizeof look, "camera.look_at_m=[%.17g, %.17g, %.17g]", at.x, at.y, at.z);
+        snprintf(up, sizeof up, "camera.up=[%.17g, %.17g, %.17g]", u.x, u.y, u.z);
+        snprintf(sd, sizeof sd, "sun.direction=[%.17g, %.17g, %.17g]", sun.x, sun.y, sun.z);
+        const char *tl[] = {shape, pos, look, up, sd};
+        nc_test_scene(yaml_sphere, tl, 5, &s);
+        nc_test_render(&s, 2, &f);
+        memset(&st, 0, sizeof st);
+        for (int y = 0; y < c->height_px; y++)
+            for (int x = 0; x < c->width_px; x++) {
+                struct nc_vec3 d = nc_v3_unit(nc_quat_rotate(c->attitude_q, nc_camera_dir(c, x, y)));
+                double ud = nc_v3_dot(u, d);
+                if (ud >= -0.05)
+                    continue;
+                double t = -h / ud; /* the plane through R u, normal u */
+                struct nc_vec3 p = nc_v3_sub(nc_v3_add(cam, nc_v3_scale(d, t)), nc_v3_scale(u, R_MOON));
+                if (fabs(nc_v3_dot(p, t1)) > 990 || fabs(nc_v3_dot(p, t2)) > 990)
+                    continue;
+                check_pixel(&st, &f, x, y, t, 0.12 / M_PI * nc_v3_dot(u, sun) * s.sun.irradiance_w_m2);
+            }
+        report(k ? "mesh patch off every axis, camera 1.3 m up" : "mesh patch off every axis, camera 1 m up", &st);
         nc_frame_free(&f);
         nc_scene_free(&s);
     }
