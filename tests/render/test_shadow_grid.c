@@ -202,9 +202,14 @@ static void check_render(const char *what, const char *rocks, double min_spared)
     }
     printf("%s: %d of %d pixels differ (%d darker with the proof)\n", what, differ, n, darker);
     /* A proven ray meets nothing: a traced one can only add a spurious
-     * float hit, never light. */
+     * float hit, never light. (That the proof is sound, that no proven ray
+     * meets the mesh, is check_grid's exhaustive cast; this is the frame.)
+     * Without rocks the frames are equal; with them a full trace of a ray
+     * grazing the ground near the terminator can stop on the triangle it
+     * leaves (docs/terrain.md): 6 pixels measured, all brighter with the
+     * proof. */
     CHECK(sum > 0 && darker == 0, "%d pixels darker with the proof", darker);
-    CHECK(differ <= n / 1000, "%d pixels differ", differ);
+    CHECK(rocks ? differ <= n / 1000 : differ == 0, "%d pixels differ", differ);
     nc_frame_free(&a);
     nc_frame_free(&b);
     nc_renderer_free(&ra);
