@@ -31,8 +31,8 @@ static const char replay_help[] =
     "the scene frame when bodies[0] sits at the origin unturned (docs/sumfiles.md).\n"
     "\n"
     "  -l, --lockstep        TCP; send each pose and wait for its frame before the next\n"
-    "  -x, --speed X         pace rows at X times real time (default 1; 0 = as fast as\n"
-    "                        possible); ignored with --lockstep\n"
+    "  -x, --speed X         pace rows at X times real time, 1e-6 to 1e6 (default 1;\n"
+    "                        0 = as fast as possible); ignored with --lockstep\n"
     "  -H, --host ADDR       numeric IPv4 address (default 127.0.0.1)\n"
     "  -p, --port N          default 5751 (TCP, lock-step) or 5750 (UDP)\n"
     "  -T, --timeout-ms N    lock-step wait per frame (default 60000)\n"
@@ -79,7 +79,13 @@ int main(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "lx:H:p:T:w:h", opts, NULL)) != -1 && !bad) {
         switch (c) {
         case 'l': lockstep = 1; break;
-        case 'x': bad = nc_cli_double("speed", optarg, 0, 1e6, &speed); break;
+        case 'x':
+            bad = nc_cli_double("speed", optarg, 0, 1e6, &speed);
+            if (!bad && speed > 0 && speed < 1e-6) { /* a row's wait would overflow a time_t */
+                fprintf(stderr, "navcam replay: --speed expects 0 or 1e-06..1e+06, got '%s'\n", optarg);
+                bad = 1;
+            }
+            break;
         case 'H': host = optarg; break;
         case 'p': bad = nc_cli_long("port", optarg, 1, 65535, &port); break;
         case 'T': bad = nc_cli_long("timeout-ms", optarg, 1, 86400000, &timeout_ms); break;

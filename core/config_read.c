@@ -308,9 +308,7 @@ int nc_cfg_missing_any(const struct nc_cfg_node *map, const char *const *keys, c
     return missing(map, NULL, msg, best, meant);
 }
 
-/* Edit distance of two keys (a few dozen characters): insertions,
- * deletions, substitutions and swaps of two neighbours (hurts: hurst)
- * count one each, as optimal string alignment. */
+/* The nearest of names within a third of key's letters' edits. */
 const char *nc__cfg_nearest(const char *key, const char *const *names, size_t n)
 {
     const char *best = NULL;
@@ -323,6 +321,9 @@ const char *nc__cfg_nearest(const char *key, const char *const *names, size_t n)
     return best;
 }
 
+/* Edit distance of two keys (a few dozen characters): insertions,
+ * deletions, substitutions and swaps of two neighbours (hurts: hurst)
+ * count one each, as optimal string alignment. */
 size_t nc__cfg_edits(const char *a, const char *b)
 {
     size_t la = strlen(a), lb = strlen(b), r0[65], r1[65], r2[65], *prev = r0, *row = r1, *back = r2;

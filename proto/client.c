@@ -51,7 +51,8 @@ long nc_client_send(struct nc_client *c, struct nc_pose_msg *m)
     m->sequence = c->next_sequence++;
     size_t n = nc_msg_encode(m, buf + 4, NC_PROTO_MAX_BYTES);
     if (!n)
-        return nc_error(-EMSGSIZE, "message too large");
+        return nc_error(-EINVAL, "message not encodable: flags 0x%x are not those of message type %d "
+                                 "(docs/protocol.md)", m->flags, (int)m->type);
     for (int i = 0; i < 4; i++)
         buf[i] = (uint8_t)(n >> (8 * i));
     const uint8_t *p = c->tcp ? buf : buf + 4;

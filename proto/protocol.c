@@ -57,7 +57,7 @@ static uint8_t *put_quat(uint8_t *p, struct nc_quat q)
 size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap)
 {
     size_t n = nc_msg_size(m->type, m->flags);
-    if (n > cap)
+    if (n > cap || (m->flags & ~NC_MSG_KNOWN_FLAGS) || (m->type != NC_MSG_POSE && (m->flags & NC_MSG_POSE_ONLY_FLAGS)))
         return 0;
     nc_le_put_u32(buf, NC_PROTO_MAGIC);
     nc_le_put_u16(buf + 4, NC_PROTO_VERSION);
@@ -144,8 +144,8 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
     /* Bits no version-1 message has, a pose's blocks on another type, or
      * a reserved word not 0 (a sender that wrote its flags there, say):
      * what the sender meant cannot be known. */
-    const uint32_t pose_only = NC_MSG_SUN_POSITION | NC_MSG_BODY_POSE | NC_MSG_CAMERA_RATES | NC_MSG_BODY_RATES;
-    if ((flags & ~NC_MSG_KNOWN_FLAGS) || (type != NC_MSG_POSE && (flags & pose_only)) || nc_le_get_u32(buf + 20))
+    if ((flags & ~NC_MSG_KNOWN_FLAGS) || (type != NC_MSG_POSE && (flags & NC_MSG_POSE_ONLY_FLAGS)) ||
+        nc_le_get_u32(buf + 20))
         return NC_REJECT_BAD_FLAGS;
     size_t want = nc_msg_size((enum nc_msg_type)type, flags);
     if (nc_le_get_u32(buf + 8) != want)

@@ -626,7 +626,10 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
                 s->body[i] = -1;
                 continue;
             }
-            double eps = 4e-6 * nc_v3_norm(s->p[i]) + 1e-9;
+            /* a refined mesh hit (scale > t): its float triangle may lie an
+             * edge's float error off the exact point */
+            const double np = nc_v3_norm(s->p[i]);
+            double eps = 4e-6 * (s->scale[i] > s->t[i] ? fmax(s->scale[i], np) : np) + 1e-9;
             orig[i] = nc_v3_add(s->p[i], nc_v3_scale(s->n[i], eps));
             live++;
         }
@@ -809,6 +812,7 @@ static void trace_camera(const struct job *j, int px0, int py0, const struct nc_
             struct nc_hit16 *h = &hit[qk[k]];
             h->t[i] = hk.t[k], h->nx[i] = hk.nx[k], h->ny[i] = hk.ny[k], h->nz[i] = hk.nz[k];
             h->body[i] = hk.body[k], h->albedo[i] = hk.albedo[k], h->rock[i] = hk.rock[k];
+            h->prim[i] = hk.prim[k];
         }
     }
 }

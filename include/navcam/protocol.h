@@ -45,6 +45,8 @@ enum nc_msg_flags {
     NC_MSG_GAIN = 1u << 6,         /* analog gain (dB) for the requested frame */
 };
 #define NC_MSG_KNOWN_FLAGS 0x7Fu
+/* The flags of a POSE's blocks, which no other type takes. */
+#define NC_MSG_POSE_ONLY_FLAGS 0x0Fu
 
 /* Why a message was rejected: one counter each in the emulator. */
 #define NC_REJECT_REASONS(X)                                                                                   \
@@ -91,7 +93,9 @@ struct nc_pose_msg {
 
 /* Bytes of an encoded message with these flags. */
 size_t nc_msg_size(enum nc_msg_type type, uint32_t flags);
-/* Encode into buf (cap bytes); returns the size, or 0 if cap is too small. */
+/* Encode into buf (cap bytes); returns the size, or 0 if cap is too small
+ * or the flags are not the type's (unknown bits; a pose's block flags on a
+ * TRIGGER or FRAME): what the decoder would refuse is not encoded. */
 size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap);
 /* Decode and validate one message of exactly len bytes. Returns
  * NC_REJECT_NONE and fills *m, or the reason of the rejection. */

@@ -69,6 +69,10 @@ int main(void)
     buf[16] |= NC_MSG_BODY_POSE;
     reseal(buf, tn);
     CHECK(nc_msg_decode(buf, tn, &out) == NC_REJECT_BAD_FLAGS, "a trigger flagged BODY_POSE is rejected");
+    /* ... and not encoded: what the decoder refuses is never sent */
+    struct nc_pose_msg sun_trig = trig;
+    sun_trig.flags |= NC_MSG_SUN_POSITION;
+    CHECK(nc_msg_encode(&sun_trig, buf, sizeof buf) == 0, "a trigger flagged SUN_POSITION was encoded");
 
     /* The minimal pose message of docs/protocol.md, byte for byte. */
     struct nc_pose_msg ex = {.type = NC_MSG_POSE, .sequence = 1, .flags = NC_MSG_CAPTURE, .sim_time_ns = 1000000000};

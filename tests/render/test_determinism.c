@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/error.h"
+
 #include "testutil.h"
 
 static int same(const struct nc_frame *a, const struct nc_frame *b)
@@ -189,6 +191,28 @@ int main(void)
         nc_test_scene(nc_default_scene_yaml, rs, 4, &rocky);
         check_lanes(&rocky, "rocks from 2 m at 1.5 km");
         nc_scene_free(&rocky);
+    }
+    {
+        /* Within a bounding radius of the surface the mesh's hits near the
+         * camera are recomputed in double (nc_rt_refine_mesh16), on every
+         * path a camera ray takes (here 4 samples without the bins' path,
+         * and a bounce): the same frame on 1 and 3 threads. */
+        const char *cs[] = {"camera.width_px=96", "camera.height_px=80", "camera.position_m=[0,-400,0]",
+                            "render.bounces=1"};
+        struct nc_scene close;
+        nc_test_scene(nc_default_scene_yaml, cs, 4, &close);
+        struct nc_renderer rc;
+        CHECK(nc_renderer_init(&rc, &close, 1) == 0, "renderer");
+        struct nc_frame c1, c3;
+        nc_frame_alloc(&c1, close.camera.width_px, close.camera.height_px);
+        CHECK(nc_render_frame(&rc, &close, &c1) == 0 && nc_rt_refine_on(rc.rt), "close: refinement on: %s",
+              nc_errmsg());
+        nc_test_render(&close, 3, &c3);
+        CHECK(same(&c1, &c3), "close camera, refined mesh hits: 3 threads differ from 1");
+        nc_frame_free(&c1);
+        nc_frame_free(&c3);
+        nc_renderer_free(&rc);
+        nc_scene_free(&close);
     }
     const int threads[] = {2, 3, 8};
     for (int k = 0; k < 3; k++) {
