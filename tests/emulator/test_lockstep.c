@@ -72,6 +72,15 @@ static int finish(pid_t pid)
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
 }
 
+/* What the server of test `name` wrote on stderr (NULL: nothing); free it. */
+static char *server_log(const char *name)
+{
+    char log[4200];
+    size_t n;
+    snprintf(log, sizeof log, "%s/%s/serve.log", tmp, name);
+    return nc_test_read(log, &n);
+}
+
 /* A server (serve) and a client connected to it; NULL (the server
  * stopped, the failure counted) when no connection came. */
 static struct nc_client *serve_one(const char *name, const char *extra, pid_t *pid)
@@ -196,10 +205,7 @@ static void refused_beyond_the_limit(void)
     nc_client_close(b);
     nc_client_close(x);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
-    char log[4200];
-    snprintf(log, sizeof log, "%s/limit/serve.log", tmp);
-    size_t n;
-    char *text = nc_test_read(log, &n);
+    char *text = server_log("limit");
     CHECK(text && nc_test_contains(text, "refused a TCP client: all 2 client slots are in use (serve.max_clients"),
           "the refusal is not in the log:\n%s", text ? text : "(none)");
     free(text);
@@ -284,10 +290,7 @@ static void failures_are_drops(void)
     CHECK(s3 == NC_FRAME_DROPPED, "a frame no output took: status %u", s3);
     nc_client_close(c);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
-    char log[4200];
-    snprintf(log, sizeof log, "%s/lost/serve.log", tmp);
-    size_t n;
-    char *text = nc_test_read(log, &n);
+    char *text = server_log("lost");
     CHECK(text && nc_test_contains(text, "render_error 1") && nc_test_contains(text, "output_failed 1") &&
               nc_test_contains(text, "output_busy 0") && nc_test_contains(text, "frames 2 "),
           "drop reasons in the statistics:\n%s", text ? text : "(none)");
