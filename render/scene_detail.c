@@ -26,6 +26,16 @@ int nc__scene_error_at(const struct nc_cfg_node *n)
 /* `shape.craters` of a mesh or asteroid: a mean count of the default
  * population (a number), or a map of its parameters. An asteroid without
  * the key gets 100. */
+
+/* max_diameter_m not above min_diameter_m: the error names the key given
+ * (max, else min: a --set of one names the --set), else the map. */
+static int diameters_error(struct nc_cfg_node *map, double d_min_m, double d_max_m)
+{
+    struct nc_cfg_node *at = nc_cfg_get(map, "max_diameter_m");
+    if (!at)
+        at = nc_cfg_get(map, "min_diameter_m");
+    return nc_cfg_error(at ? at : map, "max_diameter_m (%g) must exceed min_diameter_m (%g)", d_max_m, d_min_m);
+}
 static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir, int dry)
 {
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
@@ -82,8 +92,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const 
         if (dry) /* the diameters' defaults come from the mesh */
             return 0;
         if (!(p.d_max_m > p.d_min_m))
-            return nc_cfg_error(nc_cfg_get(map, "max_diameter_m") ? nc_cfg_get(map, "max_diameter_m") : map,
-                                "max_diameter_m (%g) must exceed min_diameter_m (%g)", p.d_max_m, p.d_min_m);
+            return diameters_error(map, p.d_min_m, p.d_max_m);
     }
     if (dry)
         return 0;
@@ -139,8 +148,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b, int
         (rc = nc_cfg_double(map, "max_diameter_m", 1e-6, 2e6, &p.d_max_m)) < 0)
         return rc;
     if (!(p.d_max_m > p.d_min_m))
-        return nc_cfg_error(nc_cfg_get(map, "max_diameter_m") ? nc_cfg_get(map, "max_diameter_m") : map,
-                            "max_diameter_m (%g) must exceed min_diameter_m (%g)", p.d_max_m, p.d_min_m);
+        return diameters_error(map, p.d_min_m, p.d_max_m);
     if ((rc = nc_cfg_doubles(map, "burial", burial, 2)) < 0)
         return rc;
     if (rc) {
