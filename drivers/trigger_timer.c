@@ -17,6 +17,7 @@
 struct timer {
     struct nc_trigger_ctx ctx;
     int64_t period_ns, width_ns;
+    double rate_hz; /* the grid: edge k at start + k / rate_hz, rounded to the nanosecond, never summed */
     pthread_t thread;
     pthread_mutex_t lock;
     pthread_cond_t cond; /* on CLOCK_MONOTONIC, so that stop() wakes the sleeper */
@@ -42,6 +43,7 @@ static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trig
         (rc = nc_param_double(opts, timer_params, "pulse_width_s", &width_s)) < 0)
         return rc;
     t->ctx = *ctx;
+    t->rate_hz = rate_hz;
     t->period_ns = llround(1e9 / rate_hz);
     t->width_ns = width_s > 0 ? llround(width_s * 1e9) : default_width(t->period_ns);
     if (t->width_ns >= t->period_ns)
@@ -75,10 +77,12 @@ static void *timer_thread(void *arg)
     for (;;) {
         pthread_mutex_lock(&t->lock);
         unsigned restart = t->restart;
-        int64_t period = t->period_ns, width = t->width_ns;
+        const int64_t width = t->width_ns, start = nc_mono_ns();
+        const double period = 1e9 / t->rate_hz; /* ns, not rounded: 60 Hz stays 60 Hz for hours */
         pthread_mutex_unlock(&t->lock);
         int go = 1;
-        for (int64_t next = nc_mono_ns() + period; go == 1; next += period) {
+        for (int64_t k = 1; go == 1; k++) {
+            const int64_t next = start + llround((double)k * period);
             struct nc_trigger_edge rise = {.mono_ns = next, .rising = 1};
             struct nc_trigger_edge fall = {.mono_ns = next + width, .rising = 0};
             if ((go = sleep_until(t, rise.mono_ns, restart)) == 1)
@@ -100,6 +104,7 @@ static int timer_control(void *priv, const char *request, void *arg)
     if (!(hz >= 1e-3 && hz <= 10000))
         return nc_error(NC_ERANGE, "timer trigger: rate %g Hz outside [0.001, 10000]", hz);
     pthread_mutex_lock(&t->lock);
+    t->rate_hz = hz;
     t->period_ns = llround(1e9 / hz);
     if (t->width_ns >= t->period_ns)
         t->width_ns = default_width(t->period_ns);

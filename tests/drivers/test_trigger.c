@@ -130,6 +130,26 @@ static void test_timer(void)
     nc_trigger_close(&t);
     nc_cfg_free(&cfg);
 
+    /* 60 Hz, a period of 16 666 666.67 ns: rising edge k at llround(k 1e9 /
+     * 60) past the grid's start, never a sum of rounded periods (which
+     * drifts 1/3 ns a tick, 72 us an hour). */
+    static struct rec r60;
+    rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 60\n", &r60);
+    CHECK(rc == 0, "open: %s", nc_errmsg());
+    if (rc < 0)
+        return;
+    nc_trigger_start(&t);
+    while (atomic_load(&r60.n) < 7)
+        nanosleep(&(struct timespec){0, 1000000}, NULL);
+    nc_trigger_stop(&t);
+    for (int k = 1; k < 7; k++)
+        CHECK(r60.e[k].edge_mono_ns - r60.e[0].edge_mono_ns == llround((k + 1) * 1e9 / 60) - llround(1e9 / 60),
+              "60 Hz: edge %d at %lld ns from edge 0, want %lld", k,
+              (long long)(r60.e[k].edge_mono_ns - r60.e[0].edge_mono_ns),
+              (long long)(llround((k + 1) * 1e9 / 60) - llround(1e9 / 60)));
+    nc_trigger_close(&t);
+    nc_cfg_free(&cfg);
+
     /* Falling edges only, then rising only after a run-time change: the gate
      * filters, and counts what it filtered. */
     static struct rec rf;
