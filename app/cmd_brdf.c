@@ -205,7 +205,7 @@ int main(int argc, char **argv)
             continue; /* blank */
         const int bad = parse_geometry(line, v);
         if (bad < 0) {
-            if (lineno == 1 && strpbrk(line, "ie") && !strpbrk(line, "0123456789"))
+            if (lineno == 1 && strpbrk(line, "ieIE") && !strpbrk(line, "0123456789"))
                 continue; /* the optional header */
             line[strcspn(line, "\r\n")] = '\0';
             fprintf(stderr, "navcam brdf: %s: expected \"i,e,g\" in degrees, got \"%s\" (field %s)\n", where, line,
