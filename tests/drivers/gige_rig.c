@@ -110,8 +110,18 @@ ArvCamera *begin(const char *name, const char *outputs, const char *more, pid_t 
     *pid = serve(dir, extra, more ? 3 : 2);
     ArvCamera *c = open_camera();
     CHECK(c != NULL, "%s: no GigE Vision camera at 127.0.0.1", name);
-    if (!c)
+    if (!c) {
         stop(*pid);
+        return NULL;
+    }
+    /* A 10 s heartbeat: on a loaded 2-core machine the device saw no
+     * heartbeat within 3 s (Aravis's default), ended the control and
+     * stopped the acquisition, and a test of something else got no frames.
+     * test_gige_control tests the heartbeat itself, at 3 s. */
+    GError *err = NULL;
+    arv_device_set_integer_feature_value(arv_camera_get_device(c), "GevHeartbeatTimeout", 10000, &err);
+    CHECK(!err, "%s: GevHeartbeatTimeout 10000: %s", name, err ? err->message : "");
+    g_clear_error(&err);
     return c;
 }
 

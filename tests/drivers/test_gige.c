@@ -349,7 +349,7 @@ static void test_write_order(void)
      * timeout under GigE Vision's 500 ms */
     static const uint32_t reg[6] = {0x100 /* Width */, 0x110 /* Gain, 0.01 dB */, 0x1010 /* TriggerMode */,
                                     0x11c /* SensorWidth */, 0x1014 /* TriggerSource */, 0x938 /* heartbeat */},
-                          bad[6] = {W + 10, 6000, 7, 99, 0, 100}, want[6] = {W, 0, 1, W, 1, 3000};
+                          bad[6] = {W + 10, 6000, 7, 99, 0, 100}, want[6] = {W, 0, 1, W, 1, 10000}; /* begin() set 10 s */
     for (int i = 0; i < 6; i++) {
         guint32 v = 0;
         arv_device_write_register(d, reg[i], bad[i], NULL);
