@@ -72,6 +72,8 @@ struct gige {
     unsigned long sent, skipped, not_acquiring, before_start, send_failed;
     struct nc__gvsp gvsp;
     atomic_llong acq_start_ns; /* CLOCK_MONOTONIC of AcquisitionStart (settings applied); 0: stopped */
+    atomic_int channel_closed;    /* GevSCPHostPort read 0 since the last frame sent */
+    struct sockaddr_in last_dest; /* of the last frame sent: a new one opens a channel, block ids from 1 */
     /* the poll and sender threads */
     pthread_t thread, sender;
     atomic_int stop;
@@ -163,6 +165,8 @@ static void *poll_thread(void *arg)
         if (g->controlled && !controlled)
             control_ended(g);
         g->controlled = controlled;
+        if ((nc__gige_reg(g->fc, REG_HOST_PORT) & 0xffff) == 0)
+            atomic_store(&g->channel_closed, 1);
         int64_t now = nc_mono_ns();
         if (controlled && g->probe_fd >= 0 && now >= next_probe_ns) {
             nc__gige_probe(g->probe_fd);
@@ -259,6 +263,11 @@ static void *sender_thread(void *arg)
         if (g->rec[k].exposure_start_mono_ns < start) {
             g->before_start++; /* the client asked for frames exposed from AcquisitionStart on */
             continue;
+        }
+        if (atomic_exchange(&g->channel_closed, 0) || dest.sin_port != g->last_dest.sin_port ||
+            dest.sin_addr.s_addr != g->last_dest.sin_addr.s_addr) {
+            g->gvsp.block_id = 0; /* a stream channel opened: block ids from 1 (gige.md, "Block ids") */
+            g->last_dest = dest;
         }
         uint32_t packet = nc__gige_reg(g->fc, REG_PACKET_SIZE) & 0xffff;
         pthread_mutex_unlock(&g->lock); /* submit() may pack and hand over the next frame meanwhile */

@@ -22,7 +22,7 @@
 
 struct nc__gvsp {
     int fd;
-    uint16_t block_id; /* of the last block sent; 0 is never used */
+    uint16_t block_id; /* of the last block sent; 0 is never used (set to 0 to count from 1 again) */
     uint8_t *packets;  /* room for one batch of packets */
     size_t packets_size;
 };

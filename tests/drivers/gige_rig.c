@@ -4,13 +4,17 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -20,6 +24,8 @@
 
 const char *navcam, *tmp;
 unsigned long incomplete; /* buffers that arrived with missing packets */
+unsigned long unfilled;   /* buffers Aravis gave back as they were (start()'s datagrams) */
+uint64_t frame_id;        /* of the last frame next_frame returned */
 
 int rig_args(int argc, char **argv, const char *prog)
 {
@@ -114,22 +120,52 @@ ArvCamera *begin(const char *name, const char *outputs, const char *more, pid_t 
         stop(*pid);
         return NULL;
     }
-    /* A 10 s heartbeat: on a loaded 2-core machine the device saw no
-     * heartbeat within 3 s (Aravis's default), ended the control and
-     * stopped the acquisition, and a test of something else got no frames.
-     * test_gige_control tests the heartbeat itself, at 3 s. */
-    GError *err = NULL;
-    arv_device_set_integer_feature_value(arv_camera_get_device(c), "GevHeartbeatTimeout", 10000, &err);
-    CHECK(!err, "%s: GevHeartbeatTimeout 10000: %s", name, err ? err->message : "");
-    g_clear_error(&err);
     return c;
+}
+
+static atomic_int flooding;
+
+/* Datagrams shaped like GigE Vision commands (WRITEMEM, 0x0086) across lo,
+ * as fast as they go while flooding is set, to a socket of their own that
+ * never reads them (a closed port would answer with ICMP messages, which
+ * such a packet socket also takes for stream blocks: Aravis 0.8.26 then
+ * asked for 34 GB and aborted). */
+static void *flood(void *arg)
+{
+    (void)arg;
+    static const uint8_t cmd[16] = {0x42, 0x01, 0x00, 0x86, 0x00, 0x08, 0x12, 0x34};
+    struct sockaddr_in to = {.sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
+    socklen_t len = sizeof to;
+    int sink = socket(AF_INET, SOCK_DGRAM, 0), fd = socket(AF_INET, SOCK_DGRAM, 0);
+    if (sink >= 0 && fd >= 0 && bind(sink, (struct sockaddr *)&to, sizeof to) == 0 &&
+        getsockname(sink, (struct sockaddr *)&to, &len) == 0)
+        while (atomic_load(&flooding))
+            sendto(fd, cmd, sizeof cmd, MSG_DONTWAIT, (struct sockaddr *)&to, sizeof to);
+    if (fd >= 0)
+        close(fd);
+    if (sink >= 0)
+        close(sink);
+    return NULL;
 }
 
 int start(ArvCamera *c, struct stream *st)
 {
     GError *err = NULL;
     st->payload = (size_t)arv_camera_get_payload(c, &err);
+    /* Every stream opens while control-shaped datagrams cross lo: Aravis,
+     * run as root, receives through a packet socket that captures every
+     * packet until its filter is attached, and takes the first one for a
+     * stream block whose id (here 0x86) it then expects to grow: it
+     * discards as late the blocks with ids up to 99 below it. The device
+     * numbers each stream channel's blocks from 1, out of that reach
+     * (docs/gige.md, "Block ids"). */
+    pthread_t flooder;
+    atomic_store(&flooding, 1);
+    const int flood_on = err == NULL && pthread_create(&flooder, NULL, flood, NULL) == 0;
     st->s = err ? NULL : arv_camera_create_stream(c, NULL, NULL, &err);
+    atomic_store(&flooding, 0);
+    if (flood_on)
+        pthread_join(flooder, NULL);
     if (!st->s) {
         fprintf(stderr, "stream: %s\n", err ? err->message : "?");
         g_clear_error(&err);
@@ -157,14 +193,17 @@ int next_frame(struct stream *st, double timeout_s, uint8_t *out, uint64_t *ts)
         ArvBuffer *b = arv_stream_timeout_pop_buffer(st->s, 100000);
         if (!b)
             continue;
-        int ok = arv_buffer_get_status(b) == ARV_BUFFER_STATUS_SUCCESS;
-        incomplete += !ok;
+        const ArvBufferStatus status = arv_buffer_get_status(b);
+        const int ok = status == ARV_BUFFER_STATUS_SUCCESS;
+        unfilled += status == ARV_BUFFER_STATUS_CLEARED;
+        incomplete += !ok && status != ARV_BUFFER_STATUS_CLEARED;
         if (ok) {
             size_t size;
             const void *d = arv_buffer_get_data(b, &size);
             memcpy(out, d, size < st->payload ? size : st->payload);
             if (ts)
                 *ts = arv_buffer_get_timestamp(b);
+            frame_id = arv_buffer_get_frame_id(b);
         }
         arv_stream_push_buffer(st->s, b);
         if (ok)

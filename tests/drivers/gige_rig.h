@@ -17,6 +17,8 @@
 
 extern const char *navcam, *tmp;
 extern unsigned long incomplete; /* buffers that arrived with missing packets */
+extern unsigned long unfilled;   /* buffers Aravis gave back as they were (start()'s datagrams) */
+extern uint64_t frame_id;        /* the GVSP block id of the last frame next_frame returned */
 
 struct stream {
     ArvStream *s;
@@ -38,6 +40,7 @@ ArvCamera *open_camera(void);
  * (serve stopped) when no camera answers. */
 ArvCamera *begin(const char *name, const char *outputs, const char *more, pid_t *pid, char *dir,
                   size_t dirlen);
+/* A stream with 8 buffers, and AcquisitionStart. */
 int start(ArvCamera *c, struct stream *st);
 void finish(ArvCamera *c, struct stream *st);
 /* The next complete frame within timeout_s, copied into out (payload bytes);
