@@ -95,8 +95,9 @@ static void publish(struct gige *g, const struct nc_acquisition *a)
 
 static void refused(struct gige *g, const char *what)
 {
-    if (g->rejected_settings++ == 0)
-        nc_log_warn("output/gige", "a client's setting was refused (the registers show what holds): %s", what);
+    if (++g->rejected_settings <= 10)
+        nc_log_warn("output/gige", "a client's setting was refused (the registers show what holds): %s%s", what,
+                    g->rejected_settings == 10 ? " (from now on refusals are only counted)" : "");
 }
 
 /* The checks a camera's firmware makes on what clients write (gige_regs.h). */
@@ -107,38 +108,41 @@ static void check_registers(struct gige *g)
         refused(g, why);
 }
 
-/* Client-written settings to the emulator, when they changed: within the
- * XML's ranges (ExposureTime 1 us to 10 s, Gain 0 to 48 dB,
- * AcquisitionFrameRate 0.01 to 1000 Hz, TriggerDelay 0 to 10 s: the last
- * two the emulator checks). */
+/* Client-written settings to the emulator, when they changed: a write outside the XML's ranges is undone, the
+ * others stand; if the emulator refuses them together (lock-step, a line it lacks), each unit is tried alone. */
 static void apply_settings(struct gige *g)
 {
-    struct nc_acquisition want;
+    struct nc_acquisition want, held = g->applied;
     nc__gige_read_settings(g->fc, &g->applied, &want);
     if (nc__gige_same(&want, &g->applied) || !g->ctl)
         return;
-    if (!(want.exposure_s >= 1e-6 && want.exposure_s <= 10.0))
-        nc_error(NC_ERANGE, "ExposureTime %g us outside 1 us to 10 s", want.exposure_s * 1e6);
-    else if (!(want.gain_db >= 0 && want.gain_db <= 48))
-        nc_error(NC_ERANGE, "Gain %g dB outside 0 to 48 dB", want.gain_db);
-    else if (!(want.frame_rate_hz >= 0.01))
-        nc_error(NC_ERANGE, "AcquisitionFrameRate %g Hz below 0.01 Hz", want.frame_rate_hz);
-    else if (g->ctl->set(g->ctl->emu, &want) >= 0) {
-        g->applied = want; /* the registers already say so */
-        return;
-    }
-    /* Refused (lock-step, out of range): show the client what holds. */
-    refused(g, nc_errmsg());
-    g->ctl->get(g->ctl->emu, &want);
-    publish(g, &want);
+    const char *why[3];
+    int undo = nc__gige_in_range(&want, &held, why);
+    for (int k = 0; k < undo; k++)
+        refused(g, why[k]);
+    if (!nc__gige_same(&want, &held) && g->ctl->set(g->ctl->emu, &want) >= 0)
+        held = want;
+    else
+        for (int u = 0; u < NC_GIGE_UNITS; u++) {
+            struct nc_acquisition t = held;
+            nc__gige_take_unit(&t, &want, u);
+            if (nc__gige_same(&t, &held))
+                continue;
+            if (g->ctl->set(g->ctl->emu, &t) >= 0)
+                held = t;
+            else
+                refused(g, nc_errmsg()), undo = 1;
+        }
+    if (undo)
+        publish(g, &held); /* the registers show what holds */
+    else
+        g->applied = held; /* the registers already say so */
 }
 
-/* The controlling client released the device, or its heartbeat ran out
- * (the device found it so at a message: nc__gige_probe sends one four
- * times a second while a client holds the control): as a GigE Vision
- * camera does, the acquisition stops and the stream channel closes, so
- * that no frame goes to a client that is gone, nor to it again when
- * another client takes the control. */
+/* The controlling client released the device, or its heartbeat ran out (the device found it so at a message:
+ * nc__gige_probe sends one four times a second while a client holds the control): as a GigE Vision camera does,
+ * the acquisition stops and the stream channel closes, so that no frame goes to a client that is gone, nor to it
+ * again when another client takes the control. */
 static void control_ended(struct gige *g)
 {
     const int acquiring = arv_fake_camera_get_acquisition_status(g->fc) != 0;
@@ -155,12 +159,9 @@ static void *poll_thread(void *arg)
     int64_t next_rate_ns = 0, next_probe_ns = 0;
     while (!atomic_load(&g->stop)) {
         nanosleep(&(struct timespec){0, period_ns}, NULL);
-        /* What a client wrote within one period is taken in the order a
-         * GenICam client writes it: settings, then AcquisitionStart, then
-         * TriggerSoftware. So the settings are applied before the stream
-         * opens to exposures starting from now, and a trigger right after
-         * the start or a setting makes a frame that is sent, with that
-         * setting. */
+        /* What a client wrote within one period is taken in a GenICam client's order: settings, AcquisitionStart,
+         * TriggerSoftware. So the settings apply before the stream opens to exposures from now on, and a trigger
+         * right after the start or a setting makes a frame that is sent, with that setting. */
         const int controlled = arv_fake_camera_get_control_channel_privilege(g->fc) != 0;
         if (g->controlled && !controlled)
             control_ended(g);
@@ -296,8 +297,8 @@ static const struct nc_param gige_params[] = {
     NC_P_ENUM("pixel_format", "Mono16", formats, "initial pixel format (clients may change it)"),
     NC_P_DOUBLE("poll_hz", "1000", 1, 10000, "Hz", "how often client-written settings are read"),
     NC_P_INT("packet_size", NULL, 576, 65000, "bytes",
-             "GVSP packet size, a multiple of 4 (default 8192 on lo, 1400 elsewhere)"),
-    NC_P_INT("metadata_row", "0", 0, 1, "", "1: append a row with the frame's metadata"),
+             "GVSP packet size, a multiple of 4 (default 65000 on lo, 1400 elsewhere)"),
+    NC_P_INT("metadata_row", "0", 0, 1, "", "1: a first row (row 0) with the frame's metadata, above the image"),
     NC_P_END,
 };
 
@@ -417,7 +418,7 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, pfs[fmt]);
     nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE, 1);
     /* Loopback carries big packets; real links start at the safe 1400. */
-    nc__gige_reg_set(g->fc, REG_PACKET_SIZE, (uint32_t)(packet > 0 ? packet : !strcmp(g->iface, "lo") ? 8192 : 1400));
+    nc__gige_reg_set(g->fc, REG_PACKET_SIZE, (uint32_t)(packet > 0 ? packet : !strcmp(g->iface, "lo") ? 65000 : 1400));
     /* Internal: the device itself never streams (its software trigger is
      * never raised; it looks for it 10 times a second); the sender does. */
     nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_TRIGGER_MODE, 1);

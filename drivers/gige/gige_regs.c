@@ -65,6 +65,38 @@ void nc__gige_read_settings(ArvFakeCamera *fc, const struct nc_acquisition *base
     a->trigger_delay_s = nc__gige_reg_double(fc, REG_TRIGGER_DELAY) * 1e-6;
 }
 
+int nc__gige_in_range(struct nc_acquisition *want, const struct nc_acquisition *held, const char *why[3])
+{
+    static _Thread_local char msg[3][96];
+    int n = 0;
+    if (!(want->exposure_s >= 1e-6 && want->exposure_s <= 10.0)) {
+        snprintf(msg[n], sizeof msg[n], "ExposureTime %g us outside 1 us to 10 s", want->exposure_s * 1e6);
+        why[n] = msg[n], n++, want->exposure_s = held->exposure_s;
+    }
+    if (!(want->gain_db >= 0 && want->gain_db <= 48)) {
+        snprintf(msg[n], sizeof msg[n], "Gain %g dB outside 0 to 48 dB", want->gain_db);
+        why[n] = msg[n], n++, want->gain_db = held->gain_db;
+    }
+    if (!(want->frame_rate_hz >= 0.01)) {
+        snprintf(msg[n], sizeof msg[n], "AcquisitionFrameRate %g Hz below 0.01 Hz", want->frame_rate_hz);
+        why[n] = msg[n], n++, want->frame_rate_hz = held->frame_rate_hz;
+    }
+    return n;
+}
+
+void nc__gige_take_unit(struct nc_acquisition *to, const struct nc_acquisition *from, int unit)
+{
+    if (unit == 0)
+        to->exposure_s = from->exposure_s;
+    else if (unit == 1)
+        to->gain_db = from->gain_db;
+    else if (unit == 2)
+        to->frame_rate_hz = from->frame_rate_hz;
+    else
+        to->triggered = from->triggered, to->source = from->source, to->activation = from->activation,
+        to->trigger_delay_s = from->trigger_delay_s;
+}
+
 int nc__gige_same(const struct nc_acquisition *a, const struct nc_acquisition *b)
 {
     return a->triggered == b->triggered && a->source == b->source && a->activation == b->activation &&
@@ -82,9 +114,23 @@ void nc__gige_hold(ArvFakeCamera *fc, uint32_t held[NC_GIGE_HELD])
         held[i] = nc__gige_reg(fc, held_reg[i]);
 }
 
+static const char *const held_name[NC_GIGE_HELD] = {"Width",       "Height",            "OffsetX",
+                                                     "OffsetY",     "PixelFormat",       "GevSCPSPacketSize",
+                                                     "GevHeartbeatTimeout"};
+
+/* Whether image and transport registers v hold for a sensor of W x H rows. */
+static int holds(const uint32_t v[NC_GIGE_HELD], uint32_t W, uint32_t H)
+{
+    const uint32_t min_w = W < 16 ? W : 16, packet = v[5] & 0xffff;
+    return v[0] >= min_w && v[0] <= W && v[2] <= W - v[0] && v[1] >= 1 && v[1] <= H && v[3] <= H - v[1] &&
+           (v[4] == PF_MONO8 || v[4] == PF_MONO12 || v[4] == PF_MONO16) && packet >= 576 && packet <= 65000 &&
+           packet % 4 == 0 && v[6] >= 500 && v[6] <= 60000;
+}
+
 int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uint32_t held[NC_GIGE_HELD],
                              const struct nc_acquisition *applied, const char **why)
 {
+    static _Thread_local char msg[320];
     int undone = 0;
     /* and AcquisitionMode, whose one entry is Continuous (1) */
     const uint32_t ro[4] = {ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT,
@@ -98,19 +144,40 @@ int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uin
         }
     uint32_t v[NC_GIGE_HELD];
     nc__gige_hold(fc, v);
-    const uint32_t W = (uint32_t)w, H = (uint32_t)(h + meta_rows), min_w = W < 16 ? W : 16, packet = v[5] & 0xffff;
-    const int ok = v[0] >= min_w && v[0] <= W && v[2] <= W - v[0] && v[1] >= 1 && v[1] <= H && v[3] <= H - v[1] &&
-                   (v[4] == PF_MONO8 || v[4] == PF_MONO12 || v[4] == PF_MONO16) && packet >= 576 &&
-                   packet <= 65000 && packet % 4 == 0 && v[6] >= 500 && v[6] <= 60000;
-    if (ok) {
-        memcpy(held, v, sizeof v);
-    } else if (memcmp(held, v, sizeof v)) {
+    const uint32_t W = (uint32_t)w, H = (uint32_t)(h + meta_rows);
+    if (!holds(v, W, H)) {
+        /* Undo the fewest of the writes since the last check that make the
+         * rest hold (the writes that held were a set that holds). */
+        unsigned changed = 0, undo = 0;
         for (int i = 0; i < NC_GIGE_HELD; i++)
-            nc__gige_reg_set(fc, held_reg[i], held[i]);
-        *why = "Width, Height, OffsetX, OffsetY, PixelFormat, GevSCPSPacketSize or GevHeartbeatTimeout outside its "
-               "range";
+            changed |= (unsigned)(v[i] != held[i]) << i;
+        for (int k = 1; k <= NC_GIGE_HELD && !undo; k++)
+            for (unsigned m = changed; m && !undo; m = (m - 1) & changed) {
+                uint32_t t[NC_GIGE_HELD];
+                for (int i = 0; i < NC_GIGE_HELD; i++)
+                    t[i] = m >> i & 1 ? held[i] : v[i];
+                if (__builtin_popcount(m) == k && holds(t, W, H))
+                    undo = m;
+            }
+        if (!undo)
+            undo = changed;
+        size_t n = (size_t)snprintf(msg, sizeof msg, "the write of");
+        for (int i = 0; i < NC_GIGE_HELD; i++)
+            if (undo >> i & 1) {
+                const char *sep = n > 12 ? "," : "";
+                n += (size_t)snprintf(msg + n, n < sizeof msg ? sizeof msg - n : 0, i == 4 ? "%s %s %#x" : "%s %s %u",
+                                      sep, held_name[i], i == 5 ? v[i] & 0xffff : v[i]);
+                nc__gige_reg_set(fc, held_reg[i], held[i]);
+                v[i] = held[i];
+            }
+        snprintf(msg + n, n < sizeof msg ? sizeof msg - n : 0,
+                 " (the region within %ux%u pixels, Width from %u; PixelFormat Mono8, Mono12 or Mono16; "
+                 "GevSCPSPacketSize 576 to 65000 bytes, a multiple of 4; GevHeartbeatTimeout 500 to 60000 ms)",
+                 W, H, W < 16 ? W : 16);
+        *why = msg;
         undone++;
     }
+    memcpy(held, v, sizeof v);
     if (nc__gige_reg(fc, REG_TRIGGER_MODE) > 1 || nc__gige_reg(fc, REG_TRIGGER_SOURCE) > 1 ||
         nc__gige_reg(fc, REG_TRIGGER_ACT) > 2) {
         nc__gige_publish(fc, applied);

@@ -43,6 +43,17 @@ void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a);
 /* The settings the registers hold now (those they do not hold from base). */
 void nc__gige_read_settings(ArvFakeCamera *fc, const struct nc_acquisition *base, struct nc_acquisition *a);
 int nc__gige_same(const struct nc_acquisition *a, const struct nc_acquisition *b);
+/* The settings a client wrote within the XML's ranges (ExposureTime 1 us
+ * to 10 s, Gain 0 to 48 dB, AcquisitionFrameRate from 0.01 Hz): a field
+ * outside gets held's value back, and why[] names the write. Returns how
+ * many were undone (why[] valid until this thread's next call). */
+int nc__gige_in_range(struct nc_acquisition *want, const struct nc_acquisition *held, const char *why[3]);
+/* What a client writes goes to the emulator in units it takes or refuses
+ * whole: 0 ExposureTime, 1 Gain, 2 AcquisitionFrameRate, 3 the trigger
+ * (TriggerMode, TriggerSource, TriggerActivation, TriggerDelay). Unit u of
+ * from into to. */
+#define NC_GIGE_UNITS 4
+void nc__gige_take_unit(struct nc_acquisition *to, const struct nc_acquisition *from, int unit);
 
 /* The image and transport registers a client writes, checked together:
  * Width, Height, OffsetX, OffsetY, PixelFormat, GevSCPSPacketSize,

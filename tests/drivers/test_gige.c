@@ -367,6 +367,25 @@ static void test_write_order(void)
         arv_device_read_register(d, reg[i], &v, NULL);
         CHECK(v == want[i], "register 0x%x written %u: reads %u, want %u (what holds)", reg[i], bad[i], v, want[i]);
     }
+    /* A refused write undoes itself alone: PixelFormat Mono8 and Width 8
+     * (below 16), then Gain 12 dB and ExposureTime 0, back to back. */
+    guint32 pf = 0, width = 0, gain = 0, exposure = 0, exposure0 = 0;
+    arv_device_read_register(d, 0x120, &exposure0, NULL);
+    arv_device_write_register(d, 0x128, 0x01080001, NULL);
+    arv_device_write_register(d, 0x100, 8, NULL);
+    arv_device_write_register(d, 0x110, 1200, NULL);
+    arv_device_write_register(d, 0x120, 0, NULL);
+    usleep(50000);
+    arv_device_read_register(d, 0x128, &pf, NULL);
+    arv_device_read_register(d, 0x100, &width, NULL);
+    arv_device_read_register(d, 0x110, &gain, NULL);
+    arv_device_read_register(d, 0x120, &exposure, NULL);
+    printf("beside refused writes: PixelFormat %#x, Width %u, Gain %u, ExposureTime %u us\n", pf, width, gain,
+           exposure);
+    CHECK(pf == 0x01080001 && width == W, "PixelFormat Mono8 with Width 8: reads %#x and %u, want Mono8 and %d", pf,
+          width, W);
+    CHECK(gain == 1200 && exposure == exposure0 && exposure0 > 0,
+          "Gain 12 dB with ExposureTime 0: reads %u and %u us, want 1200 and %u", gain, exposure, exposure0);
     /* GenApi's schema orders a number's elements: Unit before
      * Representation (strict GenICam readers refuse the file otherwise). */
     size_t len = 0;

@@ -2,7 +2,8 @@
  * clients (test_gige.c's rig): a client killed mid-stream: its stream port
  * gets packets in the first second and none once its heartbeat ran out (the
  * device stops the acquisition and closes the stream channel), then a new
- * client streams and reads GevHeartbeatTimeout; clear errors for a missing
+ * client streams and reads GevHeartbeatTimeout; in lock-step, refused
+ * settings written with one that is not are undone alone; clear errors for a missing
  * interface, a taken port 3956, an invalid XML (also one named relative to
  * a configuration file in another directory), a model name too long, a
  * packet size off its step.
@@ -114,6 +115,33 @@ static void test_client_killed(void)
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
 }
 
+/* Lock-step refuses AcquisitionFrameRate and TriggerMode On: written back to
+ * back with ExposureTime, they are undone and the exposure stands. */
+static void test_lockstep_units(void)
+{
+    char dir[4096];
+    pid_t pid;
+    ArvCamera *c = begin("lockstep", "outputs=[{driver: gige}]", "serve.mode=lockstep", &pid, dir, sizeof dir);
+    if (!c)
+        return;
+    ArvDevice *d = arv_camera_get_device(c);
+    double rate0 = arv_camera_get_frame_rate(c, NULL);
+    arv_device_set_float_feature_value(d, "ExposureTime", 2500, NULL);
+    arv_device_set_float_feature_value(d, "AcquisitionFrameRate", rate0 + 2, NULL);
+    arv_device_set_string_feature_value(d, "TriggerMode", "On", NULL);
+    usleep(100000);
+    double ex = arv_device_get_float_feature_value(d, "ExposureTime", NULL);
+    double rate = arv_camera_get_frame_rate(c, NULL);
+    const char *mode = arv_device_get_string_feature_value(d, "TriggerMode", NULL);
+    printf("lock-step, ExposureTime 2500 us, AcquisitionFrameRate %.0f Hz and TriggerMode On at once: %.0f us, "
+           "%.0f Hz, %s\n", rate0 + 2, ex, rate, mode ? mode : "?");
+    CHECK(ex == 2500 && rate == rate0 && mode && !strcmp(mode, "Off"),
+          "lock-step: ExposureTime %g us (want 2500), AcquisitionFrameRate %g Hz (want %g), TriggerMode %s (want Off)",
+          ex, rate, rate0, mode ? mode : "?");
+    g_object_unref(c);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+}
+
 /* navcam serve with extra settings must fail (exit 1) with needle in stderr. */
 static void expect_fail(const char *name, const char *const *extra, int n, const char *needle)
 {
@@ -186,6 +214,7 @@ int main(int argc, char **argv)
     if (rig_args(argc, argv, "test_gige_control") < 0)
         return 2;
     test_client_killed();
+    test_lockstep_units();
     test_errors();
     return nc_test_end();
 }
