@@ -214,7 +214,8 @@ static int setup(struct v4l2_out *v)
     /* What the driver kept must be what NavCam writes. */
     if (f.fmt.pix.pixelformat != v->fourcc) {
         char a[5], b[5];
-        return fail_setup(v, NC_EUNSUPPORTED, "the driver set pixel format %s instead of %s",
+        return fail_setup(v, NC_EUNSUPPORTED, "the driver set pixel format %s instead of %s (v4l2loopback: a reader "
+                          "still streaming, or keep_format=1, holds the last producer's format)",
                           fourcc_text(f.fmt.pix.pixelformat, a), fourcc_text(v->fourcc, b));
     }
     if ((int)f.fmt.pix.width != v->width)
