@@ -93,8 +93,9 @@ static void publish(struct gige *g, const struct nc_acquisition *a)
     g->applied = *a;
 }
 
-static void refused(struct gige *g, const char *what)
+static void refused(void *arg, const char *what)
 {
+    struct gige *g = arg;
     if (++g->rejected_settings <= 10)
         nc_log_warn("output/gige", "a client's setting was refused (the registers show what holds): %s%s", what,
                     g->rejected_settings == 10 ? " (from now on refusals are only counted)" : "");
@@ -103,19 +104,18 @@ static void refused(struct gige *g, const char *what)
 /* The checks a camera's firmware makes on what clients write (gige_regs.h). */
 static void check_registers(struct gige *g)
 {
-    const char *why = NULL;
-    for (int n = nc__gige_check_registers(g->fc, g->W, g->H, g->meta_rows, g->held, &g->applied, &why); n > 0; n--)
-        refused(g, why);
+    nc__gige_check_registers(g->fc, g->W, g->H, g->meta_rows, g->held, &g->applied, refused, g);
 }
 
 /* Client-written settings to the emulator, when they changed: a write outside the XML's ranges is undone, the
  * others stand; if the emulator refuses them together (lock-step, a line it lacks), each unit is tried alone. */
 static void apply_settings(struct gige *g)
 {
-    struct nc_acquisition want, held = g->applied;
+    struct nc_acquisition want, held = g->applied, shown;
     nc__gige_read_settings(g->fc, &g->applied, &want);
     if (nc__gige_same(&want, &g->applied) || !g->ctl)
         return;
+    shown = want;
     const char *why[3];
     int undo = nc__gige_in_range(&want, &held, why);
     for (int k = 0; k < undo; k++)
@@ -133,10 +133,9 @@ static void apply_settings(struct gige *g)
             else
                 refused(g, nc_errmsg()), undo = 1;
         }
-    if (undo)
-        publish(g, &held); /* the registers show what holds */
-    else
-        g->applied = held; /* the registers already say so */
+    if (undo) /* the registers undone show what holds; a client's write since then stands */
+        nc__gige_publish_changed(g->fc, &held, &shown);
+    g->applied = held;
 }
 
 /* The controlling client released the device, or its heartbeat ran out (the device found it so at a message:

@@ -41,43 +41,61 @@ void nc__gige_reg_set_string(ArvFakeCamera *fc, uint32_t a, size_t len, const ch
     arv_fake_camera_write_memory(fc, a, (guint32)len, buf);
 }
 
-void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a)
+/* The register images of a's settings. */
+static uint32_t exposure_reg(const struct nc_acquisition *a) { return (uint32_t)llround(a->exposure_s * 1e6); }
+static uint32_t gain_reg(const struct nc_acquisition *a) { return (uint32_t)llround(fmax(a->gain_db, 0) * 100); }
+
+void nc__gige_publish_changed(ArvFakeCamera *fc, const struct nc_acquisition *a, const struct nc_acquisition *shown)
 {
-    nc__gige_reg_set(fc, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US, (uint32_t)llround(a->exposure_s * 1e6));
-    nc__gige_reg_set(fc, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW, (uint32_t)llround(fmax(a->gain_db, 0) * 100));
-    nc__gige_reg_set_double(fc, REG_FRAME_RATE, a->frame_rate_hz);
-    nc__gige_reg_set(fc, REG_TRIGGER_MODE, (uint32_t)a->triggered);
-    nc__gige_reg_set(fc, REG_TRIGGER_SOURCE, a->source == NC_SOURCE_SOFTWARE ? 1 : 0);
-    nc__gige_reg_set(fc, REG_TRIGGER_ACT, (uint32_t)a->activation);
-    nc__gige_reg_set_double(fc, REG_TRIGGER_DELAY, a->trigger_delay_s * 1e6);
+    if (!shown || exposure_reg(a) != exposure_reg(shown))
+        nc__gige_reg_set(fc, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US, exposure_reg(a));
+    if (!shown || gain_reg(a) != gain_reg(shown))
+        nc__gige_reg_set(fc, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW, gain_reg(a));
+    if (!shown || a->frame_rate_hz != shown->frame_rate_hz)
+        nc__gige_reg_set_double(fc, REG_FRAME_RATE, a->frame_rate_hz);
+    if (!shown || a->triggered != shown->triggered)
+        nc__gige_reg_set(fc, REG_TRIGGER_MODE, (uint32_t)a->triggered);
+    if (!shown || a->source != shown->source)
+        nc__gige_reg_set(fc, REG_TRIGGER_SOURCE, a->source == NC_SOURCE_SOFTWARE ? 1 : 0);
+    if (!shown || a->activation != shown->activation)
+        nc__gige_reg_set(fc, REG_TRIGGER_ACT, (uint32_t)a->activation);
+    if (!shown || a->trigger_delay_s * 1e6 != shown->trigger_delay_s * 1e6)
+        nc__gige_reg_set_double(fc, REG_TRIGGER_DELAY, a->trigger_delay_s * 1e6);
 }
+
+void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a) { nc__gige_publish_changed(fc, a, NULL); }
 
 void nc__gige_read_settings(ArvFakeCamera *fc, const struct nc_acquisition *base, struct nc_acquisition *a)
 {
+    /* A register that still shows base's value gives base's value itself,
+     * not its rounded image (whole microseconds, 0.01 dB, no negative gain). */
     *a = *base;
-    a->exposure_s = nc__gige_reg(fc, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US) * 1e-6;
-    a->gain_db = nc__gige_reg(fc, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW) * 0.01;
+    const uint32_t ex = nc__gige_reg(fc, ARV_FAKE_CAMERA_REGISTER_EXPOSURE_TIME_US);
+    const uint32_t gain = nc__gige_reg(fc, ARV_FAKE_CAMERA_REGISTER_GAIN_RAW);
+    const double delay_us = nc__gige_reg_double(fc, REG_TRIGGER_DELAY);
+    a->exposure_s = ex == exposure_reg(base) ? base->exposure_s : ex * 1e-6;
+    a->gain_db = gain == gain_reg(base) ? base->gain_db : gain * 0.01;
     a->frame_rate_hz = nc__gige_reg_double(fc, REG_FRAME_RATE);
     a->triggered = nc__gige_reg(fc, REG_TRIGGER_MODE) != 0;
     a->source = nc__gige_reg(fc, REG_TRIGGER_SOURCE) == 1 ? NC_SOURCE_SOFTWARE : NC_SOURCE_LINE;
     uint32_t act = nc__gige_reg(fc, REG_TRIGGER_ACT);
     a->activation = act <= 2 ? (enum nc_trigger_activation)act : NC_TRIGGER_RISING;
-    a->trigger_delay_s = nc__gige_reg_double(fc, REG_TRIGGER_DELAY) * 1e-6;
+    a->trigger_delay_s = delay_us == base->trigger_delay_s * 1e6 ? base->trigger_delay_s : delay_us * 1e-6;
 }
 
 int nc__gige_in_range(struct nc_acquisition *want, const struct nc_acquisition *held, const char *why[3])
 {
     static _Thread_local char msg[3][96];
     int n = 0;
-    if (!(want->exposure_s >= 1e-6 && want->exposure_s <= 10.0)) {
+    if (want->exposure_s != held->exposure_s && !(want->exposure_s >= 1e-6 && want->exposure_s <= 10.0)) {
         snprintf(msg[n], sizeof msg[n], "ExposureTime %g us outside 1 us to 10 s", want->exposure_s * 1e6);
         why[n] = msg[n], n++, want->exposure_s = held->exposure_s;
     }
-    if (!(want->gain_db >= 0 && want->gain_db <= 48)) {
+    if (want->gain_db != held->gain_db && !(want->gain_db >= 0 && want->gain_db <= 48)) {
         snprintf(msg[n], sizeof msg[n], "Gain %g dB outside 0 to 48 dB", want->gain_db);
         why[n] = msg[n], n++, want->gain_db = held->gain_db;
     }
-    if (!(want->frame_rate_hz >= 0.01)) {
+    if (want->frame_rate_hz != held->frame_rate_hz && !(want->frame_rate_hz >= 0.01)) {
         snprintf(msg[n], sizeof msg[n], "AcquisitionFrameRate %g Hz below 0.01 Hz", want->frame_rate_hz);
         why[n] = msg[n], n++, want->frame_rate_hz = held->frame_rate_hz;
     }
@@ -128,9 +146,9 @@ static int holds(const uint32_t v[NC_GIGE_HELD], uint32_t W, uint32_t H)
 }
 
 int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uint32_t held[NC_GIGE_HELD],
-                             const struct nc_acquisition *applied, const char **why)
+                             const struct nc_acquisition *applied, void (*refused)(void *, const char *), void *arg)
 {
-    static _Thread_local char msg[320];
+    char msg[512];
     int undone = 0;
     /* and AcquisitionMode, whose one entry is Continuous (1) */
     const uint32_t ro[4] = {ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT,
@@ -139,50 +157,65 @@ int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uin
     for (int i = 0; i < 4; i++)
         if (nc__gige_reg(fc, ro[i]) != ro_value[i]) {
             nc__gige_reg_set(fc, ro[i], ro_value[i]);
-            *why = "a write to SensorWidth, SensorHeight, MetadataRows (read only) or AcquisitionMode";
+            refused(arg, "a write to SensorWidth, SensorHeight, MetadataRows (read only) or AcquisitionMode");
             undone++;
         }
-    uint32_t v[NC_GIGE_HELD];
+    uint32_t v[NC_GIGE_HELD], again[NC_GIGE_HELD];
     nc__gige_hold(fc, v);
+    nc__gige_hold(fc, again);
     const uint32_t W = (uint32_t)w, H = (uint32_t)(h + meta_rows);
-    if (!holds(v, W, H)) {
-        /* Undo the fewest of the writes since the last check that make the
-         * rest hold (the writes that held were a set that holds). */
-        unsigned changed = 0, undo = 0;
-        for (int i = 0; i < NC_GIGE_HELD; i++)
-            changed |= (unsigned)(v[i] != held[i]) << i;
-        for (int k = 1; k <= NC_GIGE_HELD && !undo; k++)
-            for (unsigned m = changed; m && !undo; m = (m - 1) & changed) {
-                uint32_t t[NC_GIGE_HELD];
-                for (int i = 0; i < NC_GIGE_HELD; i++)
-                    t[i] = m >> i & 1 ? held[i] : v[i];
-                if (__builtin_popcount(m) == k && holds(t, W, H))
-                    undo = m;
-            }
-        if (!undo)
-            undo = changed;
-        size_t n = (size_t)snprintf(msg, sizeof msg, "the write of");
-        for (int i = 0; i < NC_GIGE_HELD; i++)
-            if (undo >> i & 1) {
-                const char *sep = n > 12 ? "," : "";
-                n += (size_t)snprintf(msg + n, n < sizeof msg ? sizeof msg - n : 0, i == 4 ? "%s %s %#x" : "%s %s %u",
-                                      sep, held_name[i], i == 5 ? v[i] & 0xffff : v[i]);
-                nc__gige_reg_set(fc, held_reg[i], held[i]);
-                v[i] = held[i];
-            }
-        snprintf(msg + n, n < sizeof msg ? sizeof msg - n : 0,
-                 " (the region within %ux%u pixels, Width from %u; PixelFormat Mono8, Mono12 or Mono16; "
-                 "GevSCPSPacketSize 576 to 65000 bytes, a multiple of 4; GevHeartbeatTimeout 500 to 60000 ms)",
-                 W, H, W < 16 ? W : 16);
-        *why = msg;
-        undone++;
+    /* (read twice: if a client is writing them right now, the next check
+     * sees them whole) */
+    if (!memcmp(v, again, sizeof v)) {
+        if (!holds(v, W, H)) {
+            /* Undo the fewest of the writes since the last check that make the
+             * rest hold (the writes that held were a set that holds). */
+            unsigned changed = 0, undo = 0;
+            for (int i = 0; i < NC_GIGE_HELD; i++)
+                changed |= (unsigned)(v[i] != held[i]) << i;
+            for (int k = 1; k <= NC_GIGE_HELD && !undo; k++)
+                for (unsigned m = changed; m && !undo; m = (m - 1) & changed) {
+                    uint32_t t[NC_GIGE_HELD];
+                    for (int i = 0; i < NC_GIGE_HELD; i++)
+                        t[i] = m >> i & 1 ? held[i] : v[i];
+                    if (__builtin_popcount(m) == k && holds(t, W, H))
+                        undo = m;
+                }
+            if (!undo)
+                undo = changed;
+            size_t n = (size_t)snprintf(msg, sizeof msg, "the write of");
+            for (int i = 0; i < NC_GIGE_HELD; i++)
+                if (undo >> i & 1) {
+                    const char *sep = n > 12 ? "," : "";
+                    n += (size_t)snprintf(msg + n, n < sizeof msg ? sizeof msg - n : 0,
+                                          i == 4 ? "%s %s %#x" : "%s %s %u", sep, held_name[i],
+                                          i == 5 ? v[i] & 0xffff : v[i]);
+                    nc__gige_reg_set(fc, held_reg[i], held[i]);
+                    v[i] = held[i];
+                }
+            snprintf(msg + n, n < sizeof msg ? sizeof msg - n : 0,
+                     " (the region within %ux%u pixels, Width from %u; PixelFormat Mono8, Mono12 or Mono16; "
+                     "GevSCPSPacketSize 576 to 65000 bytes, a multiple of 4; GevHeartbeatTimeout 500 to 60000 ms)",
+                     W, H, W < 16 ? W : 16);
+            refused(arg, msg);
+            undone++;
+        }
+        memcpy(held, v, sizeof v);
     }
-    memcpy(held, v, sizeof v);
-    if (nc__gige_reg(fc, REG_TRIGGER_MODE) > 1 || nc__gige_reg(fc, REG_TRIGGER_SOURCE) > 1 ||
-        nc__gige_reg(fc, REG_TRIGGER_ACT) > 2) {
-        nc__gige_publish(fc, applied);
-        *why = "TriggerMode, TriggerSource or TriggerActivation not one of its entries";
-        undone++;
+    /* A trigger enumeration that is no entry gets the applied setting back,
+     * the others stand. */
+    const uint32_t treg[3] = {REG_TRIGGER_MODE, REG_TRIGGER_SOURCE, REG_TRIGGER_ACT}, tmax[3] = {1, 1, 2};
+    const uint32_t tapplied[3] = {(uint32_t)applied->triggered, applied->source == NC_SOURCE_SOFTWARE ? 1u : 0u,
+                                  (uint32_t)applied->activation};
+    static const char *const tname[3] = {"TriggerMode", "TriggerSource", "TriggerActivation"};
+    for (int i = 0; i < 3; i++) {
+        const uint32_t t = nc__gige_reg(fc, treg[i]);
+        if (t > tmax[i]) {
+            nc__gige_reg_set(fc, treg[i], tapplied[i]);
+            snprintf(msg, sizeof msg, "%s %u: not one of its entries", tname[i], t);
+            refused(arg, msg);
+            undone++;
+        }
     }
     return undone;
 }

@@ -38,9 +38,12 @@ double nc__gige_reg_double(ArvFakeCamera *fc, uint32_t a);
 void nc__gige_reg_set_double(ArvFakeCamera *fc, uint32_t a, double d);
 void nc__gige_reg_set_string(ArvFakeCamera *fc, uint32_t a, size_t len, const char *s);
 
-/* The registers a client sees, from the emulator's settings a. */
+/* The registers a client sees, from the emulator's settings a; _changed
+ * writes only those whose image differs from shown (what they show now). */
 void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a);
-/* The settings the registers hold now (those they do not hold from base). */
+void nc__gige_publish_changed(ArvFakeCamera *fc, const struct nc_acquisition *a, const struct nc_acquisition *shown);
+/* The settings the registers hold now (those they do not hold from base;
+ * a register that shows base's value gives base's value, not its image). */
 void nc__gige_read_settings(ArvFakeCamera *fc, const struct nc_acquisition *base, struct nc_acquisition *a);
 int nc__gige_same(const struct nc_acquisition *a, const struct nc_acquisition *b);
 /* The settings a client wrote within the XML's ranges (ExposureTime 1 us
@@ -64,13 +67,14 @@ void nc__gige_hold(ArvFakeCamera *fc, uint32_t held[NC_GIGE_HELD]);
  * the client's to check, and Aravis leaves them unchecked by default): the
  * checks a camera's firmware makes, for a sensor of w x h pixels with
  * meta_rows metadata rows. The read-only registers get their values back;
- * image registers outside the XML's ranges (the region beyond the sensor,
- * a packet size outside 576..65000 or off its step of 4, a pixel format
- * that is no entry, a heartbeat timeout outside 500..60000 ms) the last
- * values that held (held, updated when they
- * hold); a trigger enumeration that is no entry, the settings applied.
- * Returns how many kinds of write were undone, *why the last. */
+ * of the image registers (the region within the sensor, a packet size of
+ * 576..65000 in steps of 4, a pixel format that is an entry, a heartbeat
+ * timeout of 500..60000 ms) written since the last check, the fewest whose
+ * undoing makes the rest hold get their held values back (held: the last
+ * set that held, updated); a trigger enumeration that is no entry gets the
+ * applied setting back. Calls refused(arg, why) for each write undone and
+ * returns how many. */
 int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uint32_t held[NC_GIGE_HELD],
-                             const struct nc_acquisition *applied, const char **why);
+                             const struct nc_acquisition *applied, void (*refused)(void *, const char *), void *arg);
 
 #endif

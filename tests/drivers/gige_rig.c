@@ -26,6 +26,7 @@ const char *navcam, *tmp;
 unsigned long incomplete; /* buffers that arrived with missing packets */
 unsigned long unfilled;   /* buffers Aravis gave back as they were (start()'s datagrams) */
 uint64_t frame_id;        /* of the last frame next_frame returned */
+int rig_packet_size = 8192;
 
 int rig_args(int argc, char **argv, const char *prog)
 {
@@ -95,7 +96,8 @@ ArvCamera *open_camera(void)
         for (int i = 0; c && i < 5 && !arv_gv_device_is_controller(ARV_GV_DEVICE(arv_camera_get_device(c))); i++)
             arv_gv_device_take_control(ARV_GV_DEVICE(arv_camera_get_device(c)), NULL);
         if (c && arv_gv_device_is_controller(ARV_GV_DEVICE(arv_camera_get_device(c)))) {
-            arv_camera_gv_set_packet_size(c, 8192, NULL);
+            if (rig_packet_size)
+                arv_camera_gv_set_packet_size(c, rig_packet_size, NULL);
             return c;
         }
         if (c)

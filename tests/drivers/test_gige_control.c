@@ -116,20 +116,27 @@ static void test_client_killed(void)
 }
 
 /* Lock-step refuses AcquisitionFrameRate and TriggerMode On: written back to
- * back with ExposureTime, they are undone and the exposure stands. */
+ * back with ExposureTime, they are undone and the exposure stands. The
+ * packet size on lo is 65000 until a client sets it. */
 static void test_lockstep_units(void)
 {
     char dir[4096];
     pid_t pid;
-    ArvCamera *c = begin("lockstep", "outputs=[{driver: gige}]", "serve.mode=lockstep", &pid, dir, sizeof dir);
+    rig_packet_size = 0;
+    ArvCamera *c = begin("lockstep", "outputs=[{driver: gige, poll_hz: 4}]", "serve.mode=lockstep", &pid, dir,
+                         sizeof dir);
+    rig_packet_size = 8192;
     if (!c)
         return;
     ArvDevice *d = arv_camera_get_device(c);
+    gint64 packet = arv_device_get_integer_feature_value(d, "GevSCPSPacketSize", NULL);
+    printf("GevSCPSPacketSize on lo by default: %lld bytes\n", (long long)packet);
+    CHECK(packet == 65000, "GevSCPSPacketSize %lld bytes by default on lo, want 65000", (long long)packet);
     double rate0 = arv_camera_get_frame_rate(c, NULL);
     arv_device_set_float_feature_value(d, "ExposureTime", 2500, NULL);
     arv_device_set_float_feature_value(d, "AcquisitionFrameRate", rate0 + 2, NULL);
     arv_device_set_string_feature_value(d, "TriggerMode", "On", NULL);
-    usleep(100000);
+    usleep(600000); /* the device checks 4 times a second here: the three writes meet one check */
     double ex = arv_device_get_float_feature_value(d, "ExposureTime", NULL);
     double rate = arv_camera_get_frame_rate(c, NULL);
     const char *mode = arv_device_get_string_feature_value(d, "TriggerMode", NULL);
