@@ -94,23 +94,35 @@ static int open_yaml(struct nc_cfg *cfg, struct nc_trigger *t, const char *yaml,
     return rc;
 }
 
+/* open_yaml, which must succeed. */
+static int open_ok(struct nc_cfg *cfg, struct nc_trigger *t, const char *yaml, struct rec *r)
+{
+    int rc = open_yaml(cfg, t, yaml, r);
+    CHECK(rc == 0, "open: %s", nc_errmsg());
+    return rc;
+}
+
+/* Run trigger t until r holds at least n edges. */
+static void run_until(struct nc_trigger *t, struct rec *r, int n)
+{
+    CHECK(nc_trigger_start(t) == 0, "start: %s", nc_errmsg());
+    while (atomic_load(&r->n) < n)
+        nanosleep(&(struct timespec){0, 1000000}, NULL);
+    nc_trigger_stop(t);
+}
+
 static void test_timer(void)
 {
     struct nc_cfg cfg;
     struct nc_trigger t;
     static struct rec r;
     /* Every edge passes (any_edge): rising on the 5 ms grid, falling 1 ms later. */
-    int rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 200\npulse_width_s: 0.001\nactivation: any_edge\n"
-                                 "delay_s: 0.004\n", &r);
-    CHECK(rc == 0, "open: %s", nc_errmsg());
-    if (rc < 0)
+    if (open_ok(&cfg, &t, "driver: timer\nrate_hz: 200\npulse_width_s: 0.001\nactivation: any_edge\n"
+                "delay_s: 0.004\n", &r) < 0)
         return;
     CHECK(nc_cfg_check_unused(&cfg) == 0, "timer options left unread: %s", nc_errmsg());
     CHECK(nc_trigger_activation(&t) == NC_TRIGGER_ANY && nc_trigger_delay_ns(&t) == 4 * MS, "gate options not applied");
-    CHECK(nc_trigger_start(&t) == 0, "start: %s", nc_errmsg());
-    while (atomic_load(&r.n) < 20)
-        nanosleep(&(struct timespec){0, 1000000}, NULL);
-    nc_trigger_stop(&t);
+    run_until(&t, &r, 20);
     int n = atomic_load(&r.n);
     int64_t worst_late = 0;
     for (int i = 0; i < n; i++) {
@@ -134,14 +146,9 @@ static void test_timer(void)
      * 60) past the grid's start, never a sum of rounded periods (which
      * drifts 1/3 ns a tick, 72 us an hour). */
     static struct rec r60;
-    rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 60\n", &r60);
-    CHECK(rc == 0, "open: %s", nc_errmsg());
-    if (rc < 0)
+    if (open_ok(&cfg, &t, "driver: timer\nrate_hz: 60\n", &r60) < 0)
         return;
-    nc_trigger_start(&t);
-    while (atomic_load(&r60.n) < 7)
-        nanosleep(&(struct timespec){0, 1000000}, NULL);
-    nc_trigger_stop(&t);
+    run_until(&t, &r60, 7);
     for (int k = 1; k < 7; k++)
         CHECK(r60.e[k].edge_mono_ns - r60.e[0].edge_mono_ns == llround((k + 1) * 1e9 / 60) - llround(1e9 / 60),
               "60 Hz: edge %d at %lld ns from edge 0, want %lld", k,
@@ -153,14 +160,9 @@ static void test_timer(void)
     /* Falling edges only, then rising only after a run-time change: the gate
      * filters, and counts what it filtered. */
     static struct rec rf;
-    rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 200\nactivation: falling_edge\n", &rf);
-    CHECK(rc == 0, "open: %s", nc_errmsg());
-    if (rc < 0)
+    if (open_ok(&cfg, &t, "driver: timer\nrate_hz: 200\nactivation: falling_edge\n", &rf) < 0)
         return;
-    nc_trigger_start(&t);
-    while (atomic_load(&rf.n) < 6)
-        nanosleep(&(struct timespec){0, 1000000}, NULL);
-    nc_trigger_stop(&t);
+    run_until(&t, &rf, 6);
     int nf = atomic_load(&rf.n);
     for (int i = 1; i < nf; i++)
         CHECK(rf.e[i].edge_mono_ns - rf.e[i - 1].edge_mono_ns == 5 * MS, "falling edges %d, %d not one period apart",
@@ -173,9 +175,7 @@ static void test_timer(void)
 
     /* stop() wakes a timer that would next fire in 100 s. */
     static struct rec r2;
-    rc = open_yaml(&cfg, &t, "driver: timer\nrate_hz: 0.01\n", &r2);
-    CHECK(rc == 0, "open: %s", nc_errmsg());
-    if (rc < 0)
+    if (open_ok(&cfg, &t, "driver: timer\nrate_hz: 0.01\n", &r2) < 0)
         return;
     nc_trigger_start(&t);
     nanosleep(&(struct timespec){0, 20000000}, NULL);
