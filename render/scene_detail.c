@@ -23,10 +23,6 @@ int nc__scene_error_at(const struct nc_cfg_node *n)
     return nc_cfg_error(n, "%s", why);
 }
 
-/* `shape.craters` of a mesh or asteroid: a mean count of the default
- * population (a number), or a map of its parameters. An asteroid without
- * the key gets 100. */
-
 /* max_diameter_m not above min_diameter_m: the error names the key given
  * (max, else min: a --set of one names the --set), else the map. */
 static int diameters_error(struct nc_cfg_node *map, double d_min_m, double d_max_m)
@@ -36,6 +32,10 @@ static int diameters_error(struct nc_cfg_node *map, double d_min_m, double d_max
         at = nc_cfg_get(map, "min_diameter_m");
     return nc_cfg_error(at ? at : map, "max_diameter_m (%g) must exceed min_diameter_m (%g)", d_max_m, d_min_m);
 }
+
+/* `shape.craters` of a mesh or asteroid: a mean count of the default
+ * population (a number), or a map of its parameters. An asteroid without
+ * the key gets 100. */
 static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir, int dry)
 {
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
