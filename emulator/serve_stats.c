@@ -104,7 +104,7 @@ void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f)
             atomic_load(&e->received));
     fprintf(f, "\"rejected\": {");
     for (int i = 1; i < NC_REJECT_COUNT; i++)
-        fprintf(f, "%s\"%s\": %lu", i > 1 ? ", " : "", nc_reject_name((enum nc_reject)i), atomic_load(&e->rejected[i]));
+        fprintf(f, "%s\"%s\": %lu", i > 1 ? ", " : "", nc_reject_key((enum nc_reject)i), atomic_load(&e->rejected[i]));
     fprintf(f, "}, \"dropped\": {");
     for (int i = 0; i < NC__DROP_COUNT; i++)
         fprintf(f, "%s\"%s\": %lu", i ? ", " : "", nc__serve_drop_names[i], atomic_load(&e->dropped[i]));

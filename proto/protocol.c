@@ -11,9 +11,20 @@
 const char *nc_reject_name(enum nc_reject r)
 {
     switch (r) {
-#define NC__XNAME(name, text) case NC_REJECT_##name: return text;
+#define NC__XNAME(name, key, text) case NC_REJECT_##name: return text;
         NC_REJECT_REASONS(NC__XNAME)
 #undef NC__XNAME
+    default:
+        return "accepted";
+    }
+}
+
+const char *nc_reject_key(enum nc_reject r)
+{
+    switch (r) {
+#define NC__XKEY(name, key, text) case NC_REJECT_##name: return key;
+        NC_REJECT_REASONS(NC__XKEY)
+#undef NC__XKEY
     default:
         return "accepted";
     }

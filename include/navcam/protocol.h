@@ -48,30 +48,34 @@ enum nc_msg_flags {
 /* The flags of a POSE's blocks, which no other type takes. */
 #define NC_MSG_POSE_ONLY_FLAGS 0x0Fu
 
-/* Why a message was rejected: one counter each in the emulator. */
+/* Why a message was rejected: one counter each in the emulator. Each reason has a key (the name of its
+ * counter in the emulator's statistics JSON) and a phrase (its log lines). */
 #define NC_REJECT_REASONS(X)                                                                                   \
-    X(TRUNCATED, "truncated")                                                                                  \
-    X(OVERSIZED, "oversized")                                                                                  \
-    X(BAD_MAGIC, "bad magic")                                                                                  \
-    X(BAD_VERSION, "unsupported version")                                                                      \
-    X(BAD_TYPE, "unknown message type")                                                                        \
-    X(BAD_LENGTH, "length field disagrees with the message")                                                   \
-    X(BAD_FLAGS, "unknown flags")                                                                              \
-    X(BAD_CRC, "bad CRC")                                                                                      \
-    X(NOT_FINITE, "NaN or infinite value")                                                                     \
-    X(BAD_QUATERNION, "quaternion not of unit length")                                                         \
-    X(BAD_VALUE, "value out of range")                                                                         \
-    X(TIME_BACKWARDS, "simulation time went backwards")
+    X(TRUNCATED, "truncated", "truncated")                                                                     \
+    X(OVERSIZED, "oversized", "oversized")                                                                     \
+    X(BAD_MAGIC, "bad_magic", "bad magic")                                                                     \
+    X(BAD_VERSION, "bad_version", "unsupported version")                                                       \
+    X(BAD_TYPE, "bad_type", "unknown message type")                                                            \
+    X(BAD_LENGTH, "bad_length", "length field disagrees with the message")                                     \
+    X(BAD_FLAGS, "bad_flags", "unknown flags")                                                                 \
+    X(BAD_CRC, "bad_crc", "bad CRC")                                                                           \
+    X(NOT_FINITE, "not_finite", "NaN or infinite value")                                                       \
+    X(BAD_QUATERNION, "bad_quaternion", "quaternion not of unit length")                                       \
+    X(BAD_VALUE, "out_of_range", "value out of range")                                                         \
+    X(TIME_BACKWARDS, "time_backwards", "simulation time went backwards")
 
 enum nc_reject {
     NC_REJECT_NONE = 0,
-#define NC__XREJ(name, text) NC_REJECT_##name,
+#define NC__XREJ(name, key, text) NC_REJECT_##name,
     NC_REJECT_REASONS(NC__XREJ)
 #undef NC__XREJ
         NC_REJECT_COUNT
 };
 
+/* The phrase ("quaternion not of unit length"); "accepted" for NC_REJECT_NONE. */
 const char *nc_reject_name(enum nc_reject r);
+/* The key ("bad_quaternion"), as in the statistics JSON's "rejected" object; "accepted" for NC_REJECT_NONE. */
+const char *nc_reject_key(enum nc_reject r);
 
 struct nc_pose_msg {
     enum nc_msg_type type;

@@ -78,12 +78,12 @@ def reseal(b): return b[:-4] + struct.pack("<I", zlib.crc32(b[:-4]) & 0xFFFFFFFF
 msgs = {
     "truncated": good[:10],
     "oversized": good + bytes(2000),
-    "bad magic": b"X" + good[1:],
-    "unsupported version": reseal(good[:4] + b"\x02\x00" + good[6:]),
-    "unknown message type": reseal(good[:6] + b"\x09\x00" + good[8:]),
-    "bad CRC": good[:-1] + bytes([good[-1] ^ 1]),
-    "NaN or infinite value": pc.encode(pc.POSE, 2, 0, 10**9, (float("nan"), 0, 0)),
-    "quaternion not of unit length": pc.encode(pc.POSE, 3, 0, 10**9, (0, -6000, 0), (0.9, 0, 0, 0)),
+    "bad_magic": b"X" + good[1:],
+    "bad_version": reseal(good[:4] + b"\x02\x00" + good[6:]),
+    "bad_type": reseal(good[:6] + b"\x09\x00" + good[8:]),
+    "bad_crc": good[:-1] + bytes([good[-1] ^ 1]),
+    "not_finite": pc.encode(pc.POSE, 2, 0, 10**9, (float("nan"), 0, 0)),
+    "bad_quaternion": pc.encode(pc.POSE, 3, 0, 10**9, (0, -6000, 0), (0.9, 0, 0, 0)),
 }
 for m in msgs.values():
     s.sendto(m, ("127.0.0.1", port))
@@ -119,12 +119,11 @@ PY
   > "$tmp/reject/pose.out" 2>&1 && grep -q "delivered" "$tmp/reject/pose.out" && ok \
   || bad "no frame after the rejections: $(cat "$tmp/reject/pose.out")"
 stop
-[ "$(json "$tmp/reject/stats.json" "d['rejected']['quaternion not of unit length']")" = 2 ] && ok \
+[ "$(json "$tmp/reject/stats.json" "d['rejected']['bad_quaternion']")" = 2 ] && ok \
   || bad "quaternion rejection not counted twice"
 [ "$(json "$tmp/reject/stats.json" "d['dropped']['rejected_request']")" = 1 ] && ok \
   || bad "the refused capture not counted as rejected_request"
-for r in "bad magic" "unsupported version" "unknown message type" "bad CRC" \
-         "NaN or infinite value" "simulation time went backwards"; do
+for r in bad_magic bad_version bad_type bad_crc not_finite time_backwards; do
   [ "$(json "$tmp/reject/stats.json" "d['rejected']['$r']")" = 1 ] && ok || bad "rejection '$r' not counted once"
 done
 # truncated: one datagram, one TCP message; oversized: those and the 100000-byte prefix

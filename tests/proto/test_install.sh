@@ -66,7 +66,7 @@ cc -std=c11 -D_POSIX_C_SOURCE=200809L -Wall -Werror "${san[@]}" -o "$tmp/sim" "$
 # in C++ too (the headers declare C linkage).
 lib=$(pkg-config --variable=libdir navcam-client)/libnavcam-client.a
 [ "$(nm -g --defined-only "$lib" | awk 'NF == 3 {print $3}' | sort | tr '\n' ' ')" = \
-  "nc_client_close nc_client_connect nc_client_errmsg nc_client_next_frame nc_client_send nc_client_wait_frame nc_msg_decode nc_msg_encode nc_msg_size nc_reject_name " ] \
+  "nc_client_close nc_client_connect nc_client_errmsg nc_client_next_frame nc_client_send nc_client_wait_frame nc_msg_decode nc_msg_encode nc_msg_size nc_reject_key nc_reject_name " ] \
   && ok || bad "the library exports more than its API: $(nm -g --defined-only "$lib" | awk 'NF == 3 {print $3}' | tr '\n' ' ')"
 cat >"$tmp/clash.c" <<'SIM'
 #include <navcam/client.h>

@@ -123,5 +123,11 @@ int main(void)
     CHECK(nc_msg_decode(t, n, &out) == NC_REJECT_NONE && fabs(nc_quat_norm(out.cam_attitude_q) - 1) < 1e-15,
           "a quaternion within tolerance is accepted and normalised");
     CHECK(!strcmp(nc_reject_name(NC_REJECT_TIME_BACKWARDS), "simulation time went backwards"), "reason names");
+    CHECK(!strcmp(nc_reject_key(NC_REJECT_BAD_VALUE), "out_of_range") && !strcmp(nc_reject_key(NC_REJECT_NONE), "accepted"),
+          "reason keys");
+    for (int r = NC_REJECT_NONE + 1; r < NC_REJECT_COUNT; r++) { /* keys are identifiers: lower case, digits, '_' */
+        const char *k = nc_reject_key((enum nc_reject)r);
+        CHECK(k[0] && strspn(k, "abcdefghijklmnopqrstuvwxyz0123456789_") == strlen(k), "key '%s'", k);
+    }
     return nc_test_end();
 }
