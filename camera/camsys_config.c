@@ -123,7 +123,7 @@ static int passband_map(struct nc_cfg_node *pb, struct nc_optics *o)
     if (!hf || !ht)
         return nc_cfg_missing(pb, hf ? "to_m" : "from_m", "both edges of the band, in metres");
     if (!(to > from))
-        return nc_cfg_error(nc_cfg_get(pb, "to_m"), "expected to_m > from_m, got %g <= %g", to, from);
+        return nc_cfg_key_error(pb, "to_m", "expected to_m > from_m, got %g <= %g", to, from);
     const double row[2][2] = {{from, 1}, {to, 1}};
     passband_integrate(row, 2, o);
     return 0;
@@ -145,11 +145,11 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
     if ((hd = nc_cfg_double(m, "aperture_diameter_m", 1e-6, 100, &d)) < 0)
         return hd;
     if (hn && hd)
-        return nc_cfg_error(nc_cfg_get(m, "aperture_diameter_m"), "give either f_number or aperture_diameter_m, not both");
+        return nc_cfg_key_error(m, "aperture_diameter_m", "give either f_number or aperture_diameter_m, not both");
     if (hd) {
         if (!(focal_length_m > 0))
-            return nc_cfg_error(nc_cfg_get(m, "aperture_diameter_m"),
-                                "needs camera.focal_length_m (the camera gives fx_px); give f_number instead");
+            return nc_cfg_key_error(m, "aperture_diameter_m",
+                                    "needs camera.focal_length_m (the camera gives fx_px); give f_number instead");
         o->f_number = focal_length_m / d;
     }
     if ((rc = nc_cfg_double(m, "transmission", 0, 1, &o->transmission)) < 0)
@@ -216,7 +216,7 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
             if ((rc = nc_psf_image(path, &o->psf)) < 0) {
                 char why[600];
                 snprintf(why, sizeof why, "%s", nc_errmsg());
-                return nc_cfg_error(nc_cfg_get(psf, "file"), "%s", why);
+                return nc_cfg_key_error(psf, "file", "%s", why);
             }
         }
     }
@@ -251,10 +251,10 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
     /* One pitch for geometry and radiometry: the camera's (focal_length_m /
      * fx_px) when it has one. */
     if (rc && pitch_m > 0 && fabs(s->pixel_pitch_m - pitch_m) > 1e-9 * pitch_m)
-        return nc_cfg_error(nc_cfg_get(m, "pixel_pitch_m"),
-                            "%g m disagrees with the camera's pixel pitch %g m (camera.pixel_pitch_m, or "
-                            "focal_length_m / fx_px); give the pitch once, in camera",
-                            s->pixel_pitch_m, pitch_m);
+        return nc_cfg_key_error(m, "pixel_pitch_m",
+                                "%g m disagrees with the camera's pixel pitch %g m (camera.pixel_pitch_m, or "
+                                "focal_length_m / fx_px); give the pitch once, in camera",
+                                s->pixel_pitch_m, pitch_m);
     if (!(s->pixel_pitch_m > 0))
         return nc_cfg_missing(m, "pixel_pitch_m", "the pixel pitch in metres (the camera gives fx_px)");
     if ((rc = nc_cfg_double(m, "qe", 0, 1, &s->qe)) < 0)
@@ -272,8 +272,8 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
         (rc = nc_cfg_double(m, "dsnu_e_s", 0, 1e9, &s->dsnu_e_s)) < 0)
         return rc;
     if (s->dsnu_e_s > 0 && !(s->dark_current_e_s > 0))
-        return nc_cfg_error(nc_cfg_get(m, "dsnu_e_s"), "a dark signal non-uniformity scales the mean dark current: "
-                                                      "give dark_current_e_s > 0 (or dsnu_e_s: 0)");
+        return nc_cfg_key_error(m, "dsnu_e_s", "a dark signal non-uniformity scales the mean dark current: "
+                                               "give dark_current_e_s > 0 (or dsnu_e_s: 0)");
     if ((rc = nc_cfg_double(m, "prnu", 0, 1, &s->prnu)) < 0 ||
         (rc = nc_cfg_double(m, "hot_pixel_fraction", 0, 1, &s->hot_pixel_fraction)) < 0 ||
         (rc = nc_cfg_double(m, "hot_pixel_dark_e_s", 0, 1e9, &s->hot_pixel_dark_e_s)) < 0 ||
@@ -310,7 +310,7 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
     if (s->shutter == NC_SHUTTER_ROLLING && !(s->line_time_s > 0))
         return nc_cfg_missing(m, "line_time_s", "the delay between successive rows of a rolling shutter, seconds");
     if (s->bias_dn > ldexp(1.0, s->adc_bits) - 1)
-        return nc_cfg_error(nc_cfg_get(m, "bias_dn"), "bias %g DN does not fit a %d-bit ADC", s->bias_dn, s->adc_bits);
+        return nc_cfg_key_error(m, "bias_dn", "bias %g DN does not fit a %d-bit ADC", s->bias_dn, s->adc_bits);
     (void)geom;
     return 0;
 }

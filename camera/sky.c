@@ -59,7 +59,7 @@ int nc_sky_from_config(struct nc_cfg *cfg, struct nc_sky *sky)
         (rc = nc_cfg_vec3(m, "observer_velocity_m_s", &sky->observer_velocity_m_s)) < 0)
         return rc;
     if (!(nc_v3_norm(sky->observer_velocity_m_s) < 0.01 * 299792458.0))
-        return nc_cfg_error(nc_cfg_get(m, "observer_velocity_m_s"), "expected a speed below 1 %% of light's");
+        return nc_cfg_key_error(m, "observer_velocity_m_s", "expected a speed below 1 %% of light's");
     if ((rc = nc_cfg_check_unused_in(cfg, m)) < 0) /* its one reader: a typo is not a default */
         return rc;
     nc_cfg_where(m, sky->where, sizeof sky->where);

@@ -79,6 +79,10 @@ void nc_cfg_resolve_path(const struct nc_cfg_node *n, const char *file, char *ou
 /* Error helpers that prefix "origin:line: path:" for a node (or the place a
  * missing key should have been). */
 int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The error about key of map, at the key's line when it is there, else at the
+ * map's (a default that failed): "FILE:LINE: outputs[0].path: ..." either way. */
+int nc_cfg_key_error(struct nc_cfg_node *map, const char *key, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected);
 /* map lacks every one of keys (NULL-terminated): the error msg on map, with
  * the key no reader took that most likely misspells one of them. */

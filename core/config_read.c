@@ -160,7 +160,7 @@ int nc_cfg_enum(struct nc_cfg_node *parent, const char *key, const char *const *
         }
         snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", names[i]);
     }
-    return nc_cfg_error(nc_cfg_get(parent, key), "expected one of: %s; got \"%s\"", list, s);
+    return nc_cfg_key_error(parent, key, "expected one of: %s; got \"%s\"", list, s);
 }
 
 int nc_cfg_doubles(struct nc_cfg_node *parent, const char *key, double *out, size_t n)
@@ -199,8 +199,8 @@ int nc_cfg_quat(struct nc_cfg_node *parent, const char *key, struct nc_quat *out
     struct nc_quat q = {v[0], v[1], v[2], v[3]};
     double n = nc_quat_norm(q);
     if (fabs(n - 1.0) > 1e-3)
-        return nc_cfg_error(nc_cfg_get(parent, key),
-                            "expected a unit quaternion [w, x, y, z] (scalar first), got norm %.9g", n);
+        return nc_cfg_key_error(parent, key,
+                                "expected a unit quaternion [w, x, y, z] (scalar first), got norm %.9g", n);
     *out = (struct nc_quat){q.w / n, q.x / n, q.y / n, q.z / n};
     return 1;
 }
@@ -224,8 +224,10 @@ static struct nc_cfg_node *first_unused(struct nc_cfg_node *n)
 static int vcfg_error(const struct nc_cfg_node *node, const char *key, const char *fmt, va_list ap)
 {
     char path[256], msg[512];
-    nc_cfg_path(node, path, sizeof path);
     vsnprintf(msg, sizeof msg, fmt, ap);
+    if (!node) /* no place to name (a caller's nc_cfg_get of an absent key) */
+        return key ? nc_error(NC_ECONFIG, "config: %s: %s", key, msg) : nc_error(NC_ECONFIG, "config: %s", msg);
+    nc_cfg_path(node, path, sizeof path);
     const char *sep = key ? (node->parent ? "." : "") : "";
     if (key && !node->parent)
         path[0] = '\0';
@@ -239,6 +241,16 @@ int nc_cfg_error(const struct nc_cfg_node *node, const char *fmt, ...)
     va_list ap;
     va_start(ap, fmt);
     int rc = vcfg_error(node, NULL, fmt, ap);
+    va_end(ap);
+    return rc;
+}
+
+int nc_cfg_key_error(struct nc_cfg_node *map, const char *key, const char *fmt, ...)
+{
+    const struct nc_cfg_node *n = map && map->kind == NC_CFG_MAP ? nc__cfg_find(map, key) : NULL;
+    va_list ap;
+    va_start(ap, fmt);
+    int rc = n ? vcfg_error(n, NULL, fmt, ap) : vcfg_error(map, key, fmt, ap);
     va_end(ap);
     return rc;
 }

@@ -24,7 +24,7 @@ struct file_out {
 static const char *const fits_orders[] = {"top_down", "bottom_up", NULL};
 
 static const struct nc_param file_params[] = {
-    NC_P_STRING("directory", "out", "where the files go (made if missing, with its parents)"),
+    NC_P_STRING("directory", "out", "where the files go (relative to the working directory; made if missing, with its parents)"),
     NC_P_STRING("pattern", "frame_%06llu.png", "file name with one conversion %llu, %06llu or the like (flags - and 0, width up to 99) for the frame number, no other %; the extension picks the format "
      "(.png, .tif, .fits, .exr)"),
     NC_P_ENUM("fits_row_order", "top_down", fits_orders,
@@ -61,30 +61,29 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     /* The pattern must format exactly one unsigned long long, into a name
      * a directory can hold for every frame number. */
     if (!pattern_ok(pattern) || strchr(pattern, '/'))
-        return nc_cfg_error(nc_cfg_get(opts, "pattern"),
-                            "expected a file name with one %%llu conversion (flags - or 0, a width of at most 99), "
-                            "no other %% and no '/', e.g. frame_%%06llu.png");
+        return nc_cfg_key_error(opts, "pattern",
+                                "expected a file name with one %%llu conversion (flags - or 0, a width of at most 99), "
+                                "no other %% and no '/', e.g. frame_%%06llu.png");
     char probe[512];
     if (snprintf(probe, sizeof probe, pattern, ~0ULL) > NAME_MAX)
-        return nc_cfg_error(nc_cfg_get(opts, "pattern"), "makes file names longer than %d bytes", NAME_MAX);
+        return nc_cfg_key_error(opts, "pattern", "makes file names longer than %d bytes", NAME_MAX);
     snprintf(probe, sizeof probe, pattern, 0ULL);
     if (!nc_image_format_ok(probe, NULL))
-        return nc_cfg_error(nc_cfg_get(opts, "pattern"), "unsupported image format (use .png, .tif, .fits or .exr)");
+        return nc_cfg_key_error(opts, "pattern", "unsupported image format (use .png, .tif, .fits or .exr)");
     if (f->bottom_up && !nc_image_is_fits(probe))
-        return nc_cfg_error(nc_cfg_get(opts, "fits_row_order"), "applies to .fits patterns only (the pattern writes %s)",
-                            probe);
+        return nc_cfg_key_error(opts, "fits_row_order", "applies to .fits patterns only (the pattern writes %s)",
+                                probe);
     if (nc_image_prepare(probe) < 0) { /* now, not at the first frame */
         char why[4096];
         snprintf(why, sizeof why, "%s", nc_errmsg());
-        return nc_cfg_error(nc_cfg_get(opts, "pattern"), "%s", why);
+        return nc_cfg_key_error(opts, "pattern", "%s", why);
     }
     snprintf(f->dir, sizeof f->dir, "%s", dir);
     snprintf(f->pattern, sizeof f->pattern, "%s", pattern);
     if (nc_mkdirs(f->dir) < 0) { /* with every missing parent, as mkdir -p */
         char why[4200];
         snprintf(why, sizeof why, "%s", nc_errmsg());
-        return nc_cfg_error(nc_cfg_get(opts, "directory") ? nc_cfg_get(opts, "directory") : opts, "file output: %s",
-                            why);
+        return nc_cfg_key_error(opts, "directory", "file output: %s", why);
     }
     if (sidecar[0]) {
         snprintf(f->sidecar_path, sizeof f->sidecar_path, "%s/%s", f->dir, sidecar);

@@ -318,13 +318,13 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         (rc = nc_param_int(opts, gige_params, "metadata_row", &meta)) < 0)
         return rc;
     if (strlen(serial) == 0 || strlen(serial) > 15)
-        return nc_cfg_error(nc_cfg_get(opts, "serial"), "expected 1 to 15 characters");
+        return nc_cfg_key_error(opts, "serial", "expected 1 to 15 characters");
     if (strlen(model) > 31) /* DeviceModelName: 32 bytes, the last a NUL */
-        return nc_cfg_error(nc_cfg_get(opts, "model"), "expected at most 31 characters, not %zu", strlen(model));
+        return nc_cfg_key_error(opts, "model", "expected at most 31 characters, not %zu", strlen(model));
     if (packet > 0 && packet % 4)
-        return nc_cfg_error(nc_cfg_get(opts, "packet_size"), "expected a multiple of 4 (GevSCPSPacketSize's step)");
+        return nc_cfg_key_error(opts, "packet_size", "expected a multiple of 4 (GevSCPSPacketSize's step)");
     if (strlen(iface) >= sizeof g->iface)
-        return nc_cfg_error(nc_cfg_get(opts, "interface"), "interface name too long");
+        return nc_cfg_key_error(opts, "interface", "interface name too long");
     if (ctx->adc_bits > 16 || ctx->adc_bits < 8)
         return nc_error(NC_EUNSUPPORTED, "gige: ADC depth %d bits: GigE output takes 8 to 16", ctx->adc_bits);
     snprintf(g->iface, sizeof g->iface, "%s", iface);
@@ -344,7 +344,7 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
             snprintf(path, sizeof path, "%s/%s", ctx->config_dir, xml);
         GError *err = NULL;
         if (!g_file_get_contents(path, &xml_text, &xml_len, &err)) {
-            rc = nc_cfg_error(nc_cfg_get(opts, "xml"), "gige: %s", err ? err->message : "cannot read");
+            rc = nc_cfg_key_error(opts, "xml", "gige: %s", err ? err->message : "cannot read");
             g_clear_error(&err);
             return rc;
         }
@@ -353,7 +353,7 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         if (rc < 0) {
             char why[1024]; /* nc_cfg_error writes nc_errmsg's buffer */
             snprintf(why, sizeof why, "%s", nc_errmsg());
-            return nc_cfg_error(nc_cfg_get(opts, "xml"), "%s", why);
+            return nc_cfg_key_error(opts, "xml", "%s", why);
         }
     } else {
         if ((rc = nc__gige_check_xml("(built in)", navcam_genicam_xml, sizeof navcam_genicam_xml)) < 0)

@@ -328,16 +328,15 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         (rc = nc_param_int(opts, v4l2_params, "reopen_limit", &limit)) < 0)
         return rc;
     if (device && card)
-        return nc_cfg_error(nc_cfg_get(opts, "card"), "give either `device` or `card`, not both");
+        return nc_cfg_key_error(opts, "card", "give either `device` or `card`, not both");
     if (card && strlen(card) >= sizeof v->want_card)
-        return nc_cfg_error(nc_cfg_get(opts, "card"), "a V4L2 card label has at most 31 characters");
+        return nc_cfg_key_error(opts, "card", "a V4L2 card label has at most 31 characters");
     snprintf(v->want_path, sizeof v->want_path, "%s", device ? device : "");
     snprintf(v->want_card, sizeof v->want_card, "%s", card ? card : "");
     if (fmt == 0)
         fmt = ctx->adc_bits <= 8 ? 1 : 2;
     if (fmt == 1 && ctx->adc_bits > 8)
-        return nc_cfg_error(nc_cfg_get(opts, "format"), "GREY holds 8 bits; the camera's ADC has %d (use Y16)",
-                            ctx->adc_bits);
+        return nc_cfg_key_error(opts, "format", "GREY holds 8 bits; the camera's ADC has %d (use Y16)", ctx->adc_bits);
     v->fourcc = fmt == 1 ? V4L2_PIX_FMT_GREY : V4L2_PIX_FMT_Y16;
     v->msb = align == 0 && fmt == 2;
     v->io_opt = (enum io_method)io;

@@ -99,9 +99,9 @@ static int find_line(struct nc_cfg_node *opts, const struct nc_param *params, st
         out->chip = gpiod_chip_open_lookup(chip);
         if (!out->chip) {
             const int err = errno;
-            return nc_cfg_error(nc_cfg_get(opts, "chip"), "cannot open GPIO chip '%s': %s (%s)", chip, strerror(err),
-                                err == EACCES ? "udev/99-navcam.rules gives group gpio access: docs/setup.md"
-                                              : "gpiodetect lists the chips");
+            return nc_cfg_key_error(opts, "chip", "cannot open GPIO chip '%s': %s (%s)", chip, strerror(err),
+                                    err == EACCES ? "udev/99-navcam.rules gives group gpio access: docs/setup.md"
+                                                  : "gpiodetect lists the chips");
         }
     }
     struct gpiod_chip *c = out->chip ? out->chip : shared;
@@ -157,15 +157,15 @@ static int open_lines(struct gpio_trig *g, struct nc_cfg_node *opts)
     if ((rc = find_line(opts, gpio_params, NULL, &g->in)) < 0)
         return rc;
     if (gpiod_line_request_both_edges_events_flags(g->in.line, CONSUMER, bias_flags[bias]) < 0)
-        return nc_cfg_error(nc_cfg_get(opts, "line"), "cannot request GPIO %s for edge events: %s", g->in.desc,
-                            strerror(errno));
+        return nc_cfg_key_error(opts, "line", "cannot request GPIO %s for edge events: %s", g->in.desc,
+                                strerror(errno));
     if (st) {
         if ((rc = find_line(st, strobe_params, gpiod_line_get_chip(g->in.line), &g->strobe)) < 0)
             return rc;
         g->strobe_active_low = low;
         if (gpiod_line_request_output(g->strobe.line, CONSUMER, low) < 0)
-            return nc_cfg_error(nc_cfg_get(st, "line"), "cannot request GPIO %s as an output: %s", g->strobe.desc,
-                                strerror(errno));
+            return nc_cfg_key_error(st, "line", "cannot request GPIO %s as an output: %s", g->strobe.desc,
+                                    strerror(errno));
         g->have_strobe = 1;
     }
     g->wake_fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);

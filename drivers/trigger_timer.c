@@ -47,8 +47,8 @@ static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trig
     t->period_ns = llround(1e9 / rate_hz);
     t->width_ns = width_s > 0 ? llround(width_s * 1e9) : default_width(t->period_ns);
     if (t->width_ns >= t->period_ns)
-        return nc_cfg_error(nc_cfg_get(opts, "pulse_width_s"), "pulse_width_s must be shorter than the period 1/rate_hz = %g s",
-                            t->period_ns * 1e-9);
+        return nc_cfg_key_error(opts, "pulse_width_s", "pulse_width_s must be shorter than the period 1/rate_hz = %g s",
+                                t->period_ns * 1e-9);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);

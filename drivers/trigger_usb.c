@@ -131,8 +131,8 @@ static int parse_id(struct nc__usb_trig *u, struct nc_cfg_node *opts)
     char end;
     if (strlen(id) != 9 || strspn(id, "0123456789abcdefABCDEF") != 4 || id[4] != ':' ||
         strspn(id + 5, "0123456789abcdefABCDEF") != 4 || sscanf(id, "%x:%x%c", &v, &p, &end) != 2)
-        return nc_cfg_error(nc_cfg_get(opts, "id"), "'%s' is not VID:PID (four hexadecimal digits each, as lsusb "
-                            "prints them, e.g. 1209:0001)", id);
+        return nc_cfg_key_error(opts, "id", "'%s' is not VID:PID (four hexadecimal digits each, as lsusb "
+                                "prints them, e.g. 1209:0001)", id);
     u->vid = (int)v, u->pid = (int)p;
     return 0;
 }

@@ -57,8 +57,7 @@ static const void *select_driver(const void *const *list, struct nc_cfg_node *op
         const char *best = nc__cfg_nearest(name, all, n);
         if (best)
             snprintf(hint, sizeof hint, "; did you mean '%s'?", best);
-        *rc = nc_cfg_error(nc_cfg_get(opts, "driver"), "unknown %s '%s'%s (this build has: %s)", kind, name, hint,
-                           names);
+        *rc = nc_cfg_key_error(opts, "driver", "unknown %s '%s'%s (this build has: %s)", kind, name, hint, names);
     }
     return drv;
 }

@@ -134,7 +134,7 @@ int nc__serve_config(struct nc_cfg *cfg, struct nc__emu *e, const char *config_d
         e->stale_render = st;
         struct in_addr ip;
         if (bind && inet_pton(AF_INET, bind, &ip) != 1)
-            return nc_cfg_error(nc_cfg_get(sv, "bind"), "'%s' is not an IPv4 address (a name is not looked up)", bind);
+            return nc_cfg_key_error(sv, "bind", "'%s' is not an IPv4 address (a name is not looked up)", bind);
         if (bind)
             snprintf(e->bind, sizeof e->bind, "%s", bind);
         if ((rc = int_key(sv, "queue_frames", 1, 1024, &e->queue_frames)) < 0 ||

@@ -17,8 +17,8 @@ static int sumfile_intrinsics(struct nc_cfg_node *map, struct nc_camera *c, stru
                                       "fy_px", "cx_px", "cy_px", "position_m", "attitude_q", "look_at_m", "up"};
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++)
         if (nc_cfg_get(map, own[i]))
-            return nc_cfg_error(nc_cfg_get(map, own[i]), "the SUM file (camera.sumfile) sets the size, intrinsics "
-                                                         "and pose: remove %s", own[i]);
+            return nc_cfg_key_error(map, own[i], "the SUM file (camera.sumfile) sets the size, intrinsics "
+                                                 "and pose: remove %s", own[i]);
     const struct nc_cfg_node *node = nc_cfg_get(map, "sumfile");
     char path[4096], why[600];
     nc_cfg_resolve_path(node, node->value, path, sizeof path);
@@ -68,8 +68,8 @@ static int camera_read(struct nc_cfg_node *map, struct nc_camera *c, struct nc_s
         (hfy = nc_cfg_double(map, "fy_px", 1e-3, 1e9, &fy)) < 0)
         return hf < 0 ? hf : hp < 0 ? hp : hfx < 0 ? hfx : hfy;
     if ((hf || hp) && (hfx || hfy))
-        return nc_cfg_error(nc_cfg_get(map, hf ? "focal_length_m" : "pixel_pitch_m"),
-                            "give either focal_length_m and pixel_pitch_m, or fx_px and fy_px, not both");
+        return nc_cfg_key_error(map, hf ? "focal_length_m" : "pixel_pitch_m",
+                                "give either focal_length_m and pixel_pitch_m, or fx_px and fy_px, not both");
     if (hf || hp) {
         if (!hf || !hp)
             return nc_cfg_missing(map, hf ? "pixel_pitch_m" : "focal_length_m",
@@ -146,14 +146,14 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
     if (hq < 0 || ht < 0 || hu < 0)
         return hq < 0 ? hq : ht < 0 ? ht : hu;
     if (hq && ht)
-        return nc_cfg_error(nc_cfg_get(map, "look_at_m"), "give either attitude_q or look_at_m, not both");
+        return nc_cfg_key_error(map, "look_at_m", "give either attitude_q or look_at_m, not both");
     if (hu && !ht)
-        return nc_cfg_error(nc_cfg_get(map, "up"), "'up' only goes with look_at_m");
+        return nc_cfg_key_error(map, "up", "'up' only goes with look_at_m");
     if (ht) {
         if ((rc = nc_quat_look_at(c->position_m, target, up, &c->attitude_q)) < 0) {
             char why[256];
             snprintf(why, sizeof why, "%s", nc_errmsg());
-            return nc_cfg_error(nc_cfg_get(map, "look_at_m"), "%s", why);
+            return nc_cfg_key_error(map, "look_at_m", "%s", why);
         }
     } else if (!hq) {
         return nc_cfg_missing(map, "attitude_q", "[w, x, y, z] camera-to-scene, or look_at_m");

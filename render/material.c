@@ -149,11 +149,11 @@ int nc_material_from_config(struct nc_cfg_node *map, struct nc_material *m)
     if (hp) {
         if ((rc = nc_material_preset(m, preset)) < 0) {
             snprintf(why, sizeof why, "%s", nc_errmsg());
-            return nc_cfg_error(nc_cfg_get(map, "preset"), "%s", why);
+            return nc_cfg_key_error(map, "preset", "%s", why);
         }
         if (hm && strcmp(names[which], m->model->name) != 0)
-            return nc_cfg_error(nc_cfg_get(map, "model"), "preset '%s' is a %s material, not %s", preset,
-                                m->model->name, names[which]);
+            return nc_cfg_key_error(map, "model", "preset '%s' is a %s material, not %s", preset,
+                                    m->model->name, names[which]);
     } else if (!hm) {
         return nc_cfg_missing(map, "model", "a reflectance model (lambert, lommel_seeliger, hapke, mcewen) or a preset");
     } else {

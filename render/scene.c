@@ -92,7 +92,7 @@ static int shape_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
             return rc ? rc : nc_cfg_missing(sh, "radii_m", "[a, b, c] semi-axes in metres");
         for (int i = 0; i < 3; i++)
             if (!(r[i] >= 1e-6 && r[i] <= 1e10))
-                return nc_cfg_error(nc_cfg_get(sh, "radii_m"), "semi-axes must be in [1e-6, 1e10] m");
+                return nc_cfg_key_error(sh, "radii_m", "semi-axes must be in [1e-6, 1e10] m");
         b->radii_m = nc_v3(r[0], r[1], r[2]);
         b->bounding_radius_m = fmax(r[0], fmax(r[1], r[2]));
         if (b->shape == NC_SHAPE_ELLIPSOID)
@@ -190,21 +190,21 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const st
     if ((hd = nc_cfg_vec3(map, "direction", &sun->direction)) < 0)
         return hd;
     if (sum_dir && hd)
-        return nc_cfg_error(nc_cfg_get(map, "direction"), "camera.sumfile gives the Sun's direction (SZ): remove "
-                                                          "sun.direction");
+        return nc_cfg_key_error(map, "direction", "camera.sumfile gives the Sun's direction (SZ): remove "
+                                                  "sun.direction");
     if ((hp = nc_cfg_vec3(map, "position_m", &sun->position_m)) < 0)
         return hp;
     if (sum_dir && hp)
-        return nc_cfg_error(nc_cfg_get(map, "position_m"), "camera.sumfile gives the Sun's direction (SZ): give "
-                                                           "sun.distance_au or sun.irradiance_w_m2 instead of "
-                                                           "sun.position_m");
+        return nc_cfg_key_error(map, "position_m", "camera.sumfile gives the Sun's direction (SZ): give "
+                                                   "sun.distance_au or sun.irradiance_w_m2 instead of "
+                                                   "sun.position_m");
     if ((hdist = nc_cfg_double(map, "distance_au", 1e-3, 1e4, &dist_au)) < 0)
         return hdist;
     if ((rc = nc_cfg_double(map, "irradiance_w_m2", 0, 1e9, &sun->irradiance_w_m2)) < 0)
         return rc;
     sun->irradiance_override = rc;
     if (hd && hp)
-        return nc_cfg_error(nc_cfg_get(map, "position_m"), "give either direction or position_m, not both");
+        return nc_cfg_key_error(map, "position_m", "give either direction or position_m, not both");
     if (sum_dir && !hdist && !sun->irradiance_override)
         return nc_cfg_missing(map, "distance_au", "the heliocentric distance in au (camera.sumfile gives the Sun's "
                                                   "direction only)");
@@ -215,17 +215,17 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const st
     if (!hd && !hp)
         return nc_cfg_missing(map, "direction", "a vector toward the Sun in the body-fixed frame, or position_m");
     if (hp && hdist)
-        return nc_cfg_error(nc_cfg_get(map, "distance_au"), "distance_au goes with direction; position_m sets the distance");
+        return nc_cfg_key_error(map, "distance_au", "distance_au goes with direction; position_m sets the distance");
     double d_m;
     if (hd) {
         if (nc_v3_norm(sun->direction) == 0)
-            return nc_cfg_error(nc_cfg_get(map, "direction"), "the Sun direction must not be zero");
+            return nc_cfg_key_error(map, "direction", "the Sun direction must not be zero");
         sun->direction = nc_v3_unit(sun->direction);
         d_m = dist_au * NC_AU_M;
     } else {
         d_m = nc_v3_norm(sun->position_m);
         if (d_m < 1e3)
-            return nc_cfg_error(nc_cfg_get(map, "position_m"), "the Sun is closer than 1 km to the body");
+            return nc_cfg_key_error(map, "position_m", "the Sun is closer than 1 km to the body");
         sun->has_position = 1;
     }
     sun->distance_m = d_m;
@@ -257,8 +257,9 @@ static int render_from_config(struct nc_cfg_node *map, struct nc_render_settings
     if (rc) {
         long s = lround(sqrt((double)v));
         if (s * s != v)
-            return nc_cfg_error(nc_cfg_get(map, "samples_per_pixel"),
-                                "expected a square number (1, 4, 9, 16, ...) for n x n stratified samples, got %ld", v);
+            return nc_cfg_key_error(map, "samples_per_pixel",
+                                    "expected a square number (1, 4, 9, 16, ...) for n x n stratified samples, "
+                                    "got %ld", v);
         r->samples_per_pixel = (int)v;
     }
     if ((rc = nc_cfg_seed(map, "seed", &r->seed)) < 0)
@@ -373,7 +374,7 @@ int nc_cfg_load_scene(struct nc_cfg *cfg, const char *path, const char *const *s
     if (rc >= 0 && path && cfg->root && cfg->root->kind == NC_CFG_MAP &&
         (rc = nc_cfg_string(cfg->root, "base", &base)) > 0) {
         if (strcmp(base, "builtin:default"))
-            return nc_cfg_error(nc_cfg_get(cfg->root, "base"), "unknown base '%s' (known: builtin:default)", base);
+            return nc_cfg_key_error(cfg->root, "base", "unknown base '%s' (known: builtin:default)", base);
         struct nc_cfg def;
         nc_cfg_init(&def);
         if ((rc = nc_cfg_load_string(&def, nc_default_scene_yaml, "<built-in default scene>")) >= 0 &&

@@ -79,7 +79,7 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const 
         if ((has_b = nc_cfg_double(map, "slope", 0.5, 6, &p.slope)) < 0)
             return has_b;
         if (has_s && has_b && p.slope != 2)
-            return nc_cfg_error(nc_cfg_get(map, "slope"), "saturation implies slope 2");
+            return nc_cfg_key_error(map, "slope", "saturation implies slope 2");
         if (has_s) /* Gault (1970): geometric saturation N(>D) = 1.54 D^-2 per km^2, D in km */
             p.c_per_km2 = sat * 1.54e6;
         if ((rc = nc_cfg_double(map, "min_diameter_m", 1e-6, 1e7, &p.d_min_m)) < 0 ||
@@ -128,7 +128,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b, int
     if ((rc = nc_cfg_map(item, "boulders", &map)) <= 0)
         return rc;
     if (!nc_body_is_mesh(b))
-        return nc_cfg_error(nc_cfg_get(item, "boulders"), "boulders need a mesh or asteroid shape");
+        return nc_cfg_key_error(item, "boulders", "boulders need a mesh or asteroid shape");
     struct nc_boulder_params p = {.d_min_m = 1, .d_max_m = 64, .burial_min = 0.1, .burial_max = 0.5, .shapes = 48,
                                   .seed = 1};
     const char *preset = NULL;
@@ -137,7 +137,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b, int
     if ((rc = nc_cfg_string(map, "preset", &preset)) < 0)
         return rc;
     if (preset && nc_boulder_preset(preset, &p) < 0)
-        return nc_cfg_error(nc_cfg_get(map, "preset"), "unknown preset '%s': bennu, ryugu or itokawa", preset);
+        return nc_cfg_key_error(map, "preset", "unknown preset '%s': bennu, ryugu or itokawa", preset);
     if ((has_c = nc_cfg_double(map, "density_per_km2", 0, 1e15, &p.c_per_km2)) < 0 ||
         (has_slope = nc_cfg_double(map, "slope", 0.5, 6, &p.slope)) < 0)
         return has_c < 0 ? has_c : has_slope;
@@ -153,7 +153,7 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b, int
         return rc;
     if (rc) {
         if (!(burial[0] >= 0 && burial[1] >= burial[0] && burial[1] <= 1))
-            return nc_cfg_error(nc_cfg_get(map, "burial"), "expected [min, max] fractions of height, 0 <= min <= max <= 1");
+            return nc_cfg_key_error(map, "burial", "expected [min, max] fractions of height, 0 <= min <= max <= 1");
         p.burial_min = burial[0], p.burial_max = burial[1];
     }
     if ((rc = nc_cfg_int(map, "shapes", 1, NC_ROCK_SHAPES_MAX, &v)) < 0)
@@ -184,7 +184,7 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double 
     if ((rc = nc_cfg_map(sh, "relief", &map)) <= 0)
         return rc;
     if (!nc_body_is_mesh(b))
-        return nc_cfg_error(nc_cfg_get(sh, "relief"), "relief needs a mesh or asteroid shape");
+        return nc_cfg_key_error(sh, "relief", "relief needs a mesh or asteroid shape");
     struct nc_relief_params p = {.hurst = 0.8, .amplitude = 1, .seed = 1};
     if ((rc = nc_cfg_double(map, "edge_m", 1e-6, 1e7, &p.edge_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "edge_m", "the mean edge length to subdivide down to, metres");
@@ -211,8 +211,8 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b, i
     if ((rc = nc_cfg_map(item, "albedo_variation", &map)) <= 0)
         return rc;
     if (!nc_body_is_mesh(b))
-        return nc_cfg_error(nc_cfg_get(item, "albedo_variation"),
-                            "albedo_variation needs a mesh or asteroid shape (an albedo map serves the others)");
+        return nc_cfg_key_error(item, "albedo_variation",
+                                "albedo_variation needs a mesh or asteroid shape (an albedo map serves the others)");
     /* default largest wavelength: a tenth of the radius of the sphere of
      * the same area, and at least four times the shortest the mesh carries
      * (twice its mean edge: a small tile) */
@@ -228,9 +228,9 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b, i
         dry)
         return rc;
     if (given && p.largest_m < shortest_m)
-        return nc_cfg_error(nc_cfg_get(map, "largest_m"), "%g m is below the shortest wavelength the mesh carries "
-                            "(twice its mean edge: %.4g m): raise it, or refine the mesh (shape.relief)",
-                            p.largest_m, shortest_m);
+        return nc_cfg_key_error(map, "largest_m", "%g m is below the shortest wavelength the mesh carries "
+                                "(twice its mean edge: %.4g m): raise it, or refine the mesh (shape.relief)",
+                                p.largest_m, shortest_m);
     if (p.rocks_rms < 0)
         p.rocks_rms = p.rms;
     double smallest_m = 0;
@@ -250,7 +250,7 @@ int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *s
     if ((rc = nc_cfg_enum(shape, "normals", normals, &smooth)) < 0)
         return rc;
     if (rc && !nc_body_is_mesh(b))
-        return nc_cfg_error(nc_cfg_get(shape, "normals"), "normals apply to mesh and asteroid shapes");
+        return nc_cfg_key_error(shape, "normals", "normals apply to mesh and asteroid shapes");
     b->smooth_normals = smooth;
     /* Craters displace the relief along the surface under it, not along
      * its own rough normals (craters.h). */

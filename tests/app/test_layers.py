@@ -13,7 +13,10 @@ Checks, on the source tree and the built static libraries:
   4. no source file (tests and benchmarks too) is over 520 lines, but the
      render hot path;
   5. adapters/ (programs for other boards, such as the USB trigger adapter)
-     use the wire protocols and core/ only: proto/, core/, include/.
+     use the wire protocols and core/ only: proto/, core/, include/;
+  6. drivers stand alone (docs/writing-drivers.md): a driver's files
+     (drivers/output_NAME.c or trigger_NAME.c and drivers/NAME/) include no
+     other driver's, and its main file exports its struct nc_KIND_NAME alone.
 Usage: test_layers.py SOURCE_DIR BUILD_DIR
 """
 import os
@@ -29,6 +32,7 @@ LIBS = {"navcam_core": "core", "navcam_render": "render", "navcam_camera": "came
 HOT_PATH = {"render/render.c", "render/rt_embree.c"}
 MAX_LINES = 520
 GENERATED = {"core/version.h", "drivers/navcam_genicam_xml.h"}
+GENERATED_DRIVER = {"drivers/navcam_genicam_xml.h": "gige"}  # generated headers and the driver they belong to
 
 src, build = sys.argv[1], sys.argv[2]
 failures = []
@@ -39,6 +43,17 @@ edges = {}  # (from layer, to layer) -> number of includes: the include graph
 def layer_of(rel):
     top = rel.split("/")[0]
     return top if top in RANK else None
+
+
+def driver_of(rel):
+    """The driver a file of drivers/ belongs to (None: shared, such as the registry)."""
+    if rel in GENERATED_DRIVER:
+        return GENERATED_DRIVER[rel]
+    parts = rel.split("/")
+    if len(parts) == 3:
+        return parts[1]
+    m = re.match(r"(?:output|trigger)_(\w+)\.c$", parts[1])
+    return m.group(1) if m else None
 
 
 def sources():
@@ -78,6 +93,9 @@ for rel in sources():
             failures.append(f"{rel}:{n}: {layer}/ includes {target} from the higher layer {tl}/")
         elif layer == "adapters" and tl not in ADAPTERS_MAY_USE:
             failures.append(f"{rel}:{n}: an adapter program includes {target}: adapters use proto/ and core/ only")
+        elif layer == tl == "drivers" and driver_of(rel) and driver_of(target) not in (None, driver_of(rel)):
+            failures.append(f"{rel}:{n}: the driver '{driver_of(rel)}' includes {target} of the driver "
+                            f"'{driver_of(target)}': a driver uses no other driver's code")
     lines = text.count("\n")
     if lines > MAX_LINES and rel not in HOT_PATH:
         failures.append(f"{rel}: {lines} lines (at most {MAX_LINES} outside the render hot path)")
@@ -122,6 +140,19 @@ for lib, syms in needs.items():
             links += 1
             if RANK[LIBS[owner]] > RANK[LIBS[lib]]:
                 failures.append(f"lib{lib}.a ({LIBS[lib]}/) calls {sym} of lib{owner}.a ({LIBS[owner]}/), a higher layer")
+
+# A driver's main file exports its struct alone (everything else static).
+out = subprocess.run(["nm", "-g", "-A", "--defined-only", os.path.join(build, "libnavcam_drivers.a")],
+                     capture_output=True, text=True).stdout
+exported = {}
+for line in out.splitlines():
+    _, member, rest = line.split(":", 2)  # ARCHIVE:MEMBER:ADDRESS TYPE SYMBOL
+    exported.setdefault(member, set()).add(rest.split()[-1])
+for member, syms in sorted(exported.items()):
+    m = re.match(r"(output|trigger)_(\w+)\.c\.o$", member)
+    if m and syms != {f"nc_{m.group(1)}_{m.group(2)}"}:
+        failures.append(f"drivers/{member[:-2]} exports {', '.join(sorted(syms))}: a driver's main file exports "
+                        f"nc_{m.group(1)}_{m.group(2)} alone")
 
 print("include graph between folders (from -> to: includes):")
 for (a, b), n in sorted(edges.items(), key=lambda e: (RANK[e[0][0]], RANK[e[0][1]])):

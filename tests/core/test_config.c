@@ -285,5 +285,18 @@ int main(void)
     nc_test_write(path, "base: builtin:nothing\n");
     rc = nc_scene_load(path, NULL, 0, &s);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:1: base: unknown base"), "bad base: %s", nc_errmsg());
+
+    /* An error about a key names it at its line, or at its map's when it is absent (a default that failed);
+     * one about no node at all (nc_cfg_get of an absent key) still gives the message. */
+    nc_cfg_init(&cfg);
+    nc_cfg_load_string(&cfg, "outputs:\n  - driver: hello\n    path: /x\n", "drv.yaml");
+    struct nc_cfg_node *out0 = nc_cfg_get(cfg.root, "outputs")->child[0];
+    CHECK(nc_cfg_key_error(out0, "path", "cannot open") < 0 &&
+              !strcmp(nc_errmsg(), "drv.yaml:3: outputs[0].path: cannot open"), "present key: %s", nc_errmsg());
+    CHECK(nc_cfg_key_error(out0, "every", "bad default %d", 3) < 0 &&
+              !strcmp(nc_errmsg(), "drv.yaml:2: outputs[0].every: bad default 3"), "absent key: %s", nc_errmsg());
+    CHECK(nc_cfg_error(nc_cfg_get(out0, "every"), "no node") < 0 && !strcmp(nc_errmsg(), "config: no node"),
+          "no node: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
     return nc_test_end();
 }
