@@ -107,35 +107,11 @@ static void check_registers(struct gige *g)
     nc__gige_check_registers(g->fc, g->W, g->H, g->meta_rows, g->held, &g->applied, refused, g);
 }
 
-/* Client-written settings to the emulator, when they changed: a write outside the XML's ranges is undone, the
- * others stand; if the emulator refuses them together (lock-step, a line it lacks), each unit is tried alone. */
+/* Client-written settings to the emulator (gige_regs.h). */
 static void apply_settings(struct gige *g)
 {
-    struct nc_acquisition want, held = g->applied, shown;
-    nc__gige_read_settings(g->fc, &g->applied, &want);
-    if (nc__gige_same(&want, &g->applied) || !g->ctl)
-        return;
-    shown = want;
-    const char *why[3];
-    int undo = nc__gige_in_range(&want, &held, why);
-    for (int k = 0; k < undo; k++)
-        refused(g, why[k]);
-    if (!nc__gige_same(&want, &held) && g->ctl->set(g->ctl->emu, &want) >= 0)
-        held = want;
-    else
-        for (int u = 0; u < NC_GIGE_UNITS; u++) {
-            struct nc_acquisition t = held;
-            nc__gige_take_unit(&t, &want, u);
-            if (nc__gige_same(&t, &held))
-                continue;
-            if (g->ctl->set(g->ctl->emu, &t) >= 0)
-                held = t;
-            else
-                refused(g, nc_errmsg()), undo = 1;
-        }
-    if (undo) /* the registers undone show what holds; a client's write since then stands */
-        nc__gige_publish_changed(g->fc, &held, &shown);
-    g->applied = held;
+    if (g->ctl)
+        nc__gige_apply(g->fc, g->ctl, &g->applied, refused, g);
 }
 
 /* The controlling client released the device, or its heartbeat ran out (the device found it so at a message:

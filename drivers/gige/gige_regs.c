@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/error.h"
 #include "drivers/gige/gige_image.h"
 
 uint32_t nc__gige_reg(ArvFakeCamera *fc, uint32_t a)
@@ -218,4 +219,36 @@ int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uin
         }
     }
     return undone;
+}
+
+/* Client-written settings to the emulator, when they changed: a write outside the XML's ranges is undone, the
+ * others stand; if the emulator refuses them together (lock-step, a line it lacks), each unit is tried alone. */
+void nc__gige_apply(ArvFakeCamera *fc, const struct nc_camera_control *ctl, struct nc_acquisition *applied,
+                    void (*refused)(void *, const char *), void *arg)
+{
+    struct nc_acquisition want, held = *applied, shown;
+    nc__gige_read_settings(fc, applied, &want);
+    if (nc__gige_same(&want, applied))
+        return;
+    shown = want;
+    const char *why[3];
+    int undo = nc__gige_in_range(&want, &held, why);
+    for (int k = 0; k < undo; k++)
+        refused(arg, why[k]);
+    if (!nc__gige_same(&want, &held) && ctl->set(ctl->emu, &want) >= 0)
+        held = want;
+    else
+        for (int u = 0; u < NC_GIGE_UNITS; u++) {
+            struct nc_acquisition t = held;
+            nc__gige_take_unit(&t, &want, u);
+            if (nc__gige_same(&t, &held))
+                continue;
+            if (ctl->set(ctl->emu, &t) >= 0)
+                held = t;
+            else
+                refused(arg, nc_errmsg()), undo = 1;
+        }
+    if (undo) /* the registers undone show what holds; a client's write since then stands */
+        nc__gige_publish_changed(fc, &held, &shown);
+    *applied = held;
 }

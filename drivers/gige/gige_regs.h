@@ -57,6 +57,13 @@ int nc__gige_in_range(struct nc_acquisition *want, const struct nc_acquisition *
  * from into to. */
 #define NC_GIGE_UNITS 4
 void nc__gige_take_unit(struct nc_acquisition *to, const struct nc_acquisition *from, int unit);
+/* The settings the registers show, when a client changed them, to the
+ * emulator through ctl (applied: what held, updated): writes outside the
+ * XML's ranges are undone, the others stand; if the emulator refuses them
+ * together (lock-step, a line it lacks), each unit is tried alone and those
+ * it refuses are undone. Calls refused(arg, why) for each. */
+void nc__gige_apply(ArvFakeCamera *fc, const struct nc_camera_control *ctl, struct nc_acquisition *applied,
+                    void (*refused)(void *, const char *), void *arg);
 
 /* The image and transport registers a client writes, checked together:
  * Width, Height, OffsetX, OffsetY, PixelFormat, GevSCPSPacketSize,
