@@ -113,11 +113,16 @@ int nc_param_string(struct nc_cfg_node *map, const struct nc_param *table, const
     if (p->def)
         *out = p->def;
     struct nc_cfg_node *n = nc_cfg_get(map, key);
+    if (!n && (p->flags & NC_PARAM_REQUIRED))
+        return nc_cfg_missing(map, key, p->doc);
     if (n && (p->flags & NC_PARAM_EMPTY_OK) && n->kind == NC_CFG_SCALAR && !n->value[0]) {
         *out = n->value;
         return 1;
     }
-    return nc_cfg_string(map, key, out);
+    char why[256];
+    if ((rc = nc_cfg_string(map, key, out)) > 0 && p->check && p->check(*out, why, sizeof why) < 0)
+        return nc_cfg_key_error(map, key, "%s", why);
+    return rc;
 }
 
 int nc_param_enum(struct nc_cfg_node *map, const struct nc_param *table, const char *key, int *out)
@@ -174,6 +179,10 @@ int nc_params_values(struct nc_cfg_node *map, const struct nc_param *const *tabl
         }
         }
     }
+    for (int k = 0; k < ntables && rc >= 0; k++) /* the keys that must be given */
+        for (const struct nc_param *p = tables[k]; p->key && rc >= 0; p++)
+            if ((p->flags & NC_PARAM_REQUIRED) && !nc__cfg_find(map, p->key))
+                rc = nc_cfg_missing(map, p->key, p->doc);
     return rc < 0 ? rc : 0;
 }
 
@@ -183,6 +192,8 @@ static void describe(const struct nc_param *p, char *buf, size_t len)
     size_t pos = 0;
     if (p->def)
         pos += (size_t)snprintf(buf + pos, len - pos, "default %s; ", p->def);
+    else if (p->flags & NC_PARAM_REQUIRED)
+        pos += (size_t)snprintf(buf + pos, len - pos, "required; ");
     switch (p->type) {
     case NC_PARAM_BOOL: snprintf(buf + pos, len - pos, "true or false"); break;
     case NC_PARAM_INT: snprintf(buf + pos, len - pos, "whole number %.0f..%.0f", p->min, p->max); break;
@@ -227,7 +238,8 @@ static void md_rows(FILE *f, const struct nc_param *table, const char *prefix)
             for (size_t i = 0, pos = 0; p->names[i] && pos < sizeof range; i++)
                 pos += (size_t)snprintf(range + pos, sizeof range - pos, "%s`%s`", i ? ", " : "", p->names[i]);
         fprintf(f, "| `%s` | %s | %s%s%s | %s | %s | %s |\n", key, type_names[p->type], p->def ? "`" : "",
-                p->def ? p->def : "", p->def ? "`" : "", range, p->unit ? p->unit : "", p->doc);
+                p->def ? p->def : (p->flags & NC_PARAM_REQUIRED) ? "(required)" : "", p->def ? "`" : "", range,
+                p->unit ? p->unit : "", p->doc);
         if (p->type == NC_PARAM_MAP) {
             char sub[176];
             snprintf(sub, sizeof sub, "%s.", key);

@@ -31,9 +31,15 @@ struct nc_param {
     const char *const *names;  /* ENUM: NULL-terminated */
     const struct nc_param *sub;/* MAP: its table */
     const char *doc;           /* one sentence */
-    unsigned flags;            /* NC_PARAM_EMPTY_OK */
+    unsigned flags;            /* NC_PARAM_EMPTY_OK, NC_PARAM_REQUIRED */
+    /* STRING: the form a value must have (NULL: any), checked with the table's other checks, before any part is
+     * opened: < 0 with a reason in why when value is not of it. */
+    int (*check)(const char *value, char *why, size_t len);
 };
-enum { NC_PARAM_EMPTY_OK = 1u << 0 }; /* STRING: an empty value is allowed (it means "none") */
+enum {
+    NC_PARAM_EMPTY_OK = 1u << 0, /* STRING: an empty value is allowed (it means "none") */
+    NC_PARAM_REQUIRED = 1u << 1, /* STRING: the key must be given (no default) */
+};
 /* Table rows, one macro per type; a table ends with NC_P_END. */
 #define NC_P_DOUBLE(k, d, lo, hi, u, text) \
     {.key = (k), .type = NC_PARAM_DOUBLE, .def = (d), .min = (lo), .max = (hi), .unit = (u), .doc = (text)}
@@ -42,6 +48,10 @@ enum { NC_PARAM_EMPTY_OK = 1u << 0 }; /* STRING: an empty value is allowed (it m
 #define NC_P_STRING(k, d, text) {.key = (k), .type = NC_PARAM_STRING, .def = (d), .unit = "", .doc = (text)}
 #define NC_P_STRING_OR_EMPTY(k, d, text) \
     {.key = (k), .type = NC_PARAM_STRING, .def = (d), .unit = "", .doc = (text), .flags = NC_PARAM_EMPTY_OK}
+#define NC_P_STRING_REQUIRED(k, text) \
+    {.key = (k), .type = NC_PARAM_STRING, .unit = "", .doc = (text), .flags = NC_PARAM_REQUIRED}
+#define NC_P_STRING_CHECKED(k, d, fn, text) \
+    {.key = (k), .type = NC_PARAM_STRING, .def = (d), .unit = "", .doc = (text), .check = (fn)}
 #define NC_P_ENUM(k, d, list, text) {.key = (k), .type = NC_PARAM_ENUM, .def = (d), .unit = "", .names = (list), .doc = (text)}
 #define NC_P_BOOL(k, d, text) {.key = (k), .type = NC_PARAM_BOOL, .def = (d), .unit = "", .doc = (text)}
 #define NC_P_MAP(k, table, text) {.key = (k), .type = NC_PARAM_MAP, .unit = "", .sub = (table), .doc = (text)}
@@ -53,9 +63,9 @@ enum { NC_PARAM_EMPTY_OK = 1u << 0 }; /* STRING: an empty value is allowed (it m
 int nc_params_check(const struct nc_cfg_node *map, const struct nc_param *const *tables, int ntables, const char *what);
 
 /* Every configured key of map read through its table entry (type, range,
- * names; recursing into MAP entries), as the part will read it: so a part's
- * options can be checked whole before it is opened. Keys no table names are
- * left to nc_params_check. */
+ * names, form; recursing into MAP entries), as the part will read it, and
+ * every required key present: so a part's options can be checked whole
+ * before it is opened. Keys no table names are left to nc_params_check. */
 int nc_params_values(struct nc_cfg_node *map, const struct nc_param *const *tables, int ntables);
 
 /* Typed readers through a table entry: *out gets the table's default (when

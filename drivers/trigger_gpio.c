@@ -69,14 +69,14 @@ static const char *const biases[] = {"as_is", "disable", "pull_up", "pull_down",
 static const char *const levels[] = {"high", "low", NULL};
 
 static const struct nc_param strobe_params[] = {
-    NC_P_STRING("line", NULL, "name or offset of the strobe output line (required)"),
+    NC_P_STRING_REQUIRED("line", "name or offset of the strobe output line"),
     NC_P_STRING("chip", NULL, "its chip (default: the trigger line's chip)"),
     NC_P_ENUM("active", "high", levels, "the line's level during an exposure"),
     NC_P_END,
 };
 
 static const struct nc_param gpio_params[] = {
-    NC_P_STRING("line", NULL, "name or offset of the trigger input line (required)"),
+    NC_P_STRING_REQUIRED("line", "name or offset of the trigger input line (gpioinfo lists them)"),
     NC_P_STRING("chip", NULL, "gpiochipN, /dev/gpiochipN, a chip label or a number (without it `line` must be a name, searched on every chip)"),
     NC_P_ENUM("bias", "as_is", biases, "the input's pull resistor"),
     NC_P_MAP("strobe", strobe_params, "an output line active while the sensor exposes"),
@@ -92,8 +92,6 @@ static int find_line(struct nc_cfg_node *opts, const struct nc_param *params, st
     int rc;
     if ((rc = nc_param_string(opts, params, "line", &name)) < 0 || (rc = nc_param_string(opts, params, "chip", &chip)) < 0)
         return rc;
-    if (!name)
-        return nc_cfg_missing(opts, "line", "a GPIO line name or offset (gpioinfo lists them)");
     struct nc_cfg_node *ln = nc_cfg_get(opts, "line");
     if (chip) {
         out->chip = gpiod_chip_open_lookup(chip);
@@ -118,7 +116,14 @@ static int find_line(struct nc_cfg_node *opts, const struct nc_param *params, st
             return nc_cfg_error(ln, "GPIO chip %s has no line named '%s' (gpioinfo %s lists them)", gpiod_chip_name(c),
                                 name, gpiod_chip_name(c));
     } else {
-        out->line = gpiod_line_find(name);
+        errno = 0;
+        out->line = gpiod_line_find(name); /* opens every chip: ENOENT when none has the line */
+        const int err = errno;
+        if (!out->line && err && err != ENOENT)
+            return nc_cfg_error(ln, "cannot search the GPIO chips for a line named '%s': %s (%s)", name, strerror(err),
+                                err == EACCES ? "a chip this user cannot open: give `chip`, or udev/99-navcam.rules "
+                                                "gives group gpio access: docs/setup.md"
+                                              : "gpiodetect lists the chips");
         if (!out->line)
             return nc_cfg_error(ln, "no GPIO chip has a line named '%s' (gpioinfo lists them)", name);
         out->chip = gpiod_line_get_chip(out->line);

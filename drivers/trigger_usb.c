@@ -28,8 +28,18 @@
 
 #define LOG "trigger/usb"
 
+/* `id`: VID:PID, four hexadecimal digits each. */
+static int id_form(const char *id, char *why, size_t len)
+{
+    const char *hex = "0123456789abcdefABCDEF";
+    if (strlen(id) == 9 && strspn(id, hex) == 4 && id[4] == ':' && strspn(id + 5, hex) == 4)
+        return 0;
+    snprintf(why, len, "'%s' is not VID:PID (four hexadecimal digits each, as lsusb prints them, e.g. 1209:0001)", id);
+    return -1;
+}
+
 static const struct nc_param usb_params[] = {
-    NC_P_STRING("id", NULL, "VID:PID of the adapter, hexadecimal as lsusb prints it (default: any device with the adapter's interface)"),
+    NC_P_STRING_CHECKED("id", NULL, id_form, "VID:PID of the adapter, hexadecimal as lsusb prints it (default: any device with the adapter's interface)"),
     NC_P_STRING("serial", NULL, "the adapter's serial number (default: any)"),
     NC_P_INT("input", "0", 0, NC_UT_MAX_LINES - 1, "", "the adapter's input line that triggers"),
     NC_P_INT("strobe_output", "-1", -1, NC_UT_MAX_LINES - 1, "", "the adapter's output line driven during exposures (-1: none)"),
@@ -127,12 +137,8 @@ static int parse_id(struct nc__usb_trig *u, struct nc_cfg_node *opts)
     u->vid = u->pid = -1;
     if (rc < 0 || !id)
         return rc;
-    unsigned v, p;
-    char end;
-    if (strlen(id) != 9 || strspn(id, "0123456789abcdefABCDEF") != 4 || id[4] != ':' ||
-        strspn(id + 5, "0123456789abcdefABCDEF") != 4 || sscanf(id, "%x:%x%c", &v, &p, &end) != 2)
-        return nc_cfg_key_error(opts, "id", "'%s' is not VID:PID (four hexadecimal digits each, as lsusb "
-                                "prints them, e.g. 1209:0001)", id);
+    unsigned v = 0, p = 0;
+    sscanf(id, "%x:%x", &v, &p); /* of the form id_form checked */
     u->vid = (int)v, u->pid = (int)p;
     return 0;
 }

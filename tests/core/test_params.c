@@ -32,6 +32,23 @@ static const struct nc_param table[] = {
     NC_P_END,
 };
 
+/* A form: "AB" followed by digits. */
+static int ab_form(const char *v, char *why, size_t len)
+{
+    if (!strncmp(v, "AB", 2) && v[2] && strspn(v + 2, "0123456789") == strlen(v + 2))
+        return 0;
+    snprintf(why, len, "'%s' is not AB and digits", v);
+    return -1;
+}
+static const struct nc_param must[] = {
+    NC_P_STRING_REQUIRED("port", "the port to use"),
+    NC_P_STRING_CHECKED("id", "AB1", ab_form, "an id"),
+    NC_P_MAP("strobe", sub, "a nested map"),
+    NC_P_END,
+};
+static const struct nc_param sub_must[] = {NC_P_STRING_REQUIRED("line", "its line"), NC_P_END};
+static const struct nc_param must_nested[] = {NC_P_MAP("strobe", sub_must, "a nested map"), NC_P_END};
+
 static int load(struct nc_cfg *cfg, const char *yaml)
 {
     nc_cfg_init(cfg);
@@ -91,16 +108,41 @@ static void test_tables(void)
     CHECK(nc_param_double(NULL, table, "nope", &r) < 0 && nc_test_contains(nc_errmsg(), "not in the table"),
           "missing entry: %s", nc_errmsg());
 
+    /* Required keys and forms are checked with the values, before any part opens; a required key only in
+     * a map that is there. */
+    const struct nc_param *const musts[] = {must}, *const nested[] = {must_nested};
+    CHECK(load(&cfg, "id: AB7\n") == 0, "load");
+    CHECK(nc_params_values(cfg.root, musts, 1) < 0 &&
+              nc_test_contains(nc_errmsg(), "t.yaml:1: port: missing required key (expected the port to use)"),
+          "required: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
+    CHECK(load(&cfg, "port: p\nid: AC7\n") == 0, "load");
+    CHECK(nc_params_values(cfg.root, musts, 1) < 0 &&
+              nc_test_contains(nc_errmsg(), "t.yaml:2: id: 'AC7' is not AB and digits"), "form: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
+    CHECK(load(&cfg, "port: p\nid: AB12\n") == 0 && nc_params_values(cfg.root, musts, 1) == 0 &&
+              nc_param_string(cfg.root, must, "id", &s) == 1 && !strcmp(s, "AB12") &&
+              nc_params_values(cfg.root, nested, 1) == 0, "valid: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
+    CHECK(load(&cfg, "strobe: {level: slow}\n") == 0, "load");
+    CHECK(nc_params_values(cfg.root, nested, 1) < 0 &&
+              nc_test_contains(nc_errmsg(), "t.yaml:1: strobe.line: missing required key (expected its line)"),
+          "nested required: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
+
     /* Help and Markdown come from the same rows. */
     char *text = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);
     nc_params_print_help(f, table, 2);
     nc_params_print_markdown(f, table);
+    nc_params_print_markdown(f, must);
+    nc_params_print_help(f, must, 0);
     fclose(f);
     CHECK(nc_test_contains(text, "rate_hz") && nc_test_contains(text, "default 10; 0.5..100 Hz: how often") &&
               nc_test_contains(text, "strobe.level") && nc_test_contains(text, "| `rate_hz` | number | `10` | 0.5 .. 100 | Hz |") &&
-              nc_test_contains(text, "| `strobe.line` | text |"),
+              nc_test_contains(text, "| `strobe.line` | text |") &&
+              nc_test_contains(text, "| `port` | text | (required) |") && nc_test_contains(text, "required; text: the port"),
           "help text:\n%s", text);
     free(text);
 }

@@ -35,6 +35,10 @@ def jfile(path):
 node, video = [line.split() for line in open(os.path.join(out, "udev_node.txt")).read().splitlines()]
 check(node == ["plugdev", "660"], f"A: udev rule: the adapter's node is group {node[0]}, mode {node[1]}")
 check(video == ["video3", "video", "660"], f"A: udev rule: /dev/navcam0 -> {video[0]}, group {video[1]}, mode {video[2]}")
+denied = open(os.path.join(out, "gpio_denied.log")).read()
+said = next((line for line in denied.splitlines() if "serve.trigger" in line), denied.strip()[-160:])
+check("serve.trigger.line: cannot search the GPIO chips for a line named 'TRIG': Permission denied" in said and
+      "exit 1" in denied, f"A: a GPIO line named without its chip, no chip open to the user: {said[:220]}")
 recs = records(os.path.join(out, "a/files/frames.jsonl"))
 edges = csv_rows(os.path.join(out, "a/edges.csv"))
 caps = csv_rows(os.path.join(out, "a/capture.csv"))
