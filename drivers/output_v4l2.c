@@ -51,8 +51,8 @@ struct v4l2_out {
     double fps;
     int64_t reopen_ns;
     long reopen_limit;
-    /* the frame */
-    int width, height, bits;
+    /* the frame: height counts the metadata row, when there is one (row 0) */
+    int width, height, bits, meta;
     size_t bytesperline, size;
     unsigned char *buf;
     /* the open device */
@@ -301,6 +301,7 @@ static const struct nc_param v4l2_params[] = {
     NC_P_DOUBLE("frame_rate_hz", NULL, 1e-3, 1000, "Hz", "frame interval announced to readers (default serve.frame_rate_hz)"),
     NC_P_DOUBLE("reopen_interval_s", "1", 0, 3600, "s", "how often a lost device is looked for again (0: never)"),
     NC_P_INT("reopen_limit", "0", 0, 1000000000, "", "give up after this many attempts (0: never)"),
+    NC_P_INT("metadata_row", "0", 0, 1, "", "1: a first row (row 0) with the frame's metadata, above the image"),
     NC_P_END,
 };
 
@@ -310,7 +311,7 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     const char *device = NULL, *card = NULL;
     int fmt = 0, align = 0, io = 0, rc;
     double reopen_s = 0;
-    long limit = 0;
+    long limit = 0, meta = 0;
     v->fd = -1;
     v->fps = 10;
     if (ctx->control) {
@@ -325,7 +326,8 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         (rc = nc_param_enum(opts, v4l2_params, "io", &io)) < 0 ||
         (rc = nc_param_double(opts, v4l2_params, "frame_rate_hz", &v->fps)) < 0 ||
         (rc = nc_param_double(opts, v4l2_params, "reopen_interval_s", &reopen_s)) < 0 ||
-        (rc = nc_param_int(opts, v4l2_params, "reopen_limit", &limit)) < 0)
+        (rc = nc_param_int(opts, v4l2_params, "reopen_limit", &limit)) < 0 ||
+        (rc = nc_param_int(opts, v4l2_params, "metadata_row", &meta)) < 0)
         return rc;
     if (device && card)
         return nc_cfg_key_error(opts, "card", "give either `device` or `card`, not both");
@@ -343,7 +345,8 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     v->reopen_ns = llround(reopen_s * 1e9);
     v->reopen_limit = limit;
     v->width = ctx->width_px;
-    v->height = ctx->height_px;
+    v->meta = (int)meta;
+    v->height = ctx->height_px + v->meta;
     v->bits = ctx->adc_bits;
     v->bytesperline = (size_t)v->width * (fmt == 1 ? 1 : 2);
     v->size = v->bytesperline * (size_t)v->height;
@@ -352,16 +355,25 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     if ((rc = connect_device(v)) < 0)
         return rc;
     char fc[5];
-    nc_log_info("output/v4l2", "%s (card '%s', driver '%s'): %dx%d %s at %g Hz through %s", v->path,
+    nc_log_info("output/v4l2", "%s (card '%s', driver '%s'): %dx%d %s at %g Hz through %s%s", v->path,
             v->card, v->driver, v->width, v->height, fourcc_text(v->fourcc, fc), v->fps,
-            v->io == IO_MMAP ? "mmap streaming" : "write()");
+            v->io == IO_MMAP ? "mmap streaming" : "write()", v->meta ? ", row 0 the frame's metadata" : "");
     return 0;
 }
 
-/* The frame in the device's pixel format, into dst (v->size bytes). */
-static void pack(const struct v4l2_out *v, const uint16_t *dn, unsigned char *dst)
+/* The frame in the device's pixel format, into dst (v->size bytes), below
+ * its metadata row when there is one. */
+static void pack(const struct v4l2_out *v, const struct nc_frame_record *r, unsigned char *dst)
 {
-    size_t n = (size_t)v->width * (size_t)v->height;
+    if (v->meta) {
+        uint8_t m[NC_FRAME_META_BYTES];
+        nc_frame_metadata(r, m);
+        memset(dst, 0, v->bytesperline);
+        memcpy(dst, m, v->bytesperline < sizeof m ? v->bytesperline : sizeof m);
+        dst += v->bytesperline;
+    }
+    const uint16_t *dn = r->dn;
+    size_t n = (size_t)v->width * (size_t)(v->height - v->meta);
     if (v->fourcc == V4L2_PIX_FMT_GREY) {
         for (size_t i = 0; i < n; i++)
             dst[i] = (unsigned char)(dn[i] > 255 ? 255 : dn[i]);
@@ -376,9 +388,9 @@ static void pack(const struct v4l2_out *v, const uint16_t *dn, unsigned char *ds
 }
 
 /* One frame through write(): 0, -EAGAIN (no free buffer) or a failure. */
-static int put_write(struct v4l2_out *v, const uint16_t *dn)
+static int put_write(struct v4l2_out *v, const struct nc_frame_record *r)
 {
-    pack(v, dn, v->buf);
+    pack(v, r, v->buf);
     ssize_t n = write(v->fd, v->buf, v->size);
     if (n == (ssize_t)v->size)
         return 0;
@@ -391,7 +403,7 @@ static int put_write(struct v4l2_out *v, const uint16_t *dn)
 
 /* One frame through streaming I/O: take back the buffers the driver is
  * done with, fill a free one, queue it. */
-static int put_mmap(struct v4l2_out *v, const uint16_t *dn)
+static int put_mmap(struct v4l2_out *v, const struct nc_frame_record *r)
 {
     for (;;) {
         struct v4l2_buffer b = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP};
@@ -408,7 +420,7 @@ static int put_mmap(struct v4l2_out *v, const uint16_t *dn)
         k++;
     if (k == v->nmbuf)
         return -EAGAIN;
-    pack(v, dn, v->mbuf[k].mem); /* straight into the driver's buffer */
+    pack(v, r, v->mbuf[k].mem); /* straight into the driver's buffer */
     struct v4l2_buffer b = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT, .memory = V4L2_MEMORY_MMAP, .index = k,
                             .bytesused = (uint32_t)v->size, .field = V4L2_FIELD_NONE};
     if (xioctl(v->fd, VIDIOC_QBUF, &b) < 0)
@@ -444,7 +456,7 @@ static int v4l2_submit(void *priv, const struct nc_frame_record *r)
                     v->lost - v->lost_at_close);
         v->tries = 0;
     }
-    int rc = v->io == IO_MMAP ? put_mmap(v, r->dn) : put_write(v, r->dn);
+    int rc = v->io == IO_MMAP ? put_mmap(v, r) : put_write(v, r);
     if (rc == 0) {
         v->written++;
         return 0;

@@ -1,12 +1,14 @@
-/* output.c - opening drivers by name, the frame record as JSON. */
+/* output.c - opening drivers by name, the frame record as JSON and as a binary block. */
 #include "emulator/output.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 #include "core/error.h"
+#include "core/le.h"
 
 static const struct nc_param common_params[] = {
     NC_P_STRING("driver", NULL, "the output (`navcam serve --help` lists them)"),
@@ -113,4 +115,34 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
         r->soft_shadows ? "true" : "false", stars, ms, r->width_px,
         r->height_px, r->adc_bits);
     return n >= 0 && (size_t)n < len ? n : -1;
+}
+
+/* The metadata block (docs/gige.md gives the layout), little-endian: a
+ * 48-byte core with its own CRC (fits a Mono8 row of 48 pixels), then the
+ * pose, with a CRC over everything. */
+void nc_frame_metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_BYTES])
+{
+    memset(m, 0, NC_FRAME_META_BYTES);
+    memcpy(m, "NCMD", 4);
+    nc_le_put_u16(m + 4, 1);
+    nc_le_put_u16(m + 6, NC_FRAME_META_BYTES);
+    nc_le_put_u64(m + 8, r->frame);
+    nc_le_put_u64(m + 16, (uint64_t)r->exposure_start_sim_ns);
+    nc_le_put_f64(m + 24, r->exposure_s);
+    nc_le_put_f64(m + 32, r->gain_db);
+    nc_le_put_u32(m + 40, r->request_sequence);
+    nc_le_put_u32(m + 44, (uint32_t)crc32(0L, m, 44));
+    nc_le_put_u64(m + 48, (uint64_t)r->trigger_sim_ns);
+    nc_le_put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
+    nc_le_put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
+    const struct nc_pose *p = &r->pose;
+    const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
+                          p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, p->sun.x,
+                          p->sun.y,            p->sun.z};
+    for (int i = 0; i < 10; i++)
+        nc_le_put_f64(m + 72 + 8 * i, v[i]);
+    m[152] = (uint8_t)p->sun_is_position;
+    m[153] = (uint8_t)r->pose_quality;
+    nc_le_put_u16(m + 154, (uint16_t)r->adc_bits);
+    nc_le_put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
 }

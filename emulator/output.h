@@ -104,6 +104,14 @@ struct nc_output {
     unsigned long submitted, failed;
 };
 
+/* A frame's record as a binary block, the metadata row of the GigE and V4L2
+ * outputs (docs/gige.md "The metadata row"): little-endian, a 48-byte core
+ * with its own CRC-32 (frame number, exposure start, time and gain, the
+ * request's sequence), then the trigger and exposure times, the pose and
+ * the ADC's bits, with a CRC-32 over the block. */
+#define NC_FRAME_META_BYTES 160
+void nc_frame_metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_BYTES]);
+
 /* opts against the driver's table: every key known (unknown keys:
  * file:line), every value of its type and range. Touches nothing. */
 int nc_output_check(const struct nc_output_driver *drv, struct nc_cfg_node *opts);

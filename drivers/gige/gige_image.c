@@ -2,39 +2,8 @@
 #include "drivers/gige/gige_image.h"
 
 #include <string.h>
-#include <zlib.h>
 
 #include "core/le.h"
-
-/* The metadata block (docs/gige.md gives the layout), little-endian: a
- * 48-byte core with its own CRC (fits a Mono8 row of 48 pixels), then the
- * pose, with a CRC over everything. */
-void nc__gige_metadata(const struct nc_frame_record *r, uint8_t m[NC_GIGE_META_BYTES])
-{
-    memset(m, 0, NC_GIGE_META_BYTES);
-    memcpy(m, "NCMD", 4);
-    nc_le_put_u16(m + 4, 1);
-    nc_le_put_u16(m + 6, NC_GIGE_META_BYTES);
-    nc_le_put_u64(m + 8, r->frame);
-    nc_le_put_u64(m + 16, (uint64_t)r->exposure_start_sim_ns);
-    nc_le_put_f64(m + 24, r->exposure_s);
-    nc_le_put_f64(m + 32, r->gain_db);
-    nc_le_put_u32(m + 40, r->request_sequence);
-    nc_le_put_u32(m + 44, (uint32_t)crc32(0L, m, 44));
-    nc_le_put_u64(m + 48, (uint64_t)r->trigger_sim_ns);
-    nc_le_put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
-    nc_le_put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
-    const struct nc_pose *p = &r->pose;
-    const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
-                          p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, p->sun.x,
-                          p->sun.y,            p->sun.z};
-    for (int i = 0; i < 10; i++)
-        nc_le_put_f64(m + 72 + 8 * i, v[i]);
-    m[152] = (uint8_t)p->sun_is_position;
-    m[153] = (uint8_t)r->pose_quality;
-    nc_le_put_u16(m + 154, (uint16_t)r->adc_bits);
-    nc_le_put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
-}
 
 /* A DN as the pixel format stores it: (dn << left) >> right. */
 static void shifts(uint32_t pf, int bits, int *left, int *right)
@@ -76,11 +45,11 @@ void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct
     int row0 = 0, left, right;
     shifts(pf, adc_bits, &left, &right);
     if (meta) { /* the metadata row on top */
-        uint8_t m[NC_GIGE_META_BYTES];
-        nc__gige_metadata(meta, m);
+        uint8_t m[NC_FRAME_META_BYTES];
+        nc_frame_metadata(meta, m);
         size_t rowb = (size_t)w * bpp;
         memset(out, 0, rowb);
-        memcpy(out, m, rowb < NC_GIGE_META_BYTES ? rowb : NC_GIGE_META_BYTES);
+        memcpy(out, m, rowb < NC_FRAME_META_BYTES ? rowb : NC_FRAME_META_BYTES);
         row0 = 1;
     }
     for (int y = row0; y < (int)h; y++) {

@@ -13,10 +13,6 @@
 #define PF_MONO8 0x01080001u
 #define PF_MONO12 0x01100005u
 #define PF_MONO16 0x01100007u
-#define NC_GIGE_META_BYTES 160
-
-/* The metadata block of r, little-endian, with its two CRCs. */
-void nc__gige_metadata(const struct nc_frame_record *r, uint8_t m[NC_GIGE_META_BYTES]);
 /* Rows of dn (W x H DN of adc_bits) into out (w x h pixels of format pf,
  * 1 or 2 bytes little-endian), from column ox and row oy (ox <= W, oy <= H;
  * what lies outside the sensor is 0); with meta, row 0 is its metadata

@@ -13,12 +13,15 @@ B: a storm: every edge is accounted for (accepted, debounced, wrong edge),
 C: the V4L2 device failed mid-run: the failure was reported and counted,
    the file output kept every frame, and the output came back.
 D: v4l2-ctl, a reader that is not NavCam's, streams 5 free-run frames by
-   mmap (docs/setup.md's check) of a 12-bit camera: each is Y16, little-endian,
-   DN << 4 (y16_align msb), of a frame the file output wrote, in the order
-   delivered.
+   mmap (docs/setup.md's check) of a 12-bit camera with a metadata row: row 0
+   holds the record's core (magic, frame number, exposure, its CRC-32), the
+   rows below are Y16, little-endian, DN << 4 (y16_align msb), of the frame
+   of that number the file output wrote, in the order delivered.
 """
 import os
+import struct
 import sys
+import zlib
 
 from vmcheck import check, csv_rows, failures, level_at, records, stats
 
@@ -186,14 +189,23 @@ drecs = records(os.path.join(out, "d/files/frames.jsonl"))
 dframes = [fits_dn(os.path.join(out, "d/files/frame_%06d.fits" % r["frame"])) for r in drecs]
 with open(os.path.join(out, "d/frames.raw"), "rb") as f:
     raw = f.read()
-size = 2 * dframes[0][0] * dframes[0][1] if dframes else 0
+row = 2 * dframes[0][0] if dframes else 0
+size = row * (dframes[0][1] + 1) if dframes else 0
 got = [raw[i:i + size] for i in range(0, len(raw), size)] if size else []
 check(len(got) == 5 and len(raw) == 5 * size, f"D: v4l2-ctl wrote {len(raw)} bytes: {len(got)} frames of {size}")
 check("'Y16 '" in open(os.path.join(out, "d/fmt.log")).read(), "D: the reader negotiated Y16")
-index = {b"".join((v << 4).to_bytes(2, "little") for v in dn): k for k, (_, _, dn) in enumerate(dframes)}
-where = [index.get(g, -1) for g in got]
-check(got and all(k >= 0 for k in where) and where == sorted(set(where)),
-      f"D: the frames v4l2-ctl read are file-output frames {where} of {len(dframes)}, in order")
+by_number = {r["frame"]: (r, dn) for r, (_, _, dn) in zip(drecs, dframes)}
+matched = []
+for g in got:
+    magic, version, length, number, _, exposure_s = struct.unpack_from("<4sHHQqd", g)
+    crc_ok = struct.unpack_from("<I", g, 44)[0] == zlib.crc32(g[:44])
+    r, dn = by_number.get(number, (None, None))
+    same = r is not None and g[row:] == b"".join((v << 4).to_bytes(2, "little") for v in dn)
+    if magic == b"NCMD" and (version, length) == (1, 160) and crc_ok and same and exposure_s == r["exposure_s"]:
+        matched.append(number)
+check(len(matched) == len(got) == 5 and matched == sorted(set(matched)),
+      f"D: each frame v4l2-ctl read names its frame in row 0 (frames {matched}) and is that file-output frame, "
+      f"in order")
 
 print(f"{len(failures)} checks failed" if failures else "all checks passed")
 if lat:

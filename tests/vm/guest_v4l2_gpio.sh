@@ -122,10 +122,10 @@ touch c/stop-watch
 wait "$watch_pid"
 
 # ---- D: another reader: v4l2-ctl, as docs/setup.md's check runs it -----------
-step "D: free-run Y16 frames read by v4l2-ctl --stream-mmap"
+step "D: free-run Y16 frames with a metadata row read by v4l2-ctl --stream-mmap"
 start_serve d --set serve.mode=freerun --set serve.frame_rate_hz=10 --set sensor.adc_bits=12 \
     --set serve.udp_port=5780 --set serve.tcp_port=5781 \
-    --set "outputs=[{driver: v4l2, card: NavCam}, {driver: file, directory: files, pattern: frame_%06llu.fits}]"
+    --set "outputs=[{driver: v4l2, card: NavCam, metadata_row: 1}, {driver: file, directory: files, pattern: frame_%06llu.fits}]"
 # As A's reader does: wait until the device offers capture (exclusive_caps=1).
 for _ in $(seq 100); do
     v4l2-ctl -d /dev/video3 --info 2>/dev/null | sed -n '/Device Caps/,$p' | grep -q "Video Capture" && break
