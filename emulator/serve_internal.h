@@ -147,7 +147,8 @@ struct nc__emu {
     int udp_fd, tcp_fd;
     struct nc__client *clients; /* max_clients of them */
     pthread_mutex_t client_lock;
-    unsigned long refused_clients, slow_clients;
+    unsigned long refused_clients, slow_clients; /* over max_clients; disconnected for reading no answers */
+    int64_t last_refuse_log_ns;
     /* state */
     atomic_int stop; /* 1: stop taking input; 2: render exits; 3: output exits */
     atomic_int warm; /* 1: the render thread has made its warm-up frame */

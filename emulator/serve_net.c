@@ -226,10 +226,15 @@ static void refuse(struct nc__emu *e, int fd)
     size_t n = nc__serve_encode_tcp(&m, buf);
     (void)!send(fd, buf, 4 + n, MSG_NOSIGNAL | MSG_DONTWAIT);
     close(fd);
-    if (e->refused_clients++ == 0)
-        nc_log_warn("emulator/net", "refused a TCP client: all %d client slots are in use (serve.max_clients; "
-                                    "counting further refusals)",
-                    e->max_clients);
+    pthread_mutex_lock(&e->client_lock);
+    unsigned long refused = ++e->refused_clients;
+    pthread_mutex_unlock(&e->client_lock);
+    int64_t now = nc_mono_ns();
+    if (now - e->last_refuse_log_ns > 1000000000) { /* at most one line a second */
+        e->last_refuse_log_ns = now;
+        nc_log_warn("emulator/net", "refused a TCP client: all %d client slots are in use (serve.max_clients); "
+                    "%lu refused so far", e->max_clients, refused);
+    }
 }
 
 static void accept_client(struct nc__emu *e)

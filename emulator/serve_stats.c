@@ -108,7 +108,10 @@ void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f)
     fprintf(f, "}, \"dropped\": {");
     for (int i = 0; i < NC__DROP_COUNT; i++)
         fprintf(f, "%s\"%s\": %lu", i ? ", " : "", nc__serve_drop_names[i], atomic_load(&e->dropped[i]));
-    fprintf(f, "}, ");
+    pthread_mutex_lock(&e->client_lock);
+    fprintf(f, "}, \"clients\": {\"refused\": %lu, \"unread_disconnected\": %lu}, ", e->refused_clients,
+            e->slow_clients);
+    pthread_mutex_unlock(&e->client_lock);
     if (e->have_line || e->software_configured) { /* the source serve.trigger configured */
         struct nc_trigger_counts c;
         if (e->have_line) {

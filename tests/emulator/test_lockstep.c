@@ -43,8 +43,9 @@ static double now_s(void)
 #endif
 static pid_t serve(const char *name, const char *extra)
 {
-    static char dir[4096], tcp[64];
+    static char dir[4096], tcp[64], stats[4200];
     snprintf(dir, sizeof dir, "%s/%s", tmp, name);
+    snprintf(stats, sizeof stats, "%s/stats.json", dir);
     port = 20000 + (int)(getpid() % 20000);
     snprintf(tcp, sizeof tcp, "serve.tcp_port=%d", port);
     const char *argv[] = {navcam, "serve", "--set", "serve.mode=lockstep", "--set", "serve.udp_port=0", "--set", tcp,
@@ -52,7 +53,7 @@ static pid_t serve(const char *name, const char *extra)
                           "camera.height_px=256", "--set", SPP, "--set",
                           "bodies.0.shape.subdivisions=4", "--set", "serve.stats_interval_s=0", "--set",
                           "serve.queue_frames=4", "--set", extra ? extra : "serve.max_clients=64", "--max-seconds",
-                          "120", NULL};
+                          "120", "--stats-json", stats, NULL};
     return nc_test_spawn(dir, argv);
 }
 
@@ -206,8 +207,16 @@ static void refused_beyond_the_limit(void)
     nc_client_close(x);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
     char *text = server_log("limit");
-    CHECK(text && nc_test_contains(text, "refused a TCP client: all 2 client slots are in use (serve.max_clients"),
+    CHECK(text && nc_test_contains(text, "refused a TCP client: all 2 client slots are in use (serve.max_clients); "
+                                         "1 refused so far"),
           "the refusal is not in the log:\n%s", text ? text : "(none)");
+    free(text);
+    char path[4200];
+    size_t n;
+    snprintf(path, sizeof path, "%s/limit/stats.json", tmp);
+    text = nc_test_read(path, &n);
+    CHECK(text && nc_test_contains(text, "\"clients\": {\"refused\": 1, \"unread_disconnected\": 0}"),
+          "the refusal is not counted in the statistics: %s", text ? text : "(none)");
     free(text);
 }
 
