@@ -110,12 +110,20 @@ void nc_cfg_where(const struct nc_cfg_node *node, char *buf, size_t len)
 
 /* ---- loading ---------------------------------------------------------- */
 
+/* The most values a configuration may expand to: a YAML alias repeats a
+ * subtree, and aliases of aliases grow it ninefold a level (a file of a few
+ * lines would take gigabytes). */
+#define NC_CFG_MAX_VALUES 200000
+
 static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, const char *origin, int depth,
-                   struct nc_cfg_node **out)
+                   long *left, struct nc_cfg_node **out)
 {
     int line = (int)yn->start_mark.line + 1;
     if (depth > 32)
         return nc_error(NC_ECONFIG, "%s:%d: nesting deeper than 32 levels", origin, line);
+    if (--*left < 0)
+        return nc_error(NC_ECONFIG, "%s:%d: the configuration expands to more than %d values (YAML aliases that "
+                        "repeat large parts?)", origin, line, NC_CFG_MAX_VALUES);
     struct nc_cfg_node *n = NULL;
     int rc = 0;
     switch (yn->type) {
@@ -130,7 +138,7 @@ static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, co
             goto nomem;
         for (yaml_node_item_t *it = yn->data.sequence.items.start; it < yn->data.sequence.items.top; it++) {
             struct nc_cfg_node *c;
-            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, *it), origin, depth + 1, &c)) < 0)
+            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, *it), origin, depth + 1, left, &c)) < 0)
                 goto fail;
             if ((rc = node_append(n, c)) < 0) {
                 node_free(c);
@@ -160,7 +168,7 @@ static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, co
                 }
             }
             struct nc_cfg_node *c;
-            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, p->value), origin, depth + 1, &c)) < 0)
+            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, p->value), origin, depth + 1, left, &c)) < 0)
                 goto fail;
             c->line = kline;
             if (!(c->key = strdup(ks)) || node_append(n, c) < 0) {
@@ -182,13 +190,41 @@ fail:
     return rc;
 }
 
+/* Whether text nests deeper than convert() takes, found from the parser's
+ * events before the document is loaded: libyaml's scanner takes time
+ * quadratic in the nesting (100 000 brackets: half a minute), so it is
+ * stopped at the first level too deep. 0 also for a syntax error (the
+ * loader reports it). */
+static int too_deep(const char *text, size_t len, const char *origin)
+{
+    yaml_parser_t parser;
+    if (!yaml_parser_initialize(&parser))
+        return 0;
+    yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
+    int depth = 0, rc = 0, done = 0;
+    while (!done && !rc) {
+        yaml_event_t ev;
+        if (!yaml_parser_parse(&parser, &ev))
+            break;
+        if ((ev.type == YAML_SEQUENCE_START_EVENT || ev.type == YAML_MAPPING_START_EVENT) && ++depth > 33)
+            rc = nc_error(NC_ECONFIG, "%s:%d: nesting deeper than 32 levels", origin, (int)ev.start_mark.line + 1);
+        depth -= ev.type == YAML_SEQUENCE_END_EVENT || ev.type == YAML_MAPPING_END_EVENT;
+        done = ev.type == YAML_STREAM_END_EVENT;
+        yaml_event_delete(&ev);
+    }
+    yaml_parser_delete(&parser);
+    return rc;
+}
+
 /* Parse one YAML document from memory into a node tree. */
 static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const char *origin, int with_line,
                       struct nc_cfg_node **out)
 {
     yaml_parser_t parser;
     yaml_document_t doc;
-    int rc = 0;
+    int rc = too_deep(text, len, origin);
+    if (rc < 0)
+        return rc;
     if (!yaml_parser_initialize(&parser))
         return nc_error(-ENOMEM, "%s: cannot initialise the YAML parser", origin);
     yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
@@ -203,10 +239,11 @@ static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const ch
         return rc;
     }
     yaml_node_t *root = yaml_document_get_root_node(&doc);
+    long left = NC_CFG_MAX_VALUES;
     if (!root)
         *out = NULL;
     else
-        rc = convert(cfg, &doc, root, origin, 0, out);
+        rc = convert(cfg, &doc, root, origin, 0, &left, out);
     yaml_document_delete(&doc);
     yaml_parser_delete(&parser);
     return rc;

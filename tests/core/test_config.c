@@ -1,6 +1,7 @@
 /* test_config.c - configuration errors name file, line, key and what was
  * expected; unknown keys are errors; --set overrides any key. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
@@ -285,6 +286,28 @@ int main(void)
     nc_test_write(path, "base: builtin:nothing\n");
     rc = nc_scene_load(path, NULL, 0, &s);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:1: base: unknown base"), "bad base: %s", nc_errmsg());
+
+    /* YAML aliases of aliases (nine times a level: a few lines, billions of values) are refused once the
+     * tree passes the limit; nesting too deep is refused before libyaml's scanner, slow at depth, goes on. */
+    char *bomb = malloc(4096), *deep = malloc(200010);
+    if (bomb && deep) {
+        int n = snprintf(bomb, 4096, "a: &l0 [x, x, x, x, x, x, x, x, x]\n");
+        for (int i = 1; i < 10; i++)
+            n += snprintf(bomb + n, 4096 - (size_t)n, "l%d: &l%d [*l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d]\n",
+                          i, i, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1);
+        nc_cfg_init(&cfg);
+        CHECK(nc_cfg_load_string(&cfg, bomb, "bomb.yaml") < 0 &&
+                  nc_test_contains(nc_errmsg(), "the configuration expands to more than 200000 values"),
+              "alias bomb: %s", nc_errmsg());
+        nc_cfg_free(&cfg);
+        memset(deep, '[', 100000), memset(deep + 100000, ']', 100000), deep[200000] = '\0';
+        nc_cfg_init(&cfg);
+        CHECK(nc_cfg_load_string(&cfg, deep, "deep.yaml") < 0 &&
+                  nc_test_contains(nc_errmsg(), "deep.yaml:1: nesting deeper than 32 levels"),
+              "deep nesting: %s", nc_errmsg());
+        nc_cfg_free(&cfg);
+    }
+    free(bomb), free(deep);
 
     /* An error about a key names it at its line, or at its map's when it is absent (a default that failed);
      * one about no node at all (nc_cfg_get of an absent key) still gives the message. */
