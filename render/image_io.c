@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "render/image_io_impl.h"
@@ -57,6 +58,35 @@ int nc_image_prepare(const char *path)
 {
     enum fmt f = format_of(path);
     return f == FMT_NONE || f == FMT_FITS ? 0 : nc__oiio_load();
+}
+
+/* Every image is written under a temporary name beside path and renamed
+ * into place once whole: a reader never sees a partial file, a failed write
+ * leaves none, and what was at path (a file; a directory, which the rename
+ * refuses) stays until the new file is complete. The name keeps path's
+ * extension, which picks the format. */
+static int tmp_path(const char *path, char *tmp, size_t len)
+{
+    const char *slash = strrchr(path, '/'), *base = slash ? slash + 1 : path, *dot = strrchr(base, '.');
+    int n = snprintf(tmp, len, "%.*s.%.*s.%ld.tmp%s", (int)(base - path), path, (int)(dot - base), base,
+                     (long)getpid(), dot);
+    return n < 0 || (size_t)n >= len ? nc_error(NC_EIMAGE, "%s: path too long", path) : 0;
+}
+
+static int commit(int rc, const char *tmp, const char *path)
+{
+    if (rc >= 0 && rename(tmp, path) < 0)
+        rc = nc_error(-errno, "%s: %s", path, strerror(errno));
+    if (rc < 0) {
+        const size_t n = strlen(tmp);
+        if (!strncmp(nc_errmsg(), tmp, n)) { /* the writer's message names the file the user named */
+            char msg[1024];
+            snprintf(msg, sizeof msg, "%s", nc_errmsg() + n);
+            nc_error(rc, "%s%s", path, msg);
+        }
+        unlink(tmp);
+    }
+    return rc;
 }
 
 /* {"name": "value", ...} with JSON string escapes. */
@@ -142,11 +172,15 @@ int nc_image_write(const char *path, const float *px, int w, int h, const struct
         rc = nc_error(-ENOMEM, "%s: out of memory", path);
         goto out;
     }
+    char tmp[4200];
+    if ((rc = tmp_path(path, tmp, sizeof tmp)) < 0)
+        goto out;
     if (f == FMT_FITS)
-        rc = nc__fits_write(path, clean, NC__PX_FLOAT, w, h, 1, all, nall);
+        rc = nc__fits_write(tmp, clean, NC__PX_FLOAT, w, h, 1, all, nall);
     else
-        rc = nc__oiio_write(path, f == FMT_PNG ? (const void *)dn : clean, w, h, f == FMT_PNG ? NC__PX_U16 : NC__PX_FLOAT,
+        rc = nc__oiio_write(tmp, f == FMT_PNG ? (const void *)dn : clean, w, h, f == FMT_PNG ? NC__PX_U16 : NC__PX_FLOAT,
                             all, nall, desc);
+    rc = commit(rc, tmp, path);
 out:
     free(clean);
     free(dn);
@@ -186,10 +220,11 @@ int nc_image_write_dn(const char *path, const uint16_t *dn, int w, int h, int bi
     }
     enum nc__pixel t = f == FMT_EXR ? NC__PX_FLOAT : bits <= 8 ? NC__PX_U8 : NC__PX_U16;
     const void *px = buf ? buf : (const void *)dn;
-    if (f == FMT_FITS)
-        rc = nc__fits_write(path, px, t, w, h, 1, attrs, nattrs);
-    else
-        rc = nc__oiio_write(path, px, w, h, t, attrs, nattrs, desc);
+    char tmp[4200];
+    if ((rc = tmp_path(path, tmp, sizeof tmp)) >= 0)
+        rc = commit(f == FMT_FITS ? nc__fits_write(tmp, px, t, w, h, 1, attrs, nattrs)
+                                  : nc__oiio_write(tmp, px, w, h, t, attrs, nattrs, desc),
+                    tmp, path);
     free(buf);
     free(desc);
     return rc;
@@ -201,14 +236,18 @@ int nc_image_write_dn_cube(const char *path, const uint16_t *dn, int w, int h, i
     if (format_of(path) != FMT_FITS)
         return nc_error(NC_EIMAGE, "%s: a cube of frames needs .fits (or write numbered files)", path);
     size_t n = (size_t)w * (size_t)h * (size_t)nframes;
+    char tmp[4200];
+    int rc = tmp_path(path, tmp, sizeof tmp);
+    if (rc < 0)
+        return rc;
     if (bits > 8)
-        return nc__fits_write(path, dn, NC__PX_U16, w, h, nframes, attrs, nattrs);
+        return commit(nc__fits_write(tmp, dn, NC__PX_U16, w, h, nframes, attrs, nattrs), tmp, path);
     uint8_t *v = malloc(n ? n : 1);
     if (!v)
         return nc_error(-ENOMEM, "out of memory");
     for (size_t i = 0; i < n; i++)
         v[i] = (uint8_t)(dn[i] > 255 ? 255 : dn[i]);
-    int rc = nc__fits_write(path, v, NC__PX_U8, w, h, nframes, attrs, nattrs);
+    rc = commit(nc__fits_write(tmp, v, NC__PX_U8, w, h, nframes, attrs, nattrs), tmp, path);
     free(v);
     return rc;
 }
@@ -235,7 +274,9 @@ int nc_image_write_planes(const char *path, const float *planes, int w, int h, i
         snprintf(key[k], sizeof key[k], "PLANE%d", k + 1);
         all[nattrs + k] = (struct nc_image_attr){key[k], names[k]};
     }
-    rc = nc__fits_write(path, clean, NC__PX_FLOAT, w, h, nplanes, all, nattrs + nplanes);
+    char tmp[4200];
+    if ((rc = tmp_path(path, tmp, sizeof tmp)) >= 0)
+        rc = commit(nc__fits_write(tmp, clean, NC__PX_FLOAT, w, h, nplanes, all, nattrs + nplanes), tmp, path);
 out:
     free(clean);
     free(all);

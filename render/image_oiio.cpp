@@ -2,6 +2,7 @@
 // the module navcam-oiio.so, loaded on first use (image_io_impl.h). The
 // only file that touches OpenImageIO; no physics and no policy here. It
 // links nothing of NavCam's: its errors go back as text.
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cerrno>
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "core/error.h" // the codes only
 #include "render/image_io_impl.h"
@@ -46,6 +48,13 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
     auto out = ImageOutput::create(path);
     if (!out)
         return fail(NC_EIMAGE, err, elen, "%s: %s", path, OIIO::geterror().c_str());
+    // The file is encoded in memory and written here: OpenImageIO's PNG and
+    // EXR writers do not report a failed write (a full disk, a file size
+    // limit), and the caller must know that the file is whole.
+    std::vector<unsigned char> bytes;
+    Filesystem::IOVecOutput mem(bytes);
+    if (!out->set_ioproxy(&mem))
+        return fail(NC_EIMAGE, err, elen, "%s: %s cannot encode to memory", path, out->format_name());
     // OpenImageIO deflates a float TIFF with the floating-point predictor
     // (3), which some readers cannot undo (Python's tifffile without
     // imagecodecs); deflate alone is read everywhere.
@@ -60,6 +69,13 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
     }
     if (!out->close())
         return fail(NC_EIMAGE, err, elen, "%s: close: %s", path, out->geterror().c_str());
+    FILE *f = std::fopen(path, "wb");
+    if (!f)
+        return fail(-errno, err, elen, "%s: %s", path, std::strerror(errno));
+    const bool whole = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0;
+    const int e = errno;
+    if (std::fclose(f) != 0 || !whole)
+        return fail(-(whole ? errno : e), err, elen, "%s: write: %s", path, std::strerror(whole ? errno : e));
     return 0;
 }
 
