@@ -89,9 +89,13 @@ int read_image(const char *path, float **px, int *w, int *h, char *err, size_t e
     float *buf = (float *)std::malloc(n * sizeof(float));
     if (!buf)
         return fail(-ENOMEM, err, elen, "%s: out of memory", path);
-    if (!in->read_image(0, 0, 0, 1, TypeDesc::FLOAT, buf)) {
+    // A file cut short reads "successfully" with its missing rows left as they
+    // were (OpenImageIO's TIFF reader says so only in its error text).
+    bool ok = in->read_image(0, 0, 0, 1, TypeDesc::FLOAT, buf);
+    std::string e = in->geterror();
+    if (!ok || !e.empty()) {
         std::free(buf);
-        return fail(NC_EIMAGE, err, elen, "%s: read: %s", path, in->geterror().c_str());
+        return fail(NC_EIMAGE, err, elen, "%s: read: %s", path, e.empty() ? "failed" : e.c_str());
     }
     *w = spec.width;
     *h = spec.height;

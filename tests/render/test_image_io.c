@@ -6,6 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <dirent.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <fitsio.h>
 
@@ -99,6 +104,66 @@ static void fits_rows(void)
     }
 }
 
+/* A file is written whole or not at all, and one cut short is not read. */
+static void whole_or_nothing(void)
+{
+    enum { W = 256 };
+    static float img[W * W];
+    for (int i = 0; i < W * W; i++)
+        img[i] = (float)((i * 7919) % 1000);
+    const char *exts[] = {"png", "exr", "tif", "fits"};
+    struct rlimit old;
+    getrlimit(RLIMIT_FSIZE, &old);
+    signal(SIGXFSZ, SIG_IGN);
+    for (int e = 0; e < 4; e++) {
+        char name[32], keep[32];
+        snprintf(name, sizeof name, "limit.%s", exts[e]);
+        const char *path = nc_test_path(name);
+        CHECK(nc_image_write(path, img, 2, 2, NULL, 0, NULL) == 0, "%s: %s", name, nc_errmsg());
+        size_t before = 0, after = 0;
+        char *was = nc_test_read(path, &before);
+        struct rlimit lim = {1024, old.rlim_max}; /* as a full disk: write() fails past 1 KiB */
+        setrlimit(RLIMIT_FSIZE, &lim);
+        int rc = nc_image_write(path, img, W, W, NULL, 0, NULL);
+        snprintf(keep, sizeof keep, "%s", rc < 0 ? "" : "written");
+        setrlimit(RLIMIT_FSIZE, &old);
+        char *now = nc_test_read(path, &after);
+        CHECK(rc < 0 && nc_test_contains(nc_errmsg(), name) && was && now && after == before && !memcmp(was, now, after),
+              "%s over the file size limit: rc %d (%s) '%s', the file before it %s", name, rc, keep, nc_errmsg(),
+              now && after == before ? "kept" : "lost");
+        free(was), free(now);
+    }
+    signal(SIGXFSZ, SIG_DFL);
+    DIR *d = opendir(nc_test_path("."));
+    int tmps = 0;
+    for (struct dirent *de; d && (de = readdir(d));)
+        tmps += strstr(de->d_name, ".tmp") != NULL;
+    if (d)
+        closedir(d);
+    CHECK(tmps == 0, "%d temporary files left behind", tmps);
+    /* A directory of the name stays (cfitsio's overwrite removed an empty one). */
+    const char *dir = nc_test_path("adir.fits");
+    mkdir(dir, 0755);
+    struct stat st;
+    CHECK(nc_image_write(dir, img, 2, 2, NULL, 0, NULL) < 0 && stat(dir, &st) == 0 && S_ISDIR(st.st_mode),
+          "a directory named like the output: %s", nc_errmsg());
+    rmdir(dir);
+    /* A TIFF cut short (OpenImageIO reads it "successfully", the missing rows left as they were). */
+    const char *tif = nc_test_path("cut.tif");
+    float *px = NULL;
+    int w, h;
+    size_t len = 0;
+    char *bytes = NULL;
+    if (nc_image_write(tif, img, W, W, NULL, 0, NULL) == 0 && (bytes = nc_test_read(tif, &len))) {
+        FILE *fp = fopen(tif, "wb");
+        if (fp)
+            fwrite(bytes, 1, len / 2, fp), fclose(fp);
+        CHECK(nc_image_read(tif, &px, &w, &h) < 0 && nc_test_contains(nc_errmsg(), "cut.tif: read:"),
+              "a TIFF cut short: %s", nc_errmsg());
+    }
+    free(bytes);
+}
+
 int main(void)
 {
     struct nc_scene s;
@@ -188,6 +253,7 @@ int main(void)
               nc_test_contains(nc_errmsg(), "/nonexistent-dir/x.exr"),
           "unwritable path names the file: %s", nc_errmsg());
     fits_rows();
+    whole_or_nothing();
     nc_frame_free(&f);
     nc_scene_free(&s);
     return nc_test_end();
