@@ -40,6 +40,19 @@ double nc_mesh_bounding_radius(const struct nc_mesh *m)
     return sqrt(r2);
 }
 
+int nc_mesh_check_extent(struct nc_mesh *m, const char *what)
+{
+    for (size_t i = 0; i < m->nv; i++) {
+        const double *p = m->v + 3 * i, r = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        if (!(r <= NC_MESH_MAX_M)) {
+            nc_mesh_free(m);
+            return nc_error(NC_EMESH, "%s: vertex %zu (counted from 1) lies %g m from the origin, beyond %g m "
+                            "(a wrong unit or scale?)", what, i + 1, r, NC_MESH_MAX_M);
+        }
+    }
+    return 0;
+}
+
 static const char *ext_of(const char *path)
 {
     const char *dot = strrchr(path, '.');
@@ -50,14 +63,17 @@ static const char *ext_of(const char *path)
 int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out)
 {
     const char *ext = ext_of(path);
+    int rc = 0;
     if (strcasecmp(ext, "obj") == 0)
-        return nc_mesh_load_obj(path, scale_to_m, out);
-    if (strcasecmp(ext, "ply") == 0)
-        return nc_mesh_load_ply(path, scale_to_m, out);
-    if (strcasecmp(ext, "icq") == 0 || strcasecmp(ext, "txt") == 0) /* SPC's SHAPE.TXT */
-        return nc_mesh_load_icq(path, scale_to_m, out);
-    return nc_error(NC_EMESH, "%s: unknown mesh format '.%s' (expected .obj, .ply, or .icq/.txt for SPC's ICQ)", path,
+        rc = nc_mesh_load_obj(path, scale_to_m, out);
+    else if (strcasecmp(ext, "ply") == 0)
+        rc = nc_mesh_load_ply(path, scale_to_m, out);
+    else if (strcasecmp(ext, "icq") == 0 || strcasecmp(ext, "txt") == 0) /* SPC's SHAPE.TXT */
+        rc = nc_mesh_load_icq(path, scale_to_m, out);
+    else
+        return nc_error(NC_EMESH, "%s: unknown mesh format '.%s' (expected .obj, .ply, or .icq/.txt for SPC's ICQ)", path,
                     ext);
+    return rc < 0 ? rc : nc_mesh_check_extent(out, path);
 }
 
 /* ---- OBJ -------------------------------------------------------------- */

@@ -32,6 +32,11 @@ int nc_mesh_dem_tile(const float *h, int w, int rows, const struct nc_dem_tile_p
             const double e = (c - 0.5 * (w - 1)) * p->pixel_m[0], n = (0.5 * (rows - 1) - r) * p->pixel_m[1];
             const double z = isfinite(h[i]) ? p->height_offset_m + p->height_scale * h[i] : 0.0;
             double *v = out->v + 3 * i;
+            if (!(fabs(z) <= NC_MESH_MAX_M)) {
+                nc_mesh_free(out);
+                return nc_error(NC_ERANGE, "a height of %g m at row %d, column %d is beyond %g m (height_scale, or not "
+                                "an elevation image?)", z, r, c, NC_MESH_MAX_M);
+            }
             if (p->radius_m > 0 && !(p->radius_m + z > 0)) {
                 nc_mesh_free(out);
                 return nc_error(NC_ERANGE, "the DEM goes below the sphere's centre (%g m under a %g m radius, row %d, "
@@ -69,7 +74,7 @@ int nc_mesh_dem_tile(const float *h, int w, int rows, const struct nc_dem_tile_p
     }
     out->nv = nv;
     out->nt = nt;
-    return 0;
+    return nc_mesh_check_extent(out, "the DEM's heights");
 }
 
 int nc_mesh_globe(double radius_m, int subdivisions, const struct nc_albedo_map *elevation, struct nc_mesh *out)
@@ -90,5 +95,5 @@ int nc_mesh_globe(double radius_m, int subdivisions, const struct nc_albedo_map 
         for (int k = 0; k < 3; k++)
             v[k] *= s;
     }
-    return 0;
+    return nc_mesh_check_extent(out, "the elevation map's heights");
 }
