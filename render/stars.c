@@ -142,6 +142,8 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
         rc = nc_error(-ENOMEM, "out of memory");
     if (rc == 0 && fread(b, RECORD, n, f) != n)
         rc = nc_error(NC_ECONFIG, "%s: truncated (%llu stars announced)", path, (unsigned long long)n);
+    if (rc == 0 && fgetc(f) != EOF)
+        rc = nc_error(NC_ECONFIG, "%s: bytes after the %llu stars the header announces", path, (unsigned long long)n);
     fclose(f);
     for (uint64_t i = 0; rc == 0 && i < n; i++) {
         const uint8_t *p = b + i * RECORD;
@@ -156,6 +158,9 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
     free(b);
     c->n = (size_t)n;
     c->epoch_jyear = rc ? 0 : nc_le_get_f64(h + 16);
+    if (rc == 0 && !(c->epoch_jyear >= 1000 && c->epoch_jyear <= 3000)) /* Julian years: J1991.25 for Hipparcos */
+        rc = nc_error(NC_ECONFIG, "%s: header: epoch J%g is not a catalogue epoch (1000 to 3000)", path,
+                      c->epoch_jyear);
     if (rc < 0)
         nc_star_cat_free(c);
     return rc;

@@ -128,6 +128,29 @@ int main(void)
           "index round trip: %s", nc_errmsg());
     CHECK(nc_star_cat_count_to(&d, 0.0) == 1 && nc_star_cat_count_to(&d, 9) == 3, "prefix to a magnitude");
     nc_star_cat_free(&d);
+    { /* an index whose header epoch is no epoch (every star vanished), or with bytes past its stars */
+        size_t len = 0;
+        char *bytes = nc_test_read(ix, &len);
+        const double nan_epoch = NAN;
+        const char *bad = nc_test_path("bad.ncs");
+        for (int k = 0; bytes && k < 2; k++) {
+            FILE *f = fopen(bad, "wb");
+            if (!f)
+                break;
+            if (k == 0)
+                memcpy(bytes + 16, &nan_epoch, 8); /* the header's epoch (little-endian f64 at byte 16) */
+            fwrite(bytes, 1, len, f);
+            if (k == 1)
+                fputc(0, f);
+            fclose(f);
+            CHECK(nc_star_cat_load(bad, &d) < 0 &&
+                      nc_test_contains(nc_errmsg(), k ? "bytes after the 3 stars" : "epoch Jnan is not a catalogue epoch"),
+                  "a damaged index (%d): %s", k, nc_errmsg());
+            if (k == 0)
+                memcpy(bytes + 16, &(double){2000}, 8);
+        }
+        free(bytes);
+    }
     { /* a key the stars' reader does not take is an error, not a default */
         char set[1200];
         snprintf(set, sizeof set, "stars={catalogue: '%s', limit_magg: 5}", ix);
