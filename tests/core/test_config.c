@@ -293,8 +293,9 @@ int main(void)
     if (bomb && deep) {
         int n = snprintf(bomb, 4096, "a: &l0 [x, x, x, x, x, x, x, x, x]\n");
         for (int i = 1; i < 10; i++)
-            n += snprintf(bomb + n, 4096 - (size_t)n, "l%d: &l%d [*l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d]\n",
-                          i, i, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1);
+            n += snprintf(bomb + n, 4096 - (size_t)n,
+                          "l%d: &l%d [*l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d, *l%d]\n", i, i, i - 1, i - 1,
+                          i - 1, i - 1, i - 1, i - 1, i - 1, i - 1, i - 1);
         nc_cfg_init(&cfg);
         CHECK(nc_cfg_load_string(&cfg, bomb, "bomb.yaml") < 0 &&
                   nc_test_contains(nc_errmsg(), "the configuration expands to more than 200000 values"),

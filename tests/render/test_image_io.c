@@ -128,7 +128,8 @@ static void whole_or_nothing(void)
         snprintf(keep, sizeof keep, "%s", rc < 0 ? "" : "written");
         setrlimit(RLIMIT_FSIZE, &old);
         char *now = nc_test_read(path, &after);
-        CHECK(rc < 0 && nc_test_contains(nc_errmsg(), name) && was && now && after == before && !memcmp(was, now, after),
+        CHECK(rc < 0 && nc_test_contains(nc_errmsg(), name) && was && now && after == before &&
+                  !memcmp(was, now, after),
               "%s over the file size limit: rc %d (%s) '%s', the file before it %s", name, rc, keep, nc_errmsg(),
               now && after == before ? "kept" : "lost");
         free(was), free(now);

@@ -314,6 +314,10 @@ int main(void)
     expect_error(bad, NULL, 0, "bad.SUM:5: SCOBJ: '0.2000X00000D+01' is not a number");
     replaced(bad, sizeof bad, good, "  SZ\n", "  SZ\n 0.6 0.8 0  SZ\n");
     expect_error(bad, NULL, 0, "bad.SUM:10: SZ: given twice (lines 9 and 10)");
+    /* The ranges the configuration's camera keys take (a K11 of 1e-30 gave an empty frame) */
+    replaced(bad, sizeof bad, good, " 117.64700   0.00000   0.00000   0.00000 117.64700",
+             " 1.0D-30   0.00000   0.00000   0.00000 117.64700");
+    expect_error(bad, NULL, 0, "bad.SUM:10: K-MATRIX: MMFL x K11, K22 give focal lengths of 1.2");
     /* Axes off unit length or perpendicular within 1e-3 are made
      * orthonormal keeping CZ, the boresight: CX 1.0005 long, then CX . CY
      * = 9e-4 (CY turned about CZ). */
