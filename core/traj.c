@@ -70,10 +70,15 @@ static int row_error(const char *path, size_t lineno, int sum, const double *v, 
     const char *cols = sum ? sum_cols : pose_cols;
     const int need = sum ? 16 : 11;
     char name[32];
-    const size_t tok = strcspn(s, " \t,\r\n");
+    s += strspn(s, " \t");
+    const size_t tok = strcspn(s, ",\r\n");
     if (tok && k < need + 1)
-        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s): '%.*s' is not a number", path, lineno, k + 1,
-                        col_name(cols, k, name, sizeof name), (int)tok, s);
+        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s): '%.*s' is not a number%s", path, lineno, k + 1,
+                        col_name(cols, k, name, sizeof name), (int)tok, s,
+                        strchr(s, ';') ? " (columns are separated by commas)" : "");
+    if (*s == ',' && k < need + 1)
+        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s) is empty", path, lineno, k + 1,
+                        col_name(cols, k, name, sizeof name));
     if (*s && *s != '\n' && *s != '\r')
         return nc_error(NC_ECONFIG, "%s:%zu: more than %d columns: %s", path, lineno, need + 1, cols);
     if (k < need)
@@ -122,13 +127,15 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         char *s = line, *end;
         for (; k < need + 1; k++) {
             v[k] = strtod(s, &end);
-            if (end == s)
-                break;
-            s = end + strspn(end, " \t");
+            const char *after = end + strspn(end, " \t");
+            if (end == s || (*after && !strchr(",\r\n", *after)))
+                break; /* not a number, or one followed by more than a comma: the field is reported whole */
+            s = (char *)after;
             if (*s == ',')
                 s++;
         }
-        if (k == 0 && n == 0 && !header) {
+        const char *f0 = line + strspn(line, " \t\"");
+        if (k == 0 && n == 0 && !header && !(isdigit((unsigned char)*f0) || strchr("+-.", *f0))) {
             header = 1; /* a header: which layout */
             sum = sum_header(line);
             continue;
@@ -168,6 +175,10 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
             rc = nc_error(NC_ECONFIG, "%s:%zu: the Sun direction is zero", path, lineno);
             break;
         }
+        if (!(fmax(fabs(r->p.x), fmax(fabs(r->p.y), fabs(r->p.z))) <= 1e15)) { /* as camera.position_m */
+            rc = nc_error(NC_ECONFIG, "%s:%zu: the camera lies beyond 1e15 m from the scene's origin", path, lineno);
+            break;
+        }
         n++;
     }
     fclose(f);
@@ -175,9 +186,10 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         free(rows);
         return rc;
     }
-    if (n > 100000000) {
+    if (n > 100000000 || n == 0) {
         free(rows);
-        return nc_error(NC_ERANGE, "%s: %zu rows: more than 10^8", path, n);
+        return n ? nc_error(NC_ERANGE, "%s: %zu rows: more than 10^8", path, n)
+                 : nc_error(NC_ECONFIG, "%s: no poses (%zu lines: blank, comments or a header)", path, lineno);
     }
     *out = rows;
     return (int)n;

@@ -139,6 +139,10 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
     }
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
+    const struct nc_vec3 p = c->position_m;
+    const double far = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
+    if (!(far <= 1e15)) /* 6700 au: farther, the render's float view of the scene breaks down */
+        return nc_cfg_key_error(map, "position_m", "a coordinate of %g m, beyond 1e15 m", far);
     struct nc_vec3 target, up = nc_v3(0, 0, 1);
     int hq = nc_cfg_quat(map, "attitude_q", &c->attitude_q);
     int ht = nc_cfg_vec3(map, "look_at_m", &target);

@@ -24,7 +24,8 @@ void nc_mesh_free(struct nc_mesh *m);
  * value is a wrong unit or scale (the ray tracer's single precision breaks
  * down long before the 1e30 that such a file can hold). */
 #define NC_MESH_MAX_M 1e9
-/* 0, or (m freed) an error naming `what` and the first vertex beyond NC_MESH_MAX_M. */
+/* 0, or (m freed) an error naming `what` and the first vertex beyond
+ * NC_MESH_MAX_M, or saying that no triangle has an area. */
 int nc_mesh_check_extent(struct nc_mesh *m, const char *what);
 /* Load OBJ or PLY (by extension), scaling coordinates by scale_to_m. */
 int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out);

@@ -179,6 +179,14 @@ grep -q "bad.csv:2: column 4 (cam_z_m): 'x' is not a number" err.txt || fail "tr
 printf '0,1,2,3,1,0,0,0,0,1,0,0.5\n' > bad.csv
 "$navcam" batch bad.csv -o x 2> err.txt && fail "capture 0.5 accepted"
 grep -q "bad.csv:1: column 12 (capture): 0.5, expected 0 or 1" err.txt || fail "trajectory error: $(cat err.txt)"
+# a number run into letters, an empty field, semicolons, no rows: each named for what it is
+for c in "0,1,2,3x,1,0,0,0,0,1,0|bad.csv:1: column 4 (cam_z_m): '3x' is not a number" \
+         "0,1,,3,1,0,0,0,0,1,0|bad.csv:1: column 3 (cam_y_m) is empty" \
+         "0;1;2;3;1;0;0;0;0;1;0|(columns are separated by commas)" "t_s,cam_x_m|bad.csv: no poses"; do
+  printf '%s\n' "${c%%|*}" > bad.csv
+  "$navcam" batch bad.csv -o x 2> err.txt && fail "accepted: ${c%%|*}"
+  grep -qF "${c#*|}" err.txt || fail "trajectory error for ${c%%|*}: $(cat err.txt)"
+done
 
 # Slurm: a job array of 4 tasks into one directory.
 slurm=$(mktemp -d /tmp/nc_slurm.XXXXXX)
