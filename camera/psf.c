@@ -116,7 +116,13 @@ int nc_psf_image(const char *path, struct nc_psf *psf)
         psf->kernel[i] = px[i];
     }
     free(px);
-    return normalise(psf);
+    if ((rc = normalise(psf)) < 0) {
+        char why[256];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        nc_psf_free(psf);
+        return nc_error(rc, "%s: %s", path, why);
+    }
+    return 0;
 }
 
 /* Separable Gaussian: rows then columns, zero outside the image. Written as

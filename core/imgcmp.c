@@ -119,7 +119,9 @@ double nc_imgcmp_ncc(const float *a, const float *b, const unsigned char *mask, 
     if (n < 2)
         return NAN;
     double va = saa - sa * sa / (double)n, vb = sbb - sb * sb / (double)n, cab = sab - sa * sb / (double)n;
-    if (!(va > 0 && vb > 0))
+    /* a constant image (its variance lost in the rounding of these sums: a relative spread under 1e-6,
+     * float's resolution) has no correlation */
+    if (!(va > 1e-12 * saa && vb > 1e-12 * sbb))
         return NAN;
     return cab / sqrt(va * vb);
 }

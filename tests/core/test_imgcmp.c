@@ -48,6 +48,11 @@ int main(void)
     for (int k = 0; k < 5; k++)
         CHECK(fabs(r.ncc[k] - 1) < 1e-9, "itself: NCC at %d px %.12f", nc_imgcmp_blocks[k], r.ncc[k]);
     CHECK(r.foreground_px > 10000 && r.foreground_px < N / 2, "foreground %zu px (the body)", r.foreground_px);
+    /* A constant image has no correlation with anything (the sums' rounding gave 4.9e-9, not none). */
+    for (int i = 0; i < N; i++)
+        other[i] = 0.1234567f;
+    CHECK(isnan(nc_imgcmp_ncc(other, real, NULL, W, H, 1)) && isnan(nc_imgcmp_ncc(other, other, NULL, W, H, 2)),
+          "a constant image's NCC: %g", nc_imgcmp_ncc(other, real, NULL, W, H, 1));
     size_t lit = 0;
     for (int i = 0; i < N; i++)
         lit += real[i] > 0;
