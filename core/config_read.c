@@ -84,8 +84,11 @@ static int scalar_double(struct nc_cfg_node *n, double *out)
     double v = strtod(n->value, &end);
     while (*end == ' ')
         end++;
-    if (end == n->value || *end || errno == ERANGE)
+    if (end == n->value || *end)
         return nc_cfg_error(n, "expected a number, got \"%s\"", n->value);
+    if (errno == ERANGE)
+        return nc_cfg_error(n, "expected a number, got \"%s\", beyond a double's range (%s)", n->value,
+                            fabs(v) > 1 ? "at most 1.8e308" : "at least 2.2e-308 in magnitude, or 0");
     if (!isfinite(v))
         return nc_cfg_error(n, "expected a finite number, got \"%s\"", n->value);
     n->used = 1;
