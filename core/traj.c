@@ -128,14 +128,14 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         for (; k < need + 1; k++) {
             v[k] = strtod(s, &end);
             const char *after = end + strspn(end, " \t");
-            if (end == s || (*after && !strchr(",\r\n", *after)))
-                break; /* not a number, or one followed by more than a comma: the field is reported whole */
+            if (end == s || (after == end && *after && !strchr(",\r\n", *after)))
+                break; /* not a number, or one run into other characters: the field is reported whole */
             s = (char *)after;
             if (*s == ',')
                 s++;
         }
         const char *f0 = line + strspn(line, " \t\"");
-        if (k == 0 && n == 0 && !header && !(isdigit((unsigned char)*f0) || strchr("+-.", *f0))) {
+        if (k == 0 && n == 0 && !header && !(isdigit((unsigned char)*f0) || strchr("+-.,", *f0))) {
             header = 1; /* a header: which layout */
             sum = sum_header(line);
             continue;

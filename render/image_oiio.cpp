@@ -45,14 +45,15 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
             spec.attribute(attrs[i].name, attrs[i].value);
     if (description)
         spec.attribute("ImageDescription", description);
+    // The file is encoded in memory and written here: OpenImageIO's PNG and
+    // EXR writers do not report a failed write (a full disk, a file size
+    // limit), and the caller must know that the file is whole. (The buffer
+    // outlives the writer, whose destructor may still write to it.)
+    std::vector<unsigned char> bytes;
+    Filesystem::IOVecOutput mem(bytes);
     auto out = ImageOutput::create(path);
     if (!out)
         return fail(NC_EIMAGE, err, elen, "%s: %s", path, OIIO::geterror().c_str());
-    // The file is encoded in memory and written here: OpenImageIO's PNG and
-    // EXR writers do not report a failed write (a full disk, a file size
-    // limit), and the caller must know that the file is whole.
-    std::vector<unsigned char> bytes;
-    Filesystem::IOVecOutput mem(bytes);
     if (!out->set_ioproxy(&mem))
         return fail(NC_EIMAGE, err, elen, "%s: %s cannot encode to memory", path, out->format_name());
     // OpenImageIO deflates a float TIFF with the floating-point predictor

@@ -20,10 +20,10 @@ struct nc_mesh {
 };
 
 void nc_mesh_free(struct nc_mesh *m);
-/* The farthest a vertex may lie from a model's origin, metres: past it a
- * value is a wrong unit or scale (the ray tracer's single precision breaks
- * down long before the 1e30 that such a file can hold). */
-#define NC_MESH_MAX_M 1e9
+/* The farthest a vertex may lie from a model's origin, metres (the largest
+ * globe radius a configuration takes): past it a value is a wrong unit or
+ * scale (the ray tracer aborts on the 1e30 that such a file can hold). */
+#define NC_MESH_MAX_M 1e10
 /* 0, or (m freed) an error naming `what` and the first vertex beyond
  * NC_MESH_MAX_M, or saying that no triangle has an area. */
 int nc_mesh_check_extent(struct nc_mesh *m, const char *what);

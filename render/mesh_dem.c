@@ -74,7 +74,7 @@ int nc_mesh_dem_tile(const float *h, int w, int rows, const struct nc_dem_tile_p
     }
     out->nv = nv;
     out->nt = nt;
-    return nc_mesh_check_extent(out, "the DEM's heights");
+    return nc_mesh_check_extent(out, "the DEM tile");
 }
 
 int nc_mesh_globe(double radius_m, int subdivisions, const struct nc_albedo_map *elevation, struct nc_mesh *out)
@@ -95,5 +95,5 @@ int nc_mesh_globe(double radius_m, int subdivisions, const struct nc_albedo_map 
         for (int k = 0; k < 3; k++)
             v[k] *= s;
     }
-    return nc_mesh_check_extent(out, "the elevation map's heights");
+    return nc_mesh_check_extent(out, "the globe");
 }

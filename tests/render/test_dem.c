@@ -50,7 +50,7 @@ static void check_tile(void)
     nc_mesh_free(&m);
     /* a value no elevation has (the ray tracer aborted on it): refused, naming the pixel */
     h[3 * W + 4] = 3e38f;
-    CHECK(nc_mesh_dem_tile(h, W, H, &p, &m) < 0 && nc_test_contains(nc_errmsg(), "at row 3, column 4 is beyond 1e+09 m"),
+    CHECK(nc_mesh_dem_tile(h, W, H, &p, &m) < 0 && nc_test_contains(nc_errmsg(), "at row 3, column 4 is beyond 1e+10 m"),
           "a height of 3e38: %s", nc_errmsg());
     h[3 * W + 4] = 0;
     /* on a sphere: the centre pixel at (lat, lon), every vertex at radius + height */

@@ -155,7 +155,9 @@ static void whole_or_nothing(void)
     int w, h;
     size_t len = 0;
     char *bytes = NULL;
-    if (nc_image_write(tif, img, W, W, NULL, 0, NULL) == 0 && (bytes = nc_test_read(tif, &len))) {
+    CHECK(nc_image_write(tif, img, W, W, NULL, 0, NULL) == 0 && (bytes = nc_test_read(tif, &len)), "cut.tif: %s",
+          nc_errmsg());
+    if (bytes) {
         FILE *fp = fopen(tif, "wb");
         if (fp)
             fwrite(bytes, 1, len / 2, fp), fclose(fp);
