@@ -137,6 +137,16 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
                 }
                 m.v[3 * m.nv + k] = d * scale;
             }
+            for (const char *st = end; *(st += strspn(st, " \t\r\n"));) { /* then numbers only: w, or a colour */
+                char *e;
+                strtod(st, &e);
+                if (e == st) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: vertex: '%.*s' after x y z is not a number", path, lineno,
+                                  (int)strcspn(st, " \t\r\n"), st);
+                    goto out;
+                }
+                st = e;
+            }
             m.nv++;
         } else if (s[0] == 'f' && isspace((unsigned char)s[1])) {
             s++;

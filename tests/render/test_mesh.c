@@ -106,6 +106,7 @@ int main(void)
     expect_fail("nan.obj", "v 0 0 0\nv nan 0 0\nv 1 1 0\nf 1 2 3\n", "nan.obj:2: vertex coordinate is not finite");
     expect_fail("far.obj", "v 0 0 0\nv 1e30 0 0\nv 1 1 0\nf 1 2 3\n",
                 "far.obj: vertex 2 (counted from 1) lies 1e+30 m from the origin, beyond 1e+10 m");
+    expect_fail("junk.obj", "v 0 0 0 junk\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", "junk.obj:1: vertex: 'junk' after x y z");
     expect_fail("short.obj", "v 0 0\nf 1 1 1\n", "short.obj:1: vertex needs 3 numbers");
     expect_fail("empty.obj", "# nothing here\n", "mesh has no triangles");
     expect_fail("verts.obj", "v 0 0 0\nv 1 0 0\n", "mesh has no triangles");
