@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include "core/error.h"
 #include "core/grow.h"
@@ -411,6 +412,16 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
     struct nc_mesh m = {0};
     if ((rc = ply_header(&r, el, &nel)) < 0)
         goto out;
+    struct stat st;
+    long at = ftell(r.f);
+    size_t announced = 0;
+    for (int e = 0; e < nel; e++)
+        announced += el[e].count;
+    if (fstat(fileno(r.f), &st) == 0 && at >= 0 && announced > (size_t)(st.st_size - at)) { /* a byte each, at least */
+        rc = nc_error(NC_EMESH, "%s: the header announces %zu elements, more than the %lld bytes after it hold", path,
+                      announced, (long long)(st.st_size - at));
+        goto out;
+    }
     int have_v = 0, have_f = 0;
     for (int e = 0; e < nel; e++) {
         struct ply_elem *x = &el[e];

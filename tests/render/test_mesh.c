@@ -172,6 +172,10 @@ int main(void)
                 "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0\n",
                 "unexpected end of file");
     expect_fail("nohdr.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", "no end_header");
+    expect_fail("huge.ply", /* 4e9 vertices announced: said so, not "out of memory" */
+                "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+                "property float z\nend_header\n0 0 0\n",
+                "the header announces 4000000000 elements, more than the 6 bytes after it hold");
     expect_fail("notply.ply", "hello\n", "not a PLY file");
 
     /* The procedural asteroid: closed, deterministic, the requested size. */
