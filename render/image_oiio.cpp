@@ -26,6 +26,13 @@ __attribute__((format(printf, 4, 5))) int fail(int code, char *err, size_t len, 
     va_start(ap, fmt);
     std::vsnprintf(err, len, fmt, ap);
     va_end(ap);
+    // One line: OpenImageIO's error text has a line per error it met.
+    std::string one(err);
+    while (!one.empty() && one.back() == '\n')
+        one.pop_back();
+    for (size_t at; (at = one.find('\n')) != std::string::npos;)
+        one.replace(at, 1, "; ");
+    std::snprintf(err, len, "%s", one.c_str());
     return code;
 }
 
