@@ -58,6 +58,8 @@ void nc__serve_reply(struct nc__emu *e, const struct nc__job *j, uint64_t frame,
                         c->out_len / (4 + n));
             e->slow_clients++;
             shutdown(c->fd, SHUT_RDWR);
+            c->gen++; /* its remaining answers go nowhere, unlogged (the net thread closes the socket) */
+            c->out_len = 0;
         } else {
             memcpy(c->out + c->out_len, buf, 4 + n);
             c->out_len += 4 + n;
