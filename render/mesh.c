@@ -138,7 +138,7 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
                 }
                 m.v[3 * m.nv + k] = d * scale;
             }
-            for (const char *st = end; *(st += strspn(st, " \t\r\n"));) { /* then numbers only: w, or a colour */
+            for (const char *st = end; *(st += strspn(st, " \t\r\n")) && *st != '#';) { /* numbers: w, a colour */
                 char *e;
                 strtod(st, &e);
                 if (e == st) {
