@@ -10,6 +10,15 @@
 
 #include "core/vec.h"
 
+/* The camera every input may describe (camera.* keys, SUM files,
+ * trajectories): within 1e15 m (6700 au, beyond any mission) of the scene's
+ * origin on each axis (a camera at 1e200 m left the render no image axes),
+ * focal lengths of 1e-3 to 1e9 pixels, a principal point within 1e6 pixels. */
+#define NC_CAMERA_MAX_M 1e15
+#define NC_FOCAL_MIN_PX 1e-3
+#define NC_FOCAL_MAX_PX 1e9
+#define NC_PRINCIPAL_MAX_PX 1e6
+
 struct nc_pose {
     int64_t t_ns;                  /* simulation time */
     struct nc_vec3 cam_position_m; /* scene frame */

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/pose.h"
 
 enum { IT_SIZE, IT_MMFL, IT_SCOBJ, IT_CX, IT_CY, IT_CZ, IT_SZ, IT_K, IT_DIST, IT_SIGMA_VSO, IT_SIGMA_PTG, IT_N };
 static const struct {
@@ -238,14 +239,13 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
         return nc_error(NC_ECONFIG, "%s:%d: SZ: the Sun direction is zero", path, seen[IT_SZ]);
     if (out->k[0] == 0 || out->k[4] == 0)
         return nc_error(NC_ECONFIG, "%s:%d: K-MATRIX: K11 and K22 (pixels/mm) must not be zero", path, seen[IT_K]);
-    /* The ranges a configuration's camera.fx_px, fy_px, cx_px and cy_px take. */
     const double fx = out->mmfl_mm * fabs(out->k[0]), fy = out->mmfl_mm * fabs(out->k[4]);
-    if (!(fx >= 1e-3 && fx <= 1e9 && fy >= 1e-3 && fy <= 1e9))
+    if (!(fx >= NC_FOCAL_MIN_PX && fx <= NC_FOCAL_MAX_PX && fy >= NC_FOCAL_MIN_PX && fy <= NC_FOCAL_MAX_PX))
         return nc_error(NC_ECONFIG, "%s:%d: K-MATRIX: MMFL x K11, K22 give focal lengths of %g x %g pixels, expected "
-                        "1e-3 to 1e9", path, seen[IT_K], fx, fy);
-    if (!(fabs(out->ctr[0]) <= 1e6 && fabs(out->ctr[1]) <= 1e6))
-        return nc_error(NC_ECONFIG, "%s:%d: CTR: the principal point (%g, %g) lies beyond 1e6 pixels", path,
-                        seen[IT_MMFL], out->ctr[0], out->ctr[1]);
+                        "%g to %g", path, seen[IT_K], fx, fy, NC_FOCAL_MIN_PX, NC_FOCAL_MAX_PX);
+    if (!(fabs(out->ctr[0]) <= NC_PRINCIPAL_MAX_PX && fabs(out->ctr[1]) <= NC_PRINCIPAL_MAX_PX))
+        return nc_error(NC_ECONFIG, "%s:%d: CTR: the principal point (%g, %g) lies beyond %g pixels", path,
+                        seen[IT_MMFL], out->ctr[0], out->ctr[1], NC_PRINCIPAL_MAX_PX);
     return unmodelled(path, seen, out, dist);
 }
 

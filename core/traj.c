@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/pose.h"
 #include "core/sumfile.h"
 
 /* The built-in approach to the default scene's asteroid (as `make demo`):
@@ -175,8 +176,9 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
             rc = nc_error(NC_ECONFIG, "%s:%zu: the Sun direction is zero", path, lineno);
             break;
         }
-        if (!(fmax(fabs(r->p.x), fmax(fabs(r->p.y), fabs(r->p.z))) <= 1e15)) { /* as camera.position_m */
-            rc = nc_error(NC_ECONFIG, "%s:%zu: the camera lies beyond 1e15 m from the scene's origin", path, lineno);
+        if (!(nc_v3_max_abs(r->p) <= NC_CAMERA_MAX_M)) {
+            rc = nc_error(NC_ECONFIG, "%s:%zu: the camera lies beyond %g m from the scene's origin", path, lineno,
+                          NC_CAMERA_MAX_M);
             break;
         }
         n++;

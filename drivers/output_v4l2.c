@@ -366,10 +366,7 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
 static void pack(const struct v4l2_out *v, const struct nc_frame_record *r, unsigned char *dst)
 {
     if (v->meta) {
-        uint8_t m[NC_FRAME_META_BYTES];
-        nc_frame_metadata(r, m);
-        memset(dst, 0, v->bytesperline);
-        memcpy(dst, m, v->bytesperline < sizeof m ? v->bytesperline : sizeof m);
+        nc_frame_metadata_row(r, dst, v->bytesperline);
         dst += v->bytesperline;
     }
     const uint16_t *dn = r->dn;

@@ -120,7 +120,7 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
 /* The metadata block (docs/gige.md gives the layout), little-endian: a
  * 48-byte core with its own CRC (fits a Mono8 row of 48 pixels), then the
  * pose, with a CRC over everything. */
-void nc_frame_metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_BYTES])
+static void metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_BYTES])
 {
     memset(m, 0, NC_FRAME_META_BYTES);
     memcpy(m, "NCMD", 4);
@@ -145,4 +145,12 @@ void nc_frame_metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_
     m[153] = (uint8_t)r->pose_quality;
     nc_le_put_u16(m + 154, (uint16_t)r->adc_bits);
     nc_le_put_u32(m + 156, (uint32_t)crc32(0L, m, 156));
+}
+
+void nc_frame_metadata_row(const struct nc_frame_record *r, uint8_t *row, size_t len)
+{
+    uint8_t m[NC_FRAME_META_BYTES];
+    metadata(r, m);
+    memset(row, 0, len);
+    memcpy(row, m, len < sizeof m ? len : sizeof m);
 }

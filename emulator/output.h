@@ -110,7 +110,9 @@ struct nc_output {
  * request's sequence), then the trigger and exposure times, the pose and
  * the ADC's bits, with a CRC-32 over the block. */
 #define NC_FRAME_META_BYTES 160
-void nc_frame_metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_BYTES]);
+/* The block at the start of row (len bytes), the rest of it 0: a row
+ * shorter than the block holds its beginning. */
+void nc_frame_metadata_row(const struct nc_frame_record *r, uint8_t *row, size_t len);
 
 /* opts against the driver's table: every key known (unknown keys:
  * file:line), every value of its type and range. Touches nothing. */

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/pose.h"
 #include "core/sumfile.h"
 
 /* camera.sumfile: intrinsics from an SPC SUM file (core/sumfile.h). The
@@ -64,8 +65,8 @@ static int camera_read(struct nc_cfg_node *map, struct nc_camera *c, struct nc_s
     int hf, hp, hfx, hfy;
     if ((hf = nc_cfg_double(map, "focal_length_m", 1e-6, 100, &f)) < 0 ||
         (hp = nc_cfg_double(map, "pixel_pitch_m", 1e-8, 1e-2, &pitch)) < 0 ||
-        (hfx = nc_cfg_double(map, "fx_px", 1e-3, 1e9, &fx)) < 0 ||
-        (hfy = nc_cfg_double(map, "fy_px", 1e-3, 1e9, &fy)) < 0)
+        (hfx = nc_cfg_double(map, "fx_px", NC_FOCAL_MIN_PX, NC_FOCAL_MAX_PX, &fx)) < 0 ||
+        (hfy = nc_cfg_double(map, "fy_px", NC_FOCAL_MIN_PX, NC_FOCAL_MAX_PX, &fy)) < 0)
         return hf < 0 ? hf : hp < 0 ? hp : hfx < 0 ? hfx : hfy;
     if ((hf || hp) && (hfx || hfy))
         return nc_cfg_key_error(map, hf ? "focal_length_m" : "pixel_pitch_m",
@@ -86,8 +87,8 @@ static int camera_read(struct nc_cfg_node *map, struct nc_camera *c, struct nc_s
     }
     c->cx_px = 0.5 * (c->width_px - 1);
     c->cy_px = 0.5 * (c->height_px - 1);
-    if ((rc = nc_cfg_double(map, "cx_px", -1e6, 1e6, &c->cx_px)) < 0 ||
-        (rc = nc_cfg_double(map, "cy_px", -1e6, 1e6, &c->cy_px)) < 0)
+    if ((rc = nc_cfg_double(map, "cx_px", -NC_PRINCIPAL_MAX_PX, NC_PRINCIPAL_MAX_PX, &c->cx_px)) < 0 ||
+        (rc = nc_cfg_double(map, "cy_px", -NC_PRINCIPAL_MAX_PX, NC_PRINCIPAL_MAX_PX, &c->cy_px)) < 0)
         return rc;
 
 distortion:;
@@ -139,10 +140,9 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
     }
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
-    const struct nc_vec3 p = c->position_m;
-    const double far = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
-    if (!(far <= 1e15)) /* 6700 au: farther, the render's float view of the scene breaks down */
-        return nc_cfg_key_error(map, "position_m", "a coordinate of %g m, beyond 1e15 m", far);
+    if (!(nc_v3_max_abs(c->position_m) <= NC_CAMERA_MAX_M))
+        return nc_cfg_key_error(map, "position_m", "a coordinate of %g m, beyond %g m", nc_v3_max_abs(c->position_m),
+                                NC_CAMERA_MAX_M);
     struct nc_vec3 target, up = nc_v3(0, 0, 1);
     int hq = nc_cfg_quat(map, "attitude_q", &c->attitude_q);
     int ht = nc_cfg_vec3(map, "look_at_m", &target);

@@ -73,8 +73,17 @@ static int tmp_path(const char *path, char *tmp, size_t len)
     return n < 0 || (size_t)n >= len ? nc_error(NC_EIMAGE, "%s: path too long", path) : 0;
 }
 
-static int commit(int rc, const char *tmp, const char *path)
+/* px (w x h x depth of type t) to path, by its extension (FITS through
+ * cfitsio, the rest through OpenImageIO, one plane), as above. */
+static int write_file(const char *path, const void *px, enum nc__pixel t, int w, int h, int depth,
+                      const struct nc_image_attr *attrs, int nattrs, const char *desc)
 {
+    char tmp[4200];
+    int rc = tmp_path(path, tmp, sizeof tmp);
+    if (rc < 0)
+        return rc;
+    rc = format_of(path) == FMT_FITS ? nc__fits_write(tmp, px, t, w, h, depth, attrs, nattrs)
+                                     : nc__oiio_write(tmp, px, w, h, t, attrs, nattrs, desc);
     if (rc >= 0 && rename(tmp, path) < 0)
         rc = nc_error(-errno, "%s: %s", path, strerror(errno));
     if (rc < 0) {
@@ -172,15 +181,8 @@ int nc_image_write(const char *path, const float *px, int w, int h, const struct
         rc = nc_error(-ENOMEM, "%s: out of memory", path);
         goto out;
     }
-    char tmp[4200];
-    if ((rc = tmp_path(path, tmp, sizeof tmp)) < 0)
-        goto out;
-    if (f == FMT_FITS)
-        rc = nc__fits_write(tmp, clean, NC__PX_FLOAT, w, h, 1, all, nall);
-    else
-        rc = nc__oiio_write(tmp, f == FMT_PNG ? (const void *)dn : clean, w, h, f == FMT_PNG ? NC__PX_U16 : NC__PX_FLOAT,
-                            all, nall, desc);
-    rc = commit(rc, tmp, path);
+    rc = write_file(path, f == FMT_PNG ? (const void *)dn : clean, f == FMT_PNG ? NC__PX_U16 : NC__PX_FLOAT, w, h, 1,
+                    all, nall, desc);
 out:
     free(clean);
     free(dn);
@@ -220,11 +222,7 @@ int nc_image_write_dn(const char *path, const uint16_t *dn, int w, int h, int bi
     }
     enum nc__pixel t = f == FMT_EXR ? NC__PX_FLOAT : bits <= 8 ? NC__PX_U8 : NC__PX_U16;
     const void *px = buf ? buf : (const void *)dn;
-    char tmp[4200];
-    if ((rc = tmp_path(path, tmp, sizeof tmp)) >= 0)
-        rc = commit(f == FMT_FITS ? nc__fits_write(tmp, px, t, w, h, 1, attrs, nattrs)
-                                  : nc__oiio_write(tmp, px, w, h, t, attrs, nattrs, desc),
-                    tmp, path);
+    rc = write_file(path, px, t, w, h, 1, attrs, nattrs, desc);
     free(buf);
     free(desc);
     return rc;
@@ -236,18 +234,14 @@ int nc_image_write_dn_cube(const char *path, const uint16_t *dn, int w, int h, i
     if (format_of(path) != FMT_FITS)
         return nc_error(NC_EIMAGE, "%s: a cube of frames needs .fits (or write numbered files)", path);
     size_t n = (size_t)w * (size_t)h * (size_t)nframes;
-    char tmp[4200];
-    int rc = tmp_path(path, tmp, sizeof tmp);
-    if (rc < 0)
-        return rc;
     if (bits > 8)
-        return commit(nc__fits_write(tmp, dn, NC__PX_U16, w, h, nframes, attrs, nattrs), tmp, path);
+        return write_file(path, dn, NC__PX_U16, w, h, nframes, attrs, nattrs, NULL);
     uint8_t *v = malloc(n ? n : 1);
     if (!v)
         return nc_error(-ENOMEM, "out of memory");
     for (size_t i = 0; i < n; i++)
         v[i] = (uint8_t)(dn[i] > 255 ? 255 : dn[i]);
-    rc = commit(nc__fits_write(tmp, v, NC__PX_U8, w, h, nframes, attrs, nattrs), tmp, path);
+    int rc = write_file(path, v, NC__PX_U8, w, h, nframes, attrs, nattrs, NULL);
     free(v);
     return rc;
 }
@@ -274,9 +268,7 @@ int nc_image_write_planes(const char *path, const float *planes, int w, int h, i
         snprintf(key[k], sizeof key[k], "PLANE%d", k + 1);
         all[nattrs + k] = (struct nc_image_attr){key[k], names[k]};
     }
-    char tmp[4200];
-    if ((rc = tmp_path(path, tmp, sizeof tmp)) >= 0)
-        rc = commit(nc__fits_write(tmp, clean, NC__PX_FLOAT, w, h, nplanes, all, nattrs + nplanes), tmp, path);
+    rc = write_file(path, clean, NC__PX_FLOAT, w, h, nplanes, all, nattrs + nplanes, NULL);
 out:
     free(clean);
     free(all);

@@ -51,11 +51,9 @@ int nc_mesh_check_extent(struct nc_mesh *m, const char *what)
                             "(a wrong unit or scale?)", what, i + 1, r, NC_MESH_MAX_M);
         }
     }
-    for (size_t t = 0; t < m->nt; t++) {
-        struct nc_vec3 n;
-        if (nc_mesh_face(m, t, &n) > 0)
+    for (size_t t = 0; t < m->nt; t++)
+        if (nc_mesh_face(m, t, NULL) > 0)
             return 0;
-    }
     nc_mesh_free(m);
     return nc_error(NC_EMESH, "%s: no triangle has an area (every face is degenerate)", what);
 }

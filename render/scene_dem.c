@@ -14,6 +14,7 @@
 #include "core/log.h"
 #include "render/albedo_map.h"
 #include "render/image_io.h"
+#include "render/mesh.h"
 
 static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
 {
@@ -40,7 +41,7 @@ static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
     if ((rc = nc_cfg_map(sh, "on_sphere", &sph)) < 0)
         return rc;
     if (rc) {
-        if ((rc = nc_cfg_double(sph, "radius_m", 1, 1e10, &p.radius_m)) <= 0)
+        if ((rc = nc_cfg_double(sph, "radius_m", 1, NC_MESH_MAX_M, &p.radius_m)) <= 0)
             return rc ? rc : nc_cfg_missing(sph, "radius_m", "the reference sphere's radius, metres");
         if ((rc = nc_cfg_double(sph, "lat_deg", -90, 90, &p.lat_deg)) <= 0)
             return rc ? rc : nc_cfg_missing(sph, "lat_deg", "planetocentric latitude of the tile's centre");
@@ -70,7 +71,7 @@ static int globe_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
     double r;
     long sub = 7;
     int rc;
-    if ((rc = nc_cfg_double(sh, "radius_m", 1e-3, 1e10, &r)) <= 0)
+    if ((rc = nc_cfg_double(sh, "radius_m", 1e-3, NC_MESH_MAX_M, &r)) <= 0)
         return rc ? rc : nc_cfg_missing(sh, "radius_m", "the reference sphere's radius, metres");
     if ((rc = nc_cfg_int(sh, "subdivisions", 0, 9, &sub)) < 0)
         return rc;

@@ -45,11 +45,7 @@ void nc__gige_image(const uint16_t *dn, int W, int H, int adc_bits, const struct
     int row0 = 0, left, right;
     shifts(pf, adc_bits, &left, &right);
     if (meta) { /* the metadata row on top */
-        uint8_t m[NC_FRAME_META_BYTES];
-        nc_frame_metadata(meta, m);
-        size_t rowb = (size_t)w * bpp;
-        memset(out, 0, rowb);
-        memcpy(out, m, rowb < NC_FRAME_META_BYTES ? rowb : NC_FRAME_META_BYTES);
+        nc_frame_metadata_row(meta, out, (size_t)w * bpp);
         row0 = 1;
     }
     for (int y = row0; y < (int)h; y++) {

@@ -221,8 +221,6 @@ int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uin
     return undone;
 }
 
-/* Client-written settings to the emulator, when they changed: a write outside the XML's ranges is undone, the
- * others stand; if the emulator refuses them together (lock-step, a line it lacks), each unit is tried alone. */
 void nc__gige_apply(ArvFakeCamera *fc, const struct nc_camera_control *ctl, struct nc_acquisition *applied,
                     void (*refused)(void *, const char *), void *arg)
 {
