@@ -29,20 +29,36 @@ static void trim(char *s)
         s[--n] = 0;
 }
 
-/* The item whose label the line carries after its numbers (a label starts
- * the line or follows a blank or a comma), and where: -1 if none. */
-static int find_label(const char *line, const char **at)
+/* Where label starts as a word of line (at its start or after a blank or
+ * a comma, and followed by neither a letter, a digit nor '_'), or NULL. */
+static const char *label_at(const char *line, const char *label)
 {
+    const size_t n = strlen(label);
+    for (const char *p = strstr(line, label); p; p = strstr(p + 1, label))
+        if ((p == line || isspace((unsigned char)p[-1]) || p[-1] == ',') && !isalnum((unsigned char)p[n]) &&
+            p[n] != '_')
+            return p;
+    return NULL;
+}
+
+/* The item whose label the line carries after its numbers, and where: -1
+ * if none; *other another item the line names too (-1: none). */
+static int find_label(const char *line, const char **at, int *other)
+{
+    int found = -1;
+    *other = -1;
     for (int it = 0; it < IT_N; it++) {
-        const size_t n = strlen(items[it].label);
-        for (const char *p = strstr(line, items[it].label); p; p = strstr(p + 1, items[it].label))
-            if ((p == line || isspace((unsigned char)p[-1]) || p[-1] == ',') && !isalnum((unsigned char)p[n]) &&
-                p[n] != '_') {
-                *at = p;
-                return it;
-            }
+        const char *p = label_at(line, items[it].label);
+        if (!p)
+            continue;
+        if (found < 0)
+            found = it, *at = p;
+        else if (p < *at)
+            *other = found, found = it, *at = p;
+        else
+            *other = it;
     }
-    return -1;
+    return found;
 }
 
 /* The numbers of text (blank- or comma-separated; Fortran D exponents read
@@ -171,7 +187,13 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
         if (!strncmp(start, "LANDMARKS", 9) || !strncmp(start, "END FILE", 8))
             break;
         const char *at;
-        const int it = find_label(line, &at);
+        int other;
+        const int it = find_label(line, &at, &other);
+        if (other >= 0) {
+            rc = nc_error(NC_ECONFIG, "%s:%d: the line is labelled both %s and %s: one label a line", path, lineno,
+                          items[it].label, items[other].label);
+            break;
+        }
         if (it < 0 || items[it].count < 0)
             continue; /* SIGMA_VSO, SIGMA_PTG, lines NavCam does not know */
         if (seen[it]) {

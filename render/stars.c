@@ -97,10 +97,11 @@ int nc_star_cat_read_kstars(const char *path, struct nc_star_cat *c)
 
 #define MAGIC "NCSTARS1"
 #define RECORD 32
+#define HEADER 24 /* magic, star count, epoch */
 
 int nc_star_cat_write(const struct nc_star_cat *c, const char *path)
 {
-    size_t size = 24 + c->n * RECORD;
+    size_t size = HEADER + c->n * RECORD;
     uint8_t *b = malloc(size);
     if (!b)
         return nc_error(-ENOMEM, "out of memory");
@@ -108,7 +109,7 @@ int nc_star_cat_write(const struct nc_star_cat *c, const char *path)
     nc_le_put_u64(b + 8, c->n);
     nc_le_put_f64(b + 16, c->epoch_jyear);
     for (size_t i = 0; i < c->n; i++) {
-        uint8_t *p = b + 24 + i * RECORD;
+        uint8_t *p = b + HEADER + i * RECORD;
         const struct nc_star *s = &c->star[i];
         nc_le_put_f64(p, s->ra_rad);
         nc_le_put_f64(p + 8, s->dec_rad);
@@ -130,9 +131,9 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
     FILE *f = fopen(path, "rb");
     if (!f)
         return nc_error(-errno, "%s: %s", path, strerror(errno));
-    uint8_t h[24];
+    uint8_t h[HEADER];
     int rc = 0;
-    if (fread(h, 1, 24, f) != 24 || memcmp(h, MAGIC, 8))
+    if (fread(h, 1, HEADER, f) != HEADER || memcmp(h, MAGIC, 8))
         rc = nc_error(NC_ECONFIG, "%s: not a NavCam star index (write one with `navcam stars`)", path);
     uint64_t n = rc ? 0 : nc_le_get_u64(h + 8);
     if (rc == 0 && (n == 0 || n > 100000000))
@@ -149,11 +150,17 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
         const uint8_t *p = b + i * RECORD;
         struct nc_star *s = &c->star[i];
         *s = (struct nc_star){nc_le_get_f64(p), nc_le_get_f64(p + 8), nc_le_get_f32(p + 16), nc_le_get_f32(p + 20), nc_le_get_f32(p + 24), nc_le_get_f32(p + 28)};
-        if (!(fabs(s->dec_rad) <= M_PI / 2 && isfinite(s->ra_rad) && isfinite(s->v_mag) && isfinite(s->b_v) &&
-              isfinite(s->pm_ra_mas_yr) && isfinite(s->pm_dec_mas_yr)) ||
-            (i && s->v_mag < c->star[i - 1].v_mag))
-            rc = nc_error(NC_ECONFIG, "%s: star %llu is not valid or not in magnitude order", path,
-                          (unsigned long long)i);
+        const char *bad = !isfinite(s->ra_rad)                ? "right ascension (rad) is not finite"
+                          : !(fabs(s->dec_rad) <= M_PI / 2)     ? "declination (rad) is not within +-pi/2"
+                          : !isfinite(s->pm_ra_mas_yr)          ? "proper motion in RA (mas/yr) is not finite"
+                          : !isfinite(s->pm_dec_mas_yr)         ? "proper motion in Dec (mas/yr) is not finite"
+                          : !isfinite(s->v_mag)                 ? "V magnitude is not finite"
+                          : !isfinite(s->b_v)                   ? "B-V is not finite"
+                          : i && s->v_mag < c->star[i - 1].v_mag ? "V magnitude is brighter than the star before"
+                                                                  : NULL;
+        if (bad)
+            rc = nc_error(NC_ECONFIG, "%s: star %llu (from 0; byte %llu): %s (the stars are brightest first)", path,
+                          (unsigned long long)i, (unsigned long long)(HEADER + i * RECORD), bad);
     }
     free(b);
     c->n = (size_t)n;

@@ -128,26 +128,35 @@ int main(void)
           "index round trip: %s", nc_errmsg());
     CHECK(nc_star_cat_count_to(&d, 0.0) == 1 && nc_star_cat_count_to(&d, 9) == 3, "prefix to a magnitude");
     nc_star_cat_free(&d);
-    { /* an index whose header epoch is no epoch (every star vanished), or with bytes past its stars */
+    { /* an index whose header epoch is no epoch (every star vanished), with bytes past its stars, with a
+       * star's Dec beyond the pole, or out of magnitude order: each named */
         size_t len = 0;
         char *bytes = nc_test_read(ix, &len);
-        const double nan_epoch = NAN;
-        const char *bad = nc_test_path("bad.ncs");
-        for (int k = 0; bytes && k < 2; k++) {
-            FILE *f = fopen(bad, "wb");
-            if (!f)
+        const char *bad = nc_test_path("bad.ncs"),
+                   *want[] = {"epoch Jnan is not a catalogue epoch", "bytes after the 3 stars",
+                              "star 1 (from 0; byte 56): declination (rad) is not within +-pi/2",
+                              "star 2 (from 0; byte 88): V magnitude is brighter than the star before"};
+        for (int k = 0; bytes && k < 4; k++) {
+            char *b = malloc(len);
+            FILE *f = b ? fopen(bad, "wb") : NULL;
+            if (!f) {
+                free(b);
                 break;
+            }
+            memcpy(b, bytes, len);
             if (k == 0)
-                memcpy(bytes + 16, &nan_epoch, 8); /* the header's epoch (little-endian f64 at byte 16) */
-            fwrite(bytes, 1, len, f);
+                memcpy(b + 16, &(double){NAN}, 8); /* the header's epoch (little-endian f64 at byte 16) */
+            if (k == 2)
+                memcpy(b + 24 + 32 + 8, &(double){2.0}, 8); /* star 1's Dec, rad */
+            if (k == 3)
+                memcpy(b + 24 + 2 * 32 + 24, &(float){-2.0f}, 4); /* star 2's V */
+            fwrite(b, 1, len, f);
             if (k == 1)
                 fputc(0, f);
             fclose(f);
-            CHECK(nc_star_cat_load(bad, &d) < 0 &&
-                      nc_test_contains(nc_errmsg(), k ? "bytes after the 3 stars" : "epoch Jnan is not a catalogue epoch"),
-                  "a damaged index (%d): %s", k, nc_errmsg());
-            if (k == 0)
-                memcpy(bytes + 16, &(double){2000}, 8);
+            free(b);
+            CHECK(nc_star_cat_load(bad, &d) < 0 && nc_test_contains(nc_errmsg(), want[k]), "a damaged index (%d): %s",
+                  k, nc_errmsg());
         }
         free(bytes);
     }

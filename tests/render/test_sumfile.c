@@ -314,6 +314,8 @@ int main(void)
     expect_error(bad, NULL, 0, "bad.SUM:5: SCOBJ: '0.2000X00000D+01' is not a number");
     replaced(bad, sizeof bad, good, "  SZ\n", "  SZ\n 0.6 0.8 0  SZ\n");
     expect_error(bad, NULL, 0, "bad.SUM:10: SZ: given twice (lines 9 and 10)");
+    replaced(bad, sizeof bad, good, "  K-MATRIX\n", "  K-MATRIX  DISTORTION\n"); /* was read as K-MATRIX */
+    expect_error(bad, NULL, 0, "bad.SUM:10: the line is labelled both K-MATRIX and DISTORTION: one label a line");
     /* The ranges the configuration's camera keys take (a K11 of 1e-30 gave an empty frame) */
     replaced(bad, sizeof bad, good, " 117.64700   0.00000   0.00000   0.00000 117.64700",
              " 1.0D-30   0.00000   0.00000   0.00000 117.64700");
