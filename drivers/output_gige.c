@@ -11,7 +11,8 @@
  * - submit() packs each finished frame as the stream carries it (ROI and
  *   pixel format as the registers say, the optional metadata row) into one
  *   of three buffers, and the sender thread sends it at once (gige/gvsp.c),
- *   the exposure start as GVSP timestamp. A frame whose exposure started
+ *   the exposure start as GVSP timestamp (the device's counter: CLOCK_MONOTONIC
+ *   ns since a client's GevTimestampControlReset, gige_regs.h). A frame whose exposure started
  *   before the client's AcquisitionStart is never sent; a newer frame
  *   replaces one not yet sent.
  * - NavCam's poll thread reads what clients wrote (ExposureTime, Gain,
@@ -72,6 +73,7 @@ struct gige {
     unsigned long sent, skipped, not_acquiring, before_start, send_failed;
     struct nc__gvsp gvsp;
     atomic_llong acq_start_ns; /* CLOCK_MONOTONIC of AcquisitionStart (settings applied); 0: stopped */
+    struct nc__gige_clock clock; /* the GVSP timestamps' counter */
     atomic_int channel_closed;    /* GevSCPHostPort read 0 since the last frame sent */
     struct sockaddr_in last_dest; /* of the last frame sent: a new one opens a channel, block ids from 1 */
     /* the poll and sender threads */
@@ -144,6 +146,7 @@ static void *poll_thread(void *arg)
         if ((nc__gige_reg(g->fc, REG_HOST_PORT) & 0xffff) == 0)
             atomic_store(&g->channel_closed, 1);
         int64_t now = nc_mono_ns();
+        nc__gige_clock_poll(g->fc, &g->clock, now);
         if (controlled && g->probe_fd >= 0 && now >= next_probe_ns) {
             nc__gige_probe(g->probe_fd);
             next_probe_ns = now + 250000000;
@@ -190,8 +193,9 @@ static int layout(struct gige *g, const struct nc_frame_record *r)
     atomic_store(&g->packed[k], 0);
     g->im[k] = (struct nc__gvsp_image){.pixel_format = pf, .width = w, .height = h, .offset_x = (uint32_t)ox,
                                        .offset_y = (uint32_t)oy, .data = g->buf[k], .size = (size_t)w * h * bpp,
-                                       /* the GVSP timestamp: the exposure's start on CLOCK_MONOTONIC, ns */
-                                       .timestamp_ns = (uint64_t)r->exposure_start_mono_ns, .ready = &g->packed[k]};
+                                       /* the GVSP timestamp: the exposure's start on the device's counter */
+                                       .timestamp_ns = nc__gige_clock_at(&g->clock, r->exposure_start_mono_ns),
+                                       .ready = &g->packed[k]};
     g->rec[k] = *r;
     g->rec[k].dn = NULL;
     return 0;

@@ -2,6 +2,7 @@
 #include "drivers/gige/gige_regs.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -40,6 +41,26 @@ void nc__gige_reg_set_string(ArvFakeCamera *fc, uint32_t a, size_t len, const ch
     char buf[64] = {0};
     snprintf(buf, sizeof buf < len ? sizeof buf : len, "%s", s);
     arv_fake_camera_write_memory(fc, a, (guint32)len, buf);
+}
+
+void nc__gige_clock_poll(ArvFakeCamera *fc, struct nc__gige_clock *c, int64_t now_ns)
+{
+    const uint32_t control = nc__gige_reg(fc, REG_TIMESTAMP_CONTROL);
+    if (control) {
+        nc__gige_reg_set(fc, REG_TIMESTAMP_CONTROL, 0);
+        if (control & 1) { /* the one before first: a reader that sees the new origin sees it too */
+            atomic_store(&c->before_ns, atomic_load(&c->origin_ns));
+            atomic_store(&c->origin_ns, now_ns);
+        }
+    }
+    const uint64_t be = GUINT64_TO_BE(nc__gige_clock_at(c, now_ns));
+    arv_fake_camera_write_memory(fc, REG_TIMESTAMP_VALUE, 8, &be);
+}
+
+uint64_t nc__gige_clock_at(const struct nc__gige_clock *c, int64_t mono_ns)
+{
+    const int64_t origin = atomic_load(&c->origin_ns);
+    return (uint64_t)(mono_ns - (mono_ns >= origin ? origin : atomic_load(&c->before_ns)));
 }
 
 /* The register images of a's settings. */

@@ -26,6 +26,8 @@ enum {
     REG_PACKET_SIZE = 0xd04,     /* stream channel 0: packet size in the low 16 bits */
     REG_HOST_PORT = 0xd00,       /* stream channel 0: the client's port in the low 16 bits */
     REG_HEARTBEAT = 0x938,       /* heartbeat timeout, ms */
+    REG_TIMESTAMP_CONTROL = 0x944, /* a client writes 2 (latch) or 1 (reset) */
+    REG_TIMESTAMP_VALUE = 0x948,   /* 64 bits: the device clock, ns */
     REG_VENDOR = 0x48,
     REG_MODEL = 0x68,
     REG_VERSION = 0x88,
@@ -37,6 +39,23 @@ void nc__gige_reg_set(ArvFakeCamera *fc, uint32_t a, uint32_t v);
 double nc__gige_reg_double(ArvFakeCamera *fc, uint32_t a);
 void nc__gige_reg_set_double(ArvFakeCamera *fc, uint32_t a, double d);
 void nc__gige_reg_set_string(ArvFakeCamera *fc, uint32_t a, size_t len, const char *s);
+
+/* The device's timestamp counter (GVSP timestamps, GevTimestampValue):
+ * CLOCK_MONOTONIC in ns since the last GevTimestampControlReset (since the
+ * clock's own start until one). */
+struct nc__gige_clock {
+    _Atomic int64_t origin_ns, before_ns; /* CLOCK_MONOTONIC of the last reset, and of the one before */
+};
+/* At each poll, CLOCK_MONOTONIC now_ns: a reset a client wrote to the
+ * timestamp control register taken (a latch needs nothing: see below), the
+ * register cleared, and the counter's value now written to
+ * GevTimestampValue in one 8-byte store. The device cannot see a write when
+ * it comes, so the value is the counter at the last poll, never older than
+ * one poll period. */
+void nc__gige_clock_poll(ArvFakeCamera *fc, struct nc__gige_clock *c, int64_t now_ns);
+/* The counter's value at CLOCK_MONOTONIC mono_ns (an exposure's start):
+ * before the last reset, what it was then. */
+uint64_t nc__gige_clock_at(const struct nc__gige_clock *c, int64_t mono_ns);
 
 /* The registers a client sees, from the emulator's settings a; _changed
  * writes only those whose image differs from shown (what they show now). */

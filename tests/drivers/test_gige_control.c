@@ -3,7 +3,8 @@
  * gets packets in the first second and none once its heartbeat ran out (the
  * device stops the acquisition and closes the stream channel), then a new
  * client streams and reads GevHeartbeatTimeout; in lock-step, refused
- * settings written with one that is not are undone alone; clear errors for a missing
+ * settings written with one that is not are undone alone; the timestamp
+ * counter's latch and reset; clear errors for a missing
  * interface, a taken port 3956, an invalid XML (also one named relative to
  * a configuration file in another directory), a model name too long, a
  * packet size off its step.
@@ -21,6 +22,7 @@
 #include <sys/stat.h>
 #include <sys/time.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "gige_rig.h"
@@ -149,6 +151,55 @@ static void test_lockstep_units(void)
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
 }
 
+/* The timestamp counter: CLOCK_MONOTONIC in ns, read after a latch within
+ * a poll period (1 ms; 50 ms allowed for a loaded machine) before the read
+ * and never after it; after GevTimestampControlReset it counts from 0, and
+ * the GVSP timestamps of frames exposed after the reset are on it. */
+static void test_timestamps(void)
+{
+    char dir[4096];
+    pid_t pid;
+    ArvCamera *c = begin("timestamps", "outputs=[{driver: gige}]", "serve.frame_rate_hz=20", &pid, dir, sizeof dir);
+    if (!c)
+        return;
+    ArvDevice *d = arv_camera_get_device(c);
+    struct timespec ts;
+    int64_t worst_ns = 0, late = 0;
+    for (int k = 0; k < 20; k++) {
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        const int64_t t0 = ts.tv_sec * 1000000000LL + ts.tv_nsec;
+        arv_device_execute_command(d, k % 2 ? "TimestampLatch" : "GevTimestampControlLatch", NULL);
+        const int64_t v = arv_device_get_integer_feature_value(d, k % 2 ? "TimestampLatchValue" : "GevTimestampValue",
+                                                               NULL);
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        const int64_t t1 = ts.tv_sec * 1000000000LL + ts.tv_nsec;
+        late += v > t1;
+        worst_ns = v < t0 && t0 - v > worst_ns ? t0 - v : worst_ns;
+    }
+    printf("timestamp latch: 20 reads at most %.3f ms before the latch, %lld after the read\n", worst_ns * 1e-6,
+           (long long)late);
+    CHECK(late == 0 && worst_ns < 50000000, "latched counter: %lld reads after the read, one %.3f ms before the latch",
+          (long long)late, worst_ns * 1e-6);
+    arv_device_execute_command(d, "GevTimestampControlReset", NULL);
+    usleep(100000);
+    struct stream st = {0};
+    CHECK(start(c, &st) == 0, "stream");
+    uint8_t *img = malloc((size_t)W * H * 2);
+    uint64_t frame_ts = 0;
+    const int got = img && next_frame(&st, 3, img, &frame_ts) == 0;
+    arv_device_execute_command(d, "GevTimestampControlLatch", NULL);
+    const int64_t after = arv_device_get_integer_feature_value(d, "GevTimestampValue", NULL);
+    printf("after a reset: a frame's GVSP timestamp %.3f ms, the counter %.3f ms\n", frame_ts * 1e-6, after * 1e-6);
+    CHECK(got && after >= 100000000 && after < 10000000000LL && frame_ts >= 100000000 &&
+              (int64_t)frame_ts <= after,
+          "after GevTimestampControlReset and 0.1 s: counter %lld ns, frame %llu ns (want 0.1 s <= frame <= counter "
+          "< 10 s)", (long long)after, (unsigned long long)frame_ts);
+    finish(c, &st);
+    free(img);
+    g_object_unref(c);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+}
+
 /* navcam serve with extra settings must fail (exit 1) with needle in stderr. */
 static void expect_fail(const char *name, const char *const *extra, int n, const char *needle)
 {
@@ -222,6 +273,7 @@ int main(int argc, char **argv)
         return 2;
     test_client_killed();
     test_lockstep_units();
+    test_timestamps();
     test_errors();
     return nc_test_end();
 }
