@@ -24,6 +24,7 @@ static const char replay_help[] =
     "times in seconds of simulation time, the camera pose in the scene frame\n"
     "(quaternion camera -> scene), the Sun direction in the body frame; capture 1\n"
     "(the default) asks for a frame. builtin:approach is the default scene's approach.\n"
+    "Without --lockstep, times must not decrease from row to row.\n"
     "Or SPC SUM-like rows, after the header t_s,scobj_x_km,...:\n"
     "  t_s, scobj_x_km, scobj_y_km, scobj_z_km, cx_x, cx_y, cx_z, cy_x, cy_y, cy_z,\n"
     "  cz_x, cz_y, cz_z, sz_x, sz_y, sz_z[, capture]\n"
@@ -108,6 +109,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "navcam replay: %s\n", nc_errmsg());
         return 1;
     }
+    for (int i = 1; i < n && !lockstep; i++)
+        if (rows[i].t_s < rows[i - 1].t_s) { /* serve would refuse it (time_backwards), and pacing could not keep it */
+            fprintf(stderr, "navcam replay: %s:%d: t_s %.9g s is before the row before's %.9g s (line %d): free-run "
+                            "poses go forward in simulation time (--lockstep renders each pose as it comes)\n",
+                    argv[optind], rows[i].line, rows[i].t_s, rows[i - 1].t_s, rows[i - 1].line);
+            free(rows);
+            return 1;
+        }
     struct nc_client *cl;
     if (connect_waiting(host, port ? (int)port : lockstep ? 5751 : 5750, lockstep, wait_s, &cl) < 0) {
         fprintf(stderr, "navcam replay: %s\n", nc_errmsg());

@@ -135,6 +135,10 @@ expect 2 "navcam replay: --speed expects 0..1e+06, got 'abc'" -- "$navcam" repla
 expect 2 "navcam replay: --port expects 1..65535, got '99999'" -- "$navcam" replay builtin:approach -p 99999
 expect 2 "navcam replay: --timeout-ms expects 1..86400000, got '-5'" -- "$navcam" replay builtin:approach -T -5
 expect 2 "navcam serve: --threads expects 1..1024, got '0'" -- "$navcam" serve -j 0
+# A free-run trajectory whose time goes back: refused before anything is sent (nothing listens on port 9).
+printf '0,0,-5000,0,1,0,0,0,1,0,0\n4,0,-4000,0,1,0,0,0,1,0,0\n3,0,-3000,0,1,0,0,0,1,0,0\n' > "$tmp/back.csv"
+expect 1 "back.csv:3: t_s 3 s is before the row before's 4 s (line 2): free-run poses go forward" -- \
+  "$navcam" replay "$tmp/back.csv" -p 9
 expect 2 "navcam serve: --max-frames expects 1.." -- "$navcam" serve -n 2x
 # replay --lockstep started before the server: it waits (--wait) until the
 # server listens, then streams; the README's tour runs its two lines so.
