@@ -40,6 +40,30 @@ int nc_cli_long(const char *opt, const char *s, long lo, long hi, long *out)
     return 0;
 }
 
+int nc_cli_threads(const char *s, int *out)
+{
+    long v;
+    if (nc_cli_long("threads", s, 0, 1024, &v) < 0)
+        return -1;
+    if (v == 0) {
+        const long n = sysconf(_SC_NPROCESSORS_ONLN);
+        v = n > 0 ? n : 1;
+    }
+    *out = (int)v;
+    return 0;
+}
+
+void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const char *path,
+                    const char *const *extra, int n_extra)
+{
+    snprintf(buf, len, "camera={sumfile: '%s'}", path);
+    memmove(sets + 1 + n_extra, sets, (size_t)*nsets * sizeof *sets);
+    sets[0] = buf;
+    for (int i = 0; i < n_extra; i++)
+        sets[1 + i] = extra[i];
+    *nsets += 1 + n_extra;
+}
+
 int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out)
 {
     char *end;

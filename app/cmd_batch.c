@@ -55,7 +55,12 @@ static const char batch_help[] =
     "                        --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT,\n"
     "                        write the same files as one\n"
     "      --no-geometry     skip the geometry planes and the lists\n"
-    "  -j, --threads N       render threads (default: render.threads, else all cores)\n"
+    "      --sumfile X.SUM   the camera of an SPC SUM file (size, intrinsics, mirroring;\n"
+    "                        each row gives the pose and the Sun): replaces the camera\n"
+    "                        section with {sumfile: X.SUM} and takes sun.direction out\n"
+    "                        (docs/sumfiles.md)\n"
+    "  -j, --threads N       render threads (default: render.threads, else all cores;\n"
+    "                        0: all cores)\n"
     "  -h, --help            this help\n";
 
 static void json_vec(FILE *f, const char *key, const double *v, int n, const char *sep)
@@ -334,10 +339,11 @@ int main(int argc, char **argv)
         {"format", required_argument, NULL, 'F'},  {"exposure", required_argument, NULL, 'e'},
         {"shard", required_argument, NULL, 'K'},   {"no-geometry", no_argument, NULL, 'G'},
         {"threads", required_argument, NULL, 'j'}, {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+        {"sumfile", required_argument, NULL, 'U'},  {NULL, 0, NULL, 0},
     };
     const char *dir = NULL, *scene_path = NULL, *ext = "fits";
-    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+    const char **sets = calloc((size_t)argc + 2, sizeof *sets);
+    char sumset[4200];
     int nsets = 0, threads = 0, geometry = 1, c;
     long shard_k = 0, shard_n = 1;
     double exposure = -1;
@@ -352,6 +358,9 @@ int main(int argc, char **argv)
         case 'S': scene_path = optarg; break;
         case 's': sets[nsets++] = optarg; break;
         case 'G': geometry = 0; break;
+        case 'U': /* the rows give the pose and the Sun: the file's SZ and the scene's direction are not used */
+            nc_cli_sumfile(sets, &nsets, sumset, sizeof sumset, optarg, (const char *[]){"sun.direction=null"}, 1);
+            break;
         case 'F':
             ext = optarg;
             if (strcmp(ext, "fits") && strcmp(ext, "tif") && strcmp(ext, "exr") && strcmp(ext, "png")) {
@@ -383,11 +392,8 @@ int main(int argc, char **argv)
             }
             break;
         case 'j':
-            threads = (int)strtol(optarg, &end, 10);
-            if (*end || threads < 1 || threads > 1024) {
-                fprintf(stderr, "navcam batch: --threads expects 1..1024, got '%s'\n", optarg);
+            if (nc_cli_threads(optarg, &threads) < 0)
                 goto usage;
-            }
             break;
         case 'h': fputs(batch_help, stdout); free(sets); return 0;
         default: fputs("Try 'navcam batch --help'.\n", stderr); goto usage;
@@ -439,11 +445,15 @@ int main(int argc, char **argv)
         rc = nc_image_prepare(probe);
     if (rc >= 0) /* once the configuration is known good: no empty directory left by a mistake in it */
         rc = nc_mkdirs(dir);
-    long done = 0, skipped = 0, busy = 0, mine = 0;
+    long done = 0, skipped = 0, busy = 0, mine = 0, no_capture = 0;
     double t_all = now_s();
     for (long i = 0; i < nrows && rc >= 0; i++) {
-        if (i % shard_n != shard_k || !rows[i].capture)
+        if (i % shard_n != shard_k)
             continue;
+        if (!rows[i].capture) {
+            no_capture++;
+            continue;
+        }
         mine++;
         char stem[32], path[4200];
         snprintf(stem, sizeof stem, "frame_%06ld", i);
@@ -472,10 +482,13 @@ int main(int argc, char **argv)
         done++;
     }
     double el = now_s() - t_all;
+    char off[64] = "";
+    if (no_capture)
+        snprintf(off, sizeof off, " (and %ld with capture 0, not rendered)", no_capture);
     if (rc >= 0)
-        printf("navcam batch: shard %ld/%ld: %ld of %d rows are this shard's; %ld rendered, %ld already done%s; %.1f s "
-               "(%.0f frames per hour)\n",
-               shard_k, shard_n, mine, nrows, done, skipped, busy_txt(busy), el, el > 0 ? done * 3600 / el : 0.0);
+        printf("navcam batch: shard %ld/%ld: %ld of %d rows are this shard's%s; %ld rendered, %ld already done%s; "
+               "%.1f s (%.0f frames per hour)\n",
+               shard_k, shard_n, mine, nrows, off, done, skipped, busy_txt(busy), el, el > 0 ? done * 3600 / el : 0.0);
     free(geom);
     free(rock);
     free(rows);

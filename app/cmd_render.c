@@ -53,7 +53,7 @@ static const char render_help[] =
     "                           --set render.samples_per_pixel=16\n"
     "                           --set optics.f_number=null --set optics.aperture_diameter_m=0.01\n"
     "  -j, --threads N        render threads (default: render.threads, else all\n"
-    "                         cores); the image does not depend on N\n"
+    "                         cores; 0: all cores); the image does not depend on N\n"
     "      --sumfile X.SUM    the camera and pose of an SPC SUM file: replaces the\n"
     "                         camera section with {sumfile: X.SUM}; the Sun's direction\n"
     "                         comes from it too, give its distance with\n"
@@ -96,10 +96,7 @@ int main(int argc, char **argv)
         case 'o': out = optarg; break;
         case 'R': rows = optarg; break;
         case 'S': /* first, so that --set camera.X=... can still add to it */
-            snprintf(sumset, sizeof sumset, "camera={sumfile: '%s'}", optarg);
-            memmove(sets + 1, sets, (size_t)nsets * sizeof *sets);
-            sets[0] = sumset;
-            nsets++;
+            nc_cli_sumfile(sets, &nsets, sumset, sizeof sumset, optarg, NULL, 0);
             break;
         case 'e':
         case 'f': {
@@ -118,17 +115,12 @@ int main(int argc, char **argv)
             break;
         }
         case 's': sets[nsets++] = optarg; break;
-        case 'j': {
-            char *end;
-            long v = strtol(optarg, &end, 10);
-            if (*end || v < 1 || v > 1024) {
-                fprintf(stderr, "navcam render: --threads expects 1..1024, got '%s'\n", optarg);
+        case 'j':
+            if (nc_cli_threads(optarg, &threads) < 0) {
                 free(sets);
                 return 2;
             }
-            threads = (int)v;
             break;
-        }
         case 'q':
             if (nc_quantity_parse(optarg, &q) < 0) {
                 free(sets);

@@ -33,7 +33,8 @@ static const char serve_help[] =
     "                          20 ms: a fast camera passes N by a few)\n"
     "  -t, --max-seconds S     stop after S seconds\n"
     "      --stats-json FILE   also write the summary to FILE\n"
-    "  -j, --threads N         render threads\n"
+    "  -j, --threads N         render threads (default: render.threads, else all\n"
+    "                          cores; 0: all cores)\n"
     "      --driver-docs       print the drivers' options as Markdown (docs/drivers.md) and exit\n"
     "  -h, --help              this help\n"
     "\n"
@@ -102,7 +103,7 @@ int main(int argc, char **argv)
     const char **sets = calloc((size_t)argc + 1, sizeof *sets);
     struct nc_serve_options o = {0};
     int c, bad = 0;
-    long threads = 0;
+    int threads = 0;
     if (!sets)
         return 1;
     optind = 1;
@@ -112,13 +113,13 @@ int main(int argc, char **argv)
         case 'n': bad = nc_cli_long("max-frames", optarg, 1, LONG_MAX, &o.max_frames); break;
         case 't': bad = nc_cli_double("max-seconds", optarg, 1e-3, 1e9, &o.max_seconds); break;
         case 'J': o.stats_json_path = optarg; break;
-        case 'j': bad = nc_cli_long("threads", optarg, 1, 1024, &threads); break;
+        case 'j': bad = nc_cli_threads(optarg, &threads); break;
         case 'h': serve_usage(); free(sets); return 0;
         case 'D': driver_docs(); free(sets); return 0;
         default: bad = 1; break;
         }
     }
-    o.threads = (int)threads;
+    o.threads = threads;
     if (bad) {
         fputs("Try 'navcam serve --help'.\n", stderr);
         free(sets);

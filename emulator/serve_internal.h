@@ -209,11 +209,13 @@ void *nc__serve_output_thread(void *arg);
 
 /* serve_stats.c */
 /* The median time the last 16 frames kept the camera busy (busy_ms), ms
- * (0: none yet). */
+ * (0: none yet); nc__serve_busy_ms with slowest the longest of them. */
 double nc__serve_render_estimate_ms(struct nc__emu *e);
+double nc__serve_busy_ms(struct nc__emu *e, int slowest);
 /* The frame rate the camera can deliver now: the requested rate (free-run),
- * capped by 1 / nc__serve_render_estimate_ms (0: not known yet, in trigger
- * and lock-step modes before a frame). */
+ * capped by 1 / the longest busy time of the last 16 frames, so that it
+ * keeps up with each of them (0: not known yet, in trigger and lock-step
+ * modes before a frame). */
 double nc__serve_resulting_rate_hz(struct nc__emu *e);
 void nc__serve_stats_line(struct nc__emu *e, double elapsed_s);
 void nc__serve_stats_json(struct nc__emu *e, double elapsed_s, FILE *f);

@@ -49,7 +49,9 @@ static struct percentiles percentiles(struct nc__emu *e)
     return p;
 }
 
-double nc__serve_render_estimate_ms(struct nc__emu *e)
+double nc__serve_render_estimate_ms(struct nc__emu *e) { return nc__serve_busy_ms(e, 0); }
+
+double nc__serve_busy_ms(struct nc__emu *e, int slowest)
 {
     double r[16];
     pthread_mutex_lock(&e->stat_lock);
@@ -60,7 +62,7 @@ double nc__serve_render_estimate_ms(struct nc__emu *e)
     if (n == 0)
         return 0.0;
     qsort(r, n, sizeof *r, cmpd);
-    return r[n / 2];
+    return r[slowest ? n - 1 : n / 2];
 }
 
 double nc__serve_resulting_rate_hz(struct nc__emu *e)
@@ -68,7 +70,7 @@ double nc__serve_resulting_rate_hz(struct nc__emu *e)
     struct nc_acquisition a;
     nc__serve_acq_get(e, &a);
     double want = a.triggered || e->mode == NC__MODE_LOCKSTEP ? INFINITY : a.frame_rate_hz;
-    double r = nc__serve_render_estimate_ms(e), can = r > 0 ? 1000.0 / r : INFINITY;
+    double r = nc__serve_busy_ms(e, 1), can = r > 0 ? 1000.0 / r : INFINITY;
     double got = fmin(want, can);
     return isfinite(got) ? got : 0.0;
 }

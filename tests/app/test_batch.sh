@@ -113,6 +113,19 @@ import json; d = json.load(open('sumcmp.json'))
 assert d['relative_error']['p95'] < 0.02 and d['limb_iou'] > 0.99, d
 print('SUM-like rows: p95 %.4f, IoU %.4f' % (d['relative_error']['p95'], d['limb_iou']))" || fail "SUM-like rows differ"
 
+# --sumfile: the SUM file's camera (size, intrinsics), each row's pose and Sun.
+printf 'EX1\n2020 JAN 15 12:00:00.000\n    96    64    10 65535   NPX, NLN, THRSH\n    0.1D+03    0.475D+02    0.315D+02  MMFL, CTR\n   -4.0    2.0   -1.0  SCOBJ\n    0.4472135955    0.8944271910    0.0  CX\n    0.1951800146   -0.09759000729   -0.9759000729  CY\n   -0.8728715609    0.4364357805   -0.2182178902  CZ\n    0.7990018711    0.5992514033    0.04993761694  SZ\n  20.0   0.0   0.0   0.0  20.0   0.0  K-MATRIX\nEND FILE\n' > cam.SUM
+head -2 traj.csv > one.csv
+"$navcam" batch one.csv -o sumcam --sumfile cam.SUM --no-geometry --set render.samples_per_pixel=1 > /dev/null 2>&1 ||
+  fail "--sumfile"
+python3 -c "
+import json; d = json.load(open('sumcam/frame_000000.json')); c = d['camera']; r = open('one.csv').read().split('\n')[1].split(',')
+assert (c['width_px'], c['height_px'], c['fx_fy_cx_cy_px']) == (96, 64, [2000, 2000, 46.5, 30.5]), c
+assert max(abs(a - float(b)) for a, b in zip(c['position_m'], r[1:4])) < 1e-6, (c, r)
+s = [float(v) for v in r[8:11]]; n = sum(v * v for v in s) ** 0.5
+assert max(abs(a - b / n) for a, b in zip(d['sun']['direction_body0'], s)) < 1e-9, d['sun']
+print('--sumfile: 96x64, fx 2000 px, the row pose')" || fail "--sumfile: not the SUM file's camera with the row's pose"
+
 # SUM-like rows are in bodies[0]'s frame: with the body moved and turned,
 # the camera moves with it and sees the same frame.
 "$navcam" batch traj_sum.csv -o sum_moved "${scene[@]}" --no-geometry --set 'bodies.0.position_m=[300,-200,100]' \

@@ -134,7 +134,7 @@ expect 0 "navcam stars info INDEX" -- "$navcam" stars info --help
 expect 2 "navcam replay: --speed expects 0..1e+06, got 'abc'" -- "$navcam" replay builtin:approach --speed abc
 expect 2 "navcam replay: --port expects 1..65535, got '99999'" -- "$navcam" replay builtin:approach -p 99999
 expect 2 "navcam replay: --timeout-ms expects 1..86400000, got '-5'" -- "$navcam" replay builtin:approach -T -5
-expect 2 "navcam serve: --threads expects 1..1024, got '0'" -- "$navcam" serve -j 0
+expect 2 "navcam serve: --threads expects 0..1024, got '-1'" -- "$navcam" serve -j -1
 # A free-run trajectory whose time goes back: refused before anything is sent (nothing listens on port 9).
 printf '0,0,-5000,0,1,0,0,0,1,0,0\n4,0,-4000,0,1,0,0,0,1,0,0\n3,0,-3000,0,1,0,0,0,1,0,0\n' > "$tmp/back.csv"
 expect 1 "back.csv:3: t_s 3 s is before the row before's 4 s (line 2): free-run poses go forward" -- \
@@ -159,7 +159,8 @@ expect 1 "--set serve.bind=localhost: serve.bind: 'localhost' is not an IPv4 add
   "$navcam" serve --set serve.bind=localhost --max-frames 1
 expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" batch builtin:approach -o "$tmp/rocks" -q rock_id -F png
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
-expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 0
+expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 1025
+expect 0 "$(nproc) threads" -- "$navcam" render "${small[@]}" -o "$tmp/j0.exr" --threads 0 --set render.threads=1
 expect 0 "bodies:" -- "$navcam" scene
 
 # The built-in default scene with no config at all.
