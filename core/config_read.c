@@ -304,10 +304,22 @@ static int missing(const struct nc_cfg_node *parent, const char *key, const char
 
 int nc_cfg_missing(const struct nc_cfg_node *parent, const char *key, const char *expected)
 {
-    char msg[512];
+    char msg[1024];
     size_t score;
     snprintf(msg, sizeof msg, "missing required key (expected %s)", expected);
-    return missing(parent, key, msg, typo_of(parent, key, &score), key);
+    const struct nc_cfg_node *typo = typo_of(parent, key, &score), *up = parent ? parent->parent : NULL;
+    for (size_t i = 0; !typo && key && up && up->kind == NC_CFG_MAP && i < up->nchild; i++)
+        if (up->child[i]->key && !strcmp(up->child[i]->key, key)) { /* the key one level too high */
+            char where[256], here[256], at[32] = "";
+            nc_cfg_path(up, where, sizeof where);
+            nc_cfg_path(parent, here, sizeof here);
+            if (up->child[i]->line > 0)
+                snprintf(at, sizeof at, " (line %d)", up->child[i]->line);
+            const size_t n = strlen(msg);
+            snprintf(msg + n, sizeof msg - n, "; '%s'%s is given in %s instead: move it into %s", key, at,
+                     where[0] ? where : "the top level", here);
+        }
+    return missing(parent, key, msg, typo, key);
 }
 
 int nc_cfg_missing_any(const struct nc_cfg_node *map, const char *const *keys, const char *msg)

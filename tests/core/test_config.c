@@ -88,6 +88,11 @@ int main(void)
         expect_error("albedo map read after every body's keys", NULL, NULL, sets, 2, "bodies[1].zz: unknown key",
                      NULL);
     }
+    { /* a required key one level too high: named where it is */
+        const char *sets[] = {"bodies.1={shape: {type: sphere}, radius_m: 200, material: {model: lambert, A: 0.1}}"};
+        expect_error("required key one level up", NULL, NULL, sets, 1, "bodies[1].shape.radius_m: missing required key",
+                     "'radius_m' is given in bodies[1] instead: move it into bodies[1].shape");
+    }
     expect_error("missing key, cut short", "  width_px: 64\n", "  wid: 64\n", NULL, 0,
                  "camera.width_px: missing required key", "'wid' (line 7) is not a key here: a misspelling");
     { /* the key cut short, not a valid key one edit further away */
