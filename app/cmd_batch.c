@@ -326,6 +326,10 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
     if ((rc = truth(dir, stem, ext, geometry, i, row, &s, q, exposure, info.quality, nrocks, ncraters)) < 0)
         return rc;
     printf("%s (row %ld, t = %.6g s): %.0f ms\n", stem, i, row->t_s, 1e3 * (now_s() - t0));
+    if (info.sun_warning[0])
+        printf("  WARNING: row %ld (line %d): %s\n", i, row->line, info.sun_warning);
+    if (info.inside_warning[0])
+        printf("  WARNING: row %ld (line %d): %s (columns in the wrong order?)\n", i, row->line, info.inside_warning);
     fflush(stdout);
     return 0;
 }

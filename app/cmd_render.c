@@ -208,6 +208,8 @@ int main(int argc, char **argv)
             printf("  render.quality auto: %s; the pilots took %.1f ms\n", chosen, info.quality_ms);
         if (sunwarn[0])
             printf("  WARNING: %s (its centre %.2f deg off axis)\n", sunwarn, sv.off_axis_deg);
+        if (info.inside_warning[0])
+            printf("  WARNING: %s\n", info.inside_warning);
         if (sky.on)
             printf("  stars: to V %.2f, %ld in the frame, %ld hidden by bodies (%.1f ms)\n", sst.limit_mag, sst.drawn,
                    sst.hidden, info.stars_ms);

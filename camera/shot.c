@@ -152,8 +152,16 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
             info->quality_ms = qc.pilot_ms;
         }
     }
+    struct nc_rt_stats st0, st1;
+    nc_rt_get_stats(r->rt, &st0);
     if (rc >= 0)
         rc = nc_render_exposure(r, &drawn, &ex, &f, &info->time_samples);
+    nc_rt_get_stats(r->rt, &st1);
+    const unsigned long hits = st1.camera_hits - st0.camera_hits, back = st1.camera_back_hits - st0.camera_back_hits;
+    if (rc >= 0 && back > hits / 2)
+        snprintf(info->inside_warning, sizeof info->inside_warning,
+                 "%lu of the %lu camera-ray samples that met a surface met its back, inner side: is the camera "
+                 "inside a body?", back, hits);
     /* Stars (the `stars` section), drawn before the camera model's PSF. */
     char starinfo[120] = "";
     double ts0 = now_ms();

@@ -408,7 +408,7 @@ static void eval_lanes(const struct job *j, const int *body, const struct nc_pho
 
 /* Counters a tile adds up before it reports them (nc_rt_count_shadow_rays). */
 struct tile_counts {
-    unsigned long shadow_culled, shadow_traced;
+    unsigned long shadow_culled, shadow_traced, hits, back_hits;
 };
 
 /* Shadow rays' lanes that meet nothing: culled (proven) or traced. */
@@ -895,7 +895,7 @@ static void shade_tile(struct job *j, int tile)
     struct nc_hit16 hit[SLOT_GROUP];
     struct surf sf;
     memset(&sf, 0, sizeof sf); /* hard_lanes reads every lane, hit or not */
-    struct tile_counts cnt = {0, 0};
+    struct tile_counts cnt = {0, 0, 0, 0};
     double r[NC_PACKET];
 
     for (int slot0 = 0; slot0 < slots; slot0 += SLOT_GROUP) {
@@ -971,6 +971,8 @@ static void shade_tile(struct job *j, int tile)
                         acc_range[k] += sf.t[i];
                         hits[k]++;
                         any++;
+                        cnt.hits++;
+                        cnt.back_hits += !sf.outside[i];
                     }
                     if (!any)
                         continue;
@@ -1003,6 +1005,7 @@ static void shade_tile(struct job *j, int tile)
             }
     }
     nc_rt_count_shadow_rays(j->rt, cnt.shadow_culled, cnt.shadow_traced);
+    nc_rt_count_camera_hits(j->rt, cnt.hits, cnt.back_hits);
     const double inv = 1.0 / slots;
     for (int y = y0; y < y0 + TILE && y < H; y++)
         for (int x = x0; x < x0 + TILE && x < W; x++) {

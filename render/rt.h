@@ -54,6 +54,9 @@ struct nc_rt_stats {
     /* Since creation, as the renderer reports them (nc_rt_count_shadow_rays):
      * shadow rays proven unoccluded (nc_rt_shadow_cull16), and traced. */
     unsigned long shadow_rays_culled, shadow_rays_traced;
+    /* ... and camera-ray samples that met a surface, and those of them that
+     * met its back, inner side (a camera inside a body sees little else). */
+    unsigned long camera_hits, camera_back_hits;
 };
 
 int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out);
@@ -123,6 +126,7 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from,
 /* Add to the shadow-ray counts of nc_rt_get_stats (callers add a tile's
  * worth at a time: the counters are shared by every render thread). */
 void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced);
+void nc_rt_count_camera_hits(struct nc_rt *rt, unsigned long hits, unsigned long back_hits);
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
 /* The largest error bound of the levels of detail shown at the last update,
  * metres (0: every body at full resolution). */

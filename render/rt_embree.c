@@ -88,7 +88,7 @@ struct nc_rt {
     const struct nc__rt_rock_tile **inst_tile;
     unsigned ninst, inst_cap;
     struct nc_rt_stats stats;
-    atomic_ulong shadow_culled, shadow_traced;
+    atomic_ulong shadow_culled, shadow_traced, camera_hits, camera_back_hits;
     struct nc__bins bins; /* camera rays of this pass through bins (nc_rt_bin_camera) */
     /* ... and through the rocks' bins in front of the mesh hits (when
      * rock_binned; else through the rocks' trees) */
@@ -1069,11 +1069,19 @@ void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned lo
     atomic_fetch_add_explicit(&rt->shadow_traced, traced, memory_order_relaxed);
 }
 
+void nc_rt_count_camera_hits(struct nc_rt *rt, unsigned long hits, unsigned long back_hits)
+{
+    atomic_fetch_add_explicit(&rt->camera_hits, hits, memory_order_relaxed);
+    atomic_fetch_add_explicit(&rt->camera_back_hits, back_hits, memory_order_relaxed);
+}
+
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st)
 {
     *st = rt->stats;
     st->shadow_rays_culled = atomic_load(&rt->shadow_culled);
     st->shadow_rays_traced = atomic_load(&rt->shadow_traced);
+    st->camera_hits = atomic_load(&rt->camera_hits);
+    st->camera_back_hits = atomic_load(&rt->camera_back_hits);
 }
 
 double nc_rt_lod_error_m(const struct nc_rt *rt)

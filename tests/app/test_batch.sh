@@ -116,6 +116,12 @@ print('SUM-like rows: p95 %.4f, IoU %.4f' % (d['relative_error']['p95'], d['limb
 # --sumfile: the SUM file's camera (size, intrinsics), each row's pose and Sun.
 printf 'EX1\n2020 JAN 15 12:00:00.000\n    96    64    10 65535   NPX, NLN, THRSH\n    0.1D+03    0.475D+02    0.315D+02  MMFL, CTR\n   -4.0    2.0   -1.0  SCOBJ\n    0.4472135955    0.8944271910    0.0  CX\n    0.1951800146   -0.09759000729   -0.9759000729  CY\n   -0.8728715609    0.4364357805   -0.2182178902  CZ\n    0.7990018711    0.5992514033    0.04993761694  SZ\n  20.0   0.0   0.0   0.0  20.0   0.0  K-MATRIX\nEND FILE\n' > cam.SUM
 head -2 traj.csv > one.csv
+# a camera inside the body (the pose's columns in the wrong order, say): the row is warned of
+printf '0,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n' > inside.csv
+"$navcam" batch inside.csv -o inside --no-geometry --set camera.width_px=32 --set camera.height_px=32 > inside.txt 2>&1 ||
+  fail "batch inside.csv"
+grep -q "WARNING: row 0 (line 1): .* met its back, inner side: is the camera inside a body?" inside.txt ||
+  fail "a camera inside the body was not warned of: $(cat inside.txt)"
 "$navcam" batch one.csv -o sumcam --sumfile cam.SUM --no-geometry --set render.samples_per_pixel=1 > /dev/null 2>&1 ||
   fail "--sumfile"
 python3 -c "
