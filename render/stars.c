@@ -422,6 +422,14 @@ void nc_sun_view_warning(const struct nc_sun_view *v, char *buf, size_t len)
 
 /* ---- bodies smaller than a pixel ---------------------------------------------- */
 
+/* The zoom camera's farthest distance from a body, in its bounding radii:
+ * the sphere then spans 2e-4 rad, a zoom pixel some 140 steps of a float
+ * ray's direction. Seen from nearer, a body gives more light than the
+ * inverse square of its distance says (a Lambert sphere at zero phase: 1 +
+ * 0.75 R / distance, the camera's view of its near side), so nearer would
+ * err more: here by up to 7.5e-5. */
+#define ZOOM_NEAR 1e4
+
 int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, struct nc_point_source *p)
 {
     const struct nc_camera *c = &s->camera;
@@ -434,13 +442,33 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
         if (!(d > R) || 2 * asin(R / d) * fmax(c->fx_px, c->fy_px) >= 1.0)
             continue;
         enum { Z = 32 };
-        struct nc_scene z = *s; /* shallow: shares meshes and materials */
-        const double F = 12.0 / tan(asin(R / d)); /* the bounding sphere 24 px across */
-        z.camera = (struct nc_camera){.width_px = Z, .height_px = Z, .fx_px = F, .fy_px = F, .cx_px = 0.5 * (Z - 1),
-                                      .cy_px = 0.5 * (Z - 1), .position_m = c->position_m};
         const struct nc_vec3 dir = nc_v3_scale(rel, 1 / d);
+        /* Seen from its own distance the body can span less than the float
+         * rays' directions resolve (6e-8 rad): the zoom's camera stands on
+         * the same line of sight, at most ZOOM_NEAR radii from the body (its
+         * phase the same); what lies between it and the camera is one
+         * occlusion ray, and the light scales with the distances squared. */
+        const double dz = fmin(d, ZOOM_NEAR * R), gap = d - dz;
+        const struct nc_vec3 at = nc_v3_sub(s->body[b].position_m, nc_v3_scale(dir, dz));
+        int hidden = 0;
+        if (gap > 0) {
+            int rc = nc_rt_update(r->rt, s), occ[NC_PACKET] = {0};
+            if (rc < 0)
+                return rc;
+            struct nc_ray16 ray;
+            memset(&ray, 0, sizeof ray);
+            ray.dx[0] = (float)dir.x, ray.dy[0] = (float)dir.y, ray.dz[0] = (float)dir.z;
+            ray.tfar[0] = (float)gap;
+            ray.valid[0] = -1;
+            nc_rt_occluded16(r->rt, &ray, occ);
+            hidden = occ[0];
+        }
+        struct nc_scene z = *s; /* shallow: shares meshes and materials */
+        const double F = 12.0 / tan(asin(R / dz)); /* the bounding sphere 24 px across */
+        z.camera = (struct nc_camera){.width_px = Z, .height_px = Z, .fx_px = F, .fy_px = F, .cx_px = 0.5 * (Z - 1),
+                                      .cy_px = 0.5 * (Z - 1), .position_m = at};
         const struct nc_vec3 up = fabs(dir.z) < 0.9 ? nc_v3(0, 0, 1) : nc_v3(1, 0, 0);
-        nc_quat_look_at(c->position_m, s->body[b].position_m, up, &z.camera.attitude_q);
+        nc_quat_look_at(at, s->body[b].position_m, up, &z.camera.attitude_q);
         z.render.samples_per_pixel = 16;
         z.render.quality_auto = 0;
         struct nc_frame zf;
@@ -461,7 +489,9 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
                 m = nc_v3_add(m, nc_v3_scale(nc_quat_rotate(z.camera.attitude_q, nc_v3_unit(q)), w));
             }
         nc_frame_free(&zf);
-        p[n++] = (struct nc_point_source){e > 0 ? nc_v3_unit(m) : dir, e};
+        /* the centroid's offset from the line of sight, m, seen from the camera */
+        const struct nc_vec3 off = e > 0 ? nc_v3_scale(nc_v3_sub(nc_v3_unit(m), dir), dz) : nc_v3(0, 0, 0);
+        p[n++] = (struct nc_point_source){nc_v3_unit(nc_v3_add(rel, off)), hidden ? 0 : e * (dz / d) * (dz / d)};
         point[b] = 1;
     }
     memcpy(r->as_point, point, sizeof point);

@@ -72,6 +72,20 @@ int main(void)
     shoot(front, 2, &sum, &cx, &cy);
     printf("behind a black sphere: %.3g of the flux\n", sum / want);
     CHECK(sum < 1e-9 * want, "a body in front hides it: %.3g", sum / want);
+    /* Far: a 250 m sphere 3e10 m and 1e12 m away spans less than the float
+     * rays' directions resolve from there (8e-9 and 2.5e-10 rad; it came out
+     * 1.2 times too bright or black): its zoom is rendered from 1e4 radii. */
+    for (int k = 0; k < 4; k++) {
+        const double Dk = k < 2 ? 3e10 : 1e12, phi = k % 2 ? 1 / M_PI : 1; /* Lambert's phase function at 0, 90 deg */
+        char pos[64];
+        snprintf(pos, sizeof pos, "bodies.0.position_m=[0, 0, %g]", Dk);
+        const char *far[] = {"bodies.0.shape={type: sphere, radius_m: 250}", pos,
+                             k % 2 ? "sun.direction=[0, 1, 0]" : "sun.direction=[0, 0, -1]"};
+        shoot(far, 3, &sum, &cx, &cy);
+        const double w = 2.0 / 3.0 * 1361 * pow(250 / Dk, 2) * phi * 1e6;
+        printf("a 250 m sphere %g m away at %d deg phase: %.6f of p J (R/D)^2 Phi\n", Dk, k % 2 ? 90 : 0, sum / w);
+        CHECK(fabs(sum / w - 1) < 0.002, "%g m, phase %d deg: %.6f", Dk, k % 2 ? 90 : 0, sum / w);
+    }
     /* Resolved (4 px across): rendered as before, by rays. */
     const char *big[] = {"bodies.0.shape={type: sphere, radius_m: 20}", "render.samples_per_pixel=64"};
     shoot(big, 2, &sum, &cx, &cy);
