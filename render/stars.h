@@ -76,6 +76,11 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
  * sub-pixel body is hit by few samples or none: as a point its light is
  * all there, where it is. */
 int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, struct nc_point_source *p);
+/* A body a pixel or more across whose bounding sphere's angular radius is
+ * under this (a narrow-angle camera of fx over 5e5 px far from a small
+ * body) is an error there: float rays step by 6e-8 rad, so its limb would
+ * be traced to tens of percent of its radius. */
+#define NC_RESOLVED_MIN_RAD 1e-6
 
 /* Where the Sun is for the camera, and what of it the frame shows. "Near"
  * the field: within NC_SUN_NEAR_DEG of its edge (stray light in a real

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/error.h"
 #include "render/stars.h"
 #include "testutil.h"
 
@@ -85,6 +86,23 @@ int main(void)
         const double w = 2.0 / 3.0 * 1361 * pow(250 / Dk, 2) * phi * 1e6;
         printf("a 250 m sphere %g m away at %d deg phase: %.6f of p J (R/D)^2 Phi\n", Dk, k % 2 ? 90 : 0, sum / w);
         CHECK(fabs(sum / w - 1) < 0.002, "%g m, phase %d deg: %.6f", Dk, k % 2 ? 90 : 0, sum / w);
+    }
+    { /* a narrow-angle camera (fx 3e8 px) making the far body 6 px across: refused, not traced wrong */
+        const char *narrow[] = {"bodies.0.shape={type: sphere, radius_m: 1000}", "bodies.0.position_m=[0, 0, 1e11]",
+                                "camera.fx_px=3e8", "camera.fy_px=3e8"};
+        struct nc_scene sn;
+        nc_test_scene(yaml, narrow, 4, &sn);
+        struct nc_renderer r;
+        struct nc_frame f;
+        struct nc_exposure ex = {.exposure_s = 0.01};
+        nc_renderer_init(&r, &sn, 2);
+        nc_frame_alloc(&f, 64, 48);
+        CHECK(nc_render_exposure(&r, &sn, &ex, &f, NULL) < 0 &&
+                  nc_test_contains(nc_errmsg(), "body 'moon' is 6 px across but its bounding sphere spans only 1e-08 rad"),
+              "a resolved body under 1e-6 rad: %s", nc_errmsg());
+        nc_frame_free(&f);
+        nc_renderer_free(&r);
+        nc_scene_free(&sn);
     }
     /* Resolved (4 px across): rendered as before, by rays. */
     const char *big[] = {"bodies.0.shape={type: sphere, radius_m: 20}", "render.samples_per_pixel=64"};
