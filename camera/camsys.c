@@ -13,6 +13,11 @@
 #include "camera/rng.h"
 #include "render/vmath.h"
 
+/* The most charge a pixel is given before noise and the full well, e-:
+ * beyond any full well (1e9), and far below a float's range, so that
+ * sqrt(charge) times a normal stays finite. */
+#define CHARGE_MAX_E 1e30f
+
 double nc_camsys_dn_per_e(const struct nc_camsys *cs)
 {
     return exp10(cs->sensor.analog_gain_db / 20.0) / cs->sensor.gain_e_per_dn;
@@ -219,7 +224,8 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
          * low-count pixels in one batch. */
         const float t = (float)exposure_s;
         for (int x = 0; x < W; x++) {
-            lam[x] = electrons[o + x] * cs->prnu_map[o + x] + cs->dark_map[o + x] * t;
+            const float c = electrons[o + x] * cs->prnu_map[o + x] + cs->dark_map[o + x] * t;
+            lam[x] = c < CHARGE_MAX_E ? c : CHARGE_MAX_E; /* a charge beyond any well, kept finite */
             p0[x] = lam[x] < 40.0f ? -lam[x] : -40.0f;
         }
         if (s->shot_noise)

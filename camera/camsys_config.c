@@ -12,6 +12,11 @@
 #include "camera/rng.h"
 #include "core/error.h"
 
+/* The most dark current a pixel may have at its temperature, e-/s: 1e9 (the
+ * largest full well) in a microsecond; far more than any sensor, far less
+ * than a float's range over an hour's exposure. */
+#define DARK_MAX_E_S 1e15
+
 /* Solar spectrum for tabulated passbands: a 5772 K black body (IAU 2015
  * nominal solar effective temperature), normalised to the total irradiance. */
 #define SUN_TEFF_K 5772.0
@@ -283,6 +288,15 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
         (rc = nc_cfg_double(m, "analog_gain_db", -60, 60, &s->analog_gain_db)) < 0 ||
         (rc = nc_cfg_double(m, "bias_dn", 0, 65535, &s->bias_dn)) < 0)
         return rc;
+    /* the dark current at the sensor's temperature, hot pixels included */
+    const double tscale = exp2((s->temperature_k - s->dark_ref_temp_k) / s->dark_doubling_k),
+                 dark_max = (s->dark_current_e_s + s->hot_pixel_dark_e_s) * tscale;
+    if (!(dark_max <= DARK_MAX_E_S))
+        return nc_cfg_key_error(m, "temperature_k",
+                                "the dark current at %g K (doubling every %g K from %g e-/s at %g K; hot pixels %g "
+                                "e-/s) reaches %.3g e-/s a pixel: more than %g (a full well filled in a microsecond)",
+                                s->temperature_k, s->dark_doubling_k, s->dark_current_e_s, s->dark_ref_temp_k,
+                                s->hot_pixel_dark_e_s, dark_max, DARK_MAX_E_S);
     if ((rc = nc_cfg_enum(m, "blooming", bools, &b)) < 0)
         return rc;
     if (rc)

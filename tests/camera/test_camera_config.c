@@ -145,6 +145,12 @@ static void dark_current_at_temperature(void)
     CHECK(load(yaml, zero, 1, &g, &cs) < 0 && nc_test_contains(nc_errmsg(), "sensor.dsnu_e_s") &&
               nc_test_contains(nc_errmsg(), "dark_current_e_s > 0"),
           "DSNU without dark current: %s", nc_errmsg());
+    /* A dark current beyond a float's range (4e38 e-/s: half the pixels read the bias) is a configuration error. */
+    const char *hot[] = {"sensor.temperature_k=1000", "sensor.dark_doubling_k=5.7"};
+    CHECK(load(yaml, hot, 2, &g, &cs) < 0 && nc_test_contains(nc_errmsg(), "sensor.temperature_k: the dark current at "
+                                                                            "1000 K") &&
+              nc_test_contains(nc_errmsg(), "e-/s a pixel: more than 1e+15"),
+          "dark current out of range: %s", nc_errmsg());
 }
 
 static void passband_from_edges(void)
