@@ -326,6 +326,54 @@ static double edge_angle(const struct nc_camera *c, int m, double ux, double uy)
     return acos(fmin(1, d.z));
 }
 
+/* A disk under SUN_POINTS_PX pixels in radius is drawn by SUN_POINTS
+ * points spread evenly over it (a golden-angle spiral, each an equal share
+ * of its irradiance), each traced for bodies in front and added to the
+ * pixel it falls in: its light is all there, however small it is against
+ * the pixels (a grid of samples a pixel misses a disk smaller than its
+ * spacing, or doubles it). */
+#define SUN_POINTS_PX 4.0
+enum { SUN_POINTS = 1024 };
+
+static int sun_points(struct nc_renderer *r, const struct nc_scene *s, struct nc_vec3 sun, double theta, double irr,
+                      struct nc_frame *f, struct nc_sun_view *v)
+{
+    const struct nc_camera *c = &s->camera;
+    const struct nc_vec3 e1 = nc_v3_unit(nc_v3_cross(sun, fabs(sun.z) < 0.9 ? nc_v3(0, 0, 1) : nc_v3(1, 0, 0))),
+                         e2 = nc_v3_cross(sun, e1);
+    const double golden = M_PI * (3 - sqrt(5.0)), share = irr / SUN_POINTS;
+    long lit = 0;
+    for (int k0 = 0; k0 < SUN_POINTS; k0 += NC_PACKET) {
+        struct nc_ray16 ray;
+        struct nc_vec3 w[NC_PACKET];
+        int occ[NC_PACKET] = {0};
+        memset(&ray, 0, sizeof ray);
+        for (int i = 0; i < NC_PACKET; i++) {
+            const int k = k0 + i;
+            const double rho = tan(theta) * sqrt((k + 0.5) / SUN_POINTS), phi = k * golden;
+            w[i] = nc_v3_unit(nc_v3_add(sun, nc_v3_add(nc_v3_scale(e1, rho * cos(phi)), nc_v3_scale(e2, rho * sin(phi)))));
+            ray.dx[i] = (float)w[i].x, ray.dy[i] = (float)w[i].y, ray.dz[i] = (float)w[i].z;
+            ray.tfar[i] = INFINITY;
+            ray.valid[i] = -1;
+        }
+        nc_rt_occluded16(r->rt, &ray, occ);
+        for (int i = 0; i < NC_PACKET; i++) {
+            double x, y;
+            if (occ[i] || nc_camera_project(c, nc_quat_rotate(nc_quat_conj(c->attitude_q), w[i]), &x, &y) < 0)
+                continue;
+            lit++;
+            const long px = lround(x), py = lround(y);
+            if (px < 0 || py < 0 || px >= f->width_px || py >= f->height_px)
+                continue;
+            const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_dir(c, (double)px, (double)py));
+            f->radiance[(size_t)py * f->width_px + (size_t)px] += (float)(share / omega);
+            v->drawn_w_m2 += share;
+        }
+    }
+    v->hidden = lit == 0;
+    return 0;
+}
+
 int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_deg, struct nc_frame *f,
                   struct nc_sun_view *v)
 {
@@ -368,6 +416,8 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
     int rc = nc_rt_update(r->rt, s);
     if (rc < 0)
         return rc;
+    if (tan(theta) * fmax(c->fx_px, c->fy_px) < SUN_POINTS_PX)
+        return sun_points(r, s, sun, theta, irr, f, v);
     const double L = irr / (2 * M_PI * (1 - cos(theta))), cos_theta = cos(theta);
     enum { SUB = 8 };
     long lit = 0, seen = 0;

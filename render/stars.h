@@ -98,8 +98,10 @@ struct nc_sun_view {
  * mid-exposure) and, when its disk reaches the frame, draw it: a uniform
  * disk of the Sun's angular radius theta and radiance E / (2 pi (1 - cos
  * theta)) (E the solar irradiance at the camera), 8 x 8 samples a pixel,
- * each traced for bodies in front. The camera model then saturates and
- * blooms it like any light. */
+ * each traced for bodies in front; a disk under 4 px in radius as 1024
+ * points spread over it, each a 1024th of E, traced and added to the pixel
+ * it falls in. The camera model then saturates and blooms it like any
+ * light. */
 int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_deg, struct nc_frame *f,
                   struct nc_sun_view *v);
 /* "sun in field", "sun in field, hidden by a body", "sun 4.2 deg from the

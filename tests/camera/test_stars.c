@@ -281,21 +281,24 @@ int main(void)
     }
 
     /* 6. The Sun, 1 deg off the boresight of a 3.7 deg field (its disk
-     * about 9 px in radius), then 5 and 30 deg off, then behind a body. */
-    const double offs[] = {1, 5, 30, 1};
-    for (int k = 0; k < 4; k++) {
+     * about 9 px in radius), then 5 and 30 deg off, then behind a body; then
+     * from 5 au on the boresight of a 73 deg field (fx 100 px: its disk
+     * 0.093 px in radius, which 8 x 8 samples a pixel missed), in the open
+     * and behind the body. */
+    const double offs[] = {1, 5, 30, 1, 0, 0};
+    for (int k = 0; k < 6; k++) {
         char sunset[160], rockset[160];
         double o = offs[k] * M_PI / 180;
         snprintf(sunset, sizeof sunset, "sun.direction=[%.17g, 0, %.17g]", sin(o), cos(o));
         snprintf(rockset, sizeof rockset, "bodies.0.position_m=[%.17g, 0, %.17g]", k == 3 ? 1e4 * sin(o) : 0.0,
-                 k == 3 ? 1e4 * cos(o) : -1e4);
-        const char *sets[] = {sunset, rockset};
+                 k == 3 || k == 5 ? 1e4 * cos(o) : -1e4);
+        const char *sets[] = {sunset, rockset, "camera.fx_px=100", "camera.fy_px=100", "sun.distance_au=5"};
         struct nc_scene sc;
         nc_test_scene("bodies:\n  - shape: {type: sphere, radius_m: 200}\n    material: {model: lambert, A: 0.1}\n"
                       "sun: {direction: [0, 0, 1]}\n"
                       "camera: {width_px: 128, height_px: 128, fx_px: 2000, fy_px: 2000, position_m: [0, 0, 0],\n"
                       "         attitude_q: [1, 0, 0, 0]}\n",
-                      sets, 2, &sc);
+                      sets, k < 4 ? 2 : 5, &sc);
         struct nc_renderer rs;
         struct nc_frame fs;
         struct nc_sun_view sv;
@@ -319,9 +322,12 @@ int main(void)
                   "the Sun near the field: edge %.4f deg", sv.edge_deg);
         if (k == 2)
             CHECK(!sv.in_field && !sv.near_field && !warn[0], "the Sun far from the field");
-        if (k == 3)
+        if (k == 3 || k == 5)
             CHECK(sv.in_field && sv.hidden && sv.drawn_w_m2 == 0 && !strcmp(warn, "sun in field, hidden by a body"),
-                  "the Sun behind a body");
+                  "the Sun behind a body (%d)", k);
+        if (k == 4)
+            CHECK(sv.in_field && !sv.hidden && fabs(sv.drawn_w_m2 / irr - 1) < 1e-9,
+                  "the Sun's disk 0.093 px in radius: drawn %.9f of its irradiance", sv.drawn_w_m2 / irr);
         nc_frame_free(&fs);
         nc_renderer_free(&rs);
         nc_scene_free(&sc);
