@@ -176,9 +176,9 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
             rc = nc_error(NC_ECONFIG, "%s:%zu: the Sun direction is zero", path, lineno);
             break;
         }
-        if (!(nc_v3_max_abs(r->p) <= NC_CAMERA_MAX_M)) {
-            rc = nc_error(NC_ECONFIG, "%s:%zu: the camera lies beyond %g m from the scene's origin", path, lineno,
-                          NC_CAMERA_MAX_M);
+        if (!(nc_v3_norm(r->p) <= NC_CAMERA_MAX_M)) {
+            rc = nc_error(NC_ECONFIG, "%s:%zu: the camera lies %g m from the scene's origin, beyond %g m", path,
+                          lineno, nc_v3_norm(r->p), NC_CAMERA_MAX_M);
             break;
         }
         n++;

@@ -31,7 +31,6 @@ static inline struct nc_vec3 nc_v3_unit(struct nc_vec3 a)
     return n > 0 ? nc_v3_scale(a, 1.0 / n) : a;
 }
 static inline int nc_v3_isfinite(struct nc_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
-static inline double nc_v3_max_abs(struct nc_vec3 a) { return fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z))); }
 /* Two unit axes across the unit vector a: (e1, e2, a) is right-handed. */
 static inline void nc_v3_basis(struct nc_vec3 a, struct nc_vec3 *e1, struct nc_vec3 *e2)
 {

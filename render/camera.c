@@ -140,9 +140,9 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
     }
     if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
-    if (!(nc_v3_max_abs(c->position_m) <= NC_CAMERA_MAX_M))
-        return nc_cfg_key_error(map, "position_m", "a coordinate of %g m, beyond %g m", nc_v3_max_abs(c->position_m),
-                                NC_CAMERA_MAX_M);
+    if (!(nc_v3_norm(c->position_m) <= NC_CAMERA_MAX_M))
+        return nc_cfg_key_error(map, "position_m", "%g m from the scene's origin, beyond %g m",
+                                nc_v3_norm(c->position_m), NC_CAMERA_MAX_M);
     struct nc_vec3 target, up = nc_v3(0, 0, 1);
     int hq = nc_cfg_quat(map, "attitude_q", &c->attitude_q);
     int ht = nc_cfg_vec3(map, "look_at_m", &target);

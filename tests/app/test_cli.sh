@@ -160,6 +160,9 @@ expect 1 "--set serve.bind=localhost: serve.bind: 'localhost' is not an IPv4 add
 expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" batch builtin:approach -o "$tmp/rocks" -q rock_id -F png
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
 expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 1025
+# The camera's 1e15 m limit is a distance, not a coordinate.
+expect 1 "camera.position_m: 1.55885e+15 m from the scene's origin, beyond 1e+15 m" -- \
+  "$navcam" render -o "$tmp/far.fits" --set 'camera.position_m=[9e14,9e14,9e14]'
 # A camera inside the body (20 m from the centre of the default asteroid) is warned of.
 expect 0 "camera-ray samples that met a surface met its back, inner side: is the camera inside a body?" -- \
   "$navcam" render "${small[@]}" -o "$tmp/inside.fits" --set 'camera.position_m=[0,-20,0]'
