@@ -63,7 +63,9 @@ int nc_psf_airy(double wavelength_m, double f_number, double pitch_m, struct nc_
      * r = 1.22 lambda N. Cut at the 12th dark ring (v = 38.4748, the 12th
      * zero of J1: r = 12.247 lambda N), a circle, in a square kernel of
      * that half-width (at least 3 px), integrated over each pixel with 8x8
-     * samples. */
+     * samples, or more when the pattern is small against the pixel (4 to a
+     * lambda N, at most 128x128); a pattern that fits in the middle pixel
+     * is all in it. */
     const double v12 = 38.4748;
     double lnp = wavelength_m * f_number / pitch_m; /* lambda N in pixels */
     int r = (int)ceil(fmax(3.0, v12 / M_PI * lnp));
@@ -74,7 +76,11 @@ int nc_psf_airy(double wavelength_m, double f_number, double pitch_m, struct nc_
     psf->kernel = calloc((size_t)psf->size * psf->size, sizeof(double));
     if (!psf->kernel)
         return nc_error(-ENOMEM, "out of memory");
-    const int ss = 8;
+    if (v12 / M_PI * lnp <= 0.5) {
+        psf->kernel[r * psf->size + r] = 1;
+        return 0;
+    }
+    const int ss = (int)fmin(128, fmax(8, ceil(4 / lnp)));
     for (int y = -r; y <= r; y++)
         for (int x = -r; x <= r; x++) {
             double sum = 0;
