@@ -261,7 +261,10 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
                                 "focal_length_m / fx_px); give the pitch once, in camera",
                                 s->pixel_pitch_m, pitch_m);
     if (!(s->pixel_pitch_m > 0))
-        return nc_cfg_missing(m, "pixel_pitch_m", "the pixel pitch in metres (the camera gives fx_px)");
+        return nc_cfg_missing(m, "pixel_pitch_m",
+                              "the pixel pitch in metres: a camera given by fx_px has no pixel size, and the camera "
+                              "model (read for every quantity) needs one: give sensor.pixel_pitch_m, or the camera's "
+                              "focal_length_m and pixel_pitch_m");
     if ((rc = nc_cfg_double(m, "qe", 0, 1, &s->qe)) < 0)
         return rc;
     if ((rc = nc_cfg_enum(m, "shot_noise", bools, &b)) < 0)
