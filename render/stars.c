@@ -321,7 +321,8 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
     memset(r->as_point, 0, sizeof r->as_point);
     for (int b = 0; b < s->nbodies; b++) {
         const struct nc_vec3 rel = nc_v3_sub(s->body[b].position_m, c->position_m);
-        const double d = nc_v3_norm(rel), R = s->body[b].bounding_radius_m, px = 2 * asin(R / d) * fmax(c->fx_px, c->fy_px);
+        const double d = nc_v3_norm(rel), R = s->body[b].bounding_radius_m;
+        const double px = 2 * asin(R / d) * fmax(c->fx_px, c->fy_px); /* its angular diameter in pixels */
         if (d > R && px >= 1.0 && R / d < NC_RESOLVED_MIN_RAD)
             return nc_error(NC_ERANGE, "body '%s' is %.3g px across but its bounding sphere spans only %.3g rad "
                             "(%.3g m at %.3g m): the float rays (6e-8 rad a step) cannot trace a body under %g rad; "

@@ -53,7 +53,8 @@ static int sun_points(struct nc_renderer *r, const struct nc_scene *s, struct nc
         for (int i = 0; i < NC_PACKET; i++) {
             const int k = k0 + i;
             const double rho = tan(theta) * sqrt((k + 0.5) / SUN_POINTS), phi = k * golden;
-            w[i] = nc_v3_unit(nc_v3_add(sun, nc_v3_add(nc_v3_scale(e1, rho * cos(phi)), nc_v3_scale(e2, rho * sin(phi)))));
+            const struct nc_vec3 off = nc_v3_add(nc_v3_scale(e1, rho * cos(phi)), nc_v3_scale(e2, rho * sin(phi)));
+            w[i] = nc_v3_unit(nc_v3_add(sun, off));
             ray.dx[i] = (float)w[i].x, ray.dy[i] = (float)w[i].y, ray.dz[i] = (float)w[i].z;
             ray.tfar[i] = INFINITY;
             ray.valid[i] = -1;

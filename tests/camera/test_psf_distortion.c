@@ -107,7 +107,8 @@ int main(void)
     nc_psf_free(&a);
     CHECK(nc_psf_airy(5e-7, 10, 5e-5, &a) == 0 && a.kernel[(a.size / 2) * a.size + a.size / 2] > 0.97,
           "Airy of lambda N = 0.1 px: middle %g", a.kernel[(a.size / 2) * a.size + a.size / 2]);
-    printf("Airy lambda N = 0.1 px: %.4f of the light in the middle pixel\n", a.kernel[(a.size / 2) * a.size + a.size / 2]);
+    printf("Airy lambda N = 0.1 px: %.4f of the light in the middle pixel\n",
+           a.kernel[(a.size / 2) * a.size + a.size / 2]);
     nc_psf_free(&a);
 
     /* A user kernel image, asymmetric, through the direct path (5x5). */

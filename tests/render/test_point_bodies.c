@@ -98,7 +98,8 @@ int main(void)
         nc_renderer_init(&r, &sn, 2);
         nc_frame_alloc(&f, 64, 48);
         CHECK(nc_render_exposure(&r, &sn, &ex, &f, NULL) < 0 &&
-                  nc_test_contains(nc_errmsg(), "body 'moon' is 6 px across but its bounding sphere spans only 1e-08 rad"),
+                  nc_test_contains(nc_errmsg(), "body 'moon' is 6 px across but its bounding sphere spans only "
+                                                "1e-08 rad"),
               "a resolved body under 1e-6 rad: %s", nc_errmsg());
         nc_frame_free(&f);
         nc_renderer_free(&r);
