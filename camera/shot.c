@@ -161,7 +161,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     if (rc >= 0 && back > hits / 2)
         snprintf(info->inside_warning, sizeof info->inside_warning,
                  "%lu of the %lu camera-ray samples that met a surface met its back, inner side: is the camera "
-                 "inside a body?", back, hits);
+                 "inside a body (or a mesh wound inward)?", back, hits);
     /* Stars (the `stars` section), drawn before the camera model's PSF. */
     char starinfo[120] = "";
     double ts0 = now_ms();

@@ -22,7 +22,7 @@ struct nc_shot_info {
     double stars_ms;
     struct nc_sun_view sun;
     char sun_warning[80];  /* "" when none */
-    char inside_warning[160]; /* most camera rays met the back of a surface ("" when not) */
+    char inside_warning[200]; /* most camera rays met the back of a surface ("" when not) */
     double render_ms;
     double preview_scale;  /* 16-bit preview: what 65535 stands for (0: not a preview) */
 };

@@ -120,7 +120,7 @@ head -2 traj.csv > one.csv
 printf '0,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n' > inside.csv
 "$navcam" batch inside.csv -o inside --no-geometry --set camera.width_px=32 --set camera.height_px=32 > inside.txt 2>&1 ||
   fail "batch inside.csv"
-grep -q "WARNING: row 0 (line 1): .* met its back, inner side: is the camera inside a body?" inside.txt ||
+grep -q "WARNING: row 0 (line 1): .* met its back, inner side: is the camera inside a body (or a mesh wound inward)?" inside.txt ||
   fail "a camera inside the body was not warned of: $(cat inside.txt)"
 "$navcam" batch one.csv -o sumcam --sumfile cam.SUM --no-geometry --set render.samples_per_pixel=1 > /dev/null 2>&1 ||
   fail "--sumfile"

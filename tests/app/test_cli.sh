@@ -164,7 +164,7 @@ expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 1025
 expect 1 "camera.position_m: 1.55885e+15 m from the scene's origin, beyond 1e+15 m" -- \
   "$navcam" render -o "$tmp/far.fits" --set 'camera.position_m=[9e14,9e14,9e14]'
 # A camera inside the body (20 m from the centre of the default asteroid) is warned of.
-expect 0 "camera-ray samples that met a surface met its back, inner side: is the camera inside a body?" -- \
+expect 0 "camera-ray samples that met a surface met its back, inner side: is the camera inside a body (or a mesh wound inward)?" -- \
   "$navcam" render "${small[@]}" -o "$tmp/inside.fits" --set 'camera.position_m=[0,-20,0]'
 expect 0 "$(nproc) threads" -- "$navcam" render "${small[@]}" -o "$tmp/j0.exr" --threads 0 --set render.threads=1
 expect 0 "bodies:" -- "$navcam" scene
