@@ -208,9 +208,8 @@ void *nc__serve_render_thread(void *arg);
 void *nc__serve_output_thread(void *arg);
 
 /* serve_stats.c */
-/* The median time the last 16 frames kept the camera busy (busy_ms), ms
- * (0: none yet); nc__serve_busy_ms with slowest the longest of them. */
-double nc__serve_render_estimate_ms(struct nc__emu *e);
+/* The median time the last 16 frames kept the camera busy (busy_ms), ms,
+ * or with slowest the longest of them (0: none yet). */
 double nc__serve_busy_ms(struct nc__emu *e, int slowest);
 /* The frame rate the camera can deliver now: the requested rate (free-run),
  * capped by 1 / the longest busy time of the last 16 frames, so that it

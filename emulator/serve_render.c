@@ -34,7 +34,7 @@ static int next_job(struct nc__emu *e, struct nc__job *j)
          * end and then renders. Until the render starts (and refines it),
          * a trigger must already see that, or it would queue an exposure
          * behind this one and wait a whole render (too_late). */
-        double est_ms = nc__serve_render_estimate_ms(e);
+        double est_ms = nc__serve_busy_ms(e, 0);
         atomic_store(&e->readout_end_ns, est_ms > 0 ? j->ready_mono_ns + llround(est_ms * 1e6) : INT64_MAX);
     }
     pthread_mutex_unlock(&e->jlock);
@@ -311,7 +311,7 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
             nc__serve_drop(e, &j, NC__DROP_OVERRUN);
             continue;
         }
-        double est_ms = nc__serve_render_estimate_ms(e); /* 0 before the first frame: no tick waits for it */
+        double est_ms = nc__serve_busy_ms(e, 0); /* 0 before the first frame: no tick waits for it */
         atomic_store(&e->readout_end_ns, est_ms > 0 ? x.t0 + llround(est_ms * 1e6) : INT64_MAX);
         struct nc_quality_choice qc; /* render.quality: auto, per frame (its pilots count as render time) */
         x.rc = at.render.quality_auto ? nc_quality_auto(&e->renderer, &at, &e->cs, j.exposure_s, &qc) : 0;

@@ -49,8 +49,6 @@ static struct percentiles percentiles(struct nc__emu *e)
     return p;
 }
 
-double nc__serve_render_estimate_ms(struct nc__emu *e) { return nc__serve_busy_ms(e, 0); }
-
 double nc__serve_busy_ms(struct nc__emu *e, int slowest)
 {
     double r[16];

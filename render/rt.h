@@ -115,6 +115,10 @@ void nc_rt_refine_mesh16(const struct nc_rt *rt, const struct nc_hit16 *hit, con
                          const struct nc_vec3 *dir, double *t, double *scale);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
+/* The same for n (at most NC_PACKET) rays from the camera along the unit
+ * scene-frame directions dir, each to distance tfar_m (INFINITY: the whole
+ * way): stars, the Sun's disk, a far body's line of sight. */
+void nc_rt_occluded_dirs(struct nc_rt *rt, const struct nc_vec3 *dir, int n, double tfar_m, int *occluded);
 /* Shadow rays that need no full trace: from[i] >= 0 says ray i leaves the
  * outer side of body from[i] (a surface point whose normal faces both
  * camera and ray). Rays proven clear of every mesh (shadow_grid.h for the

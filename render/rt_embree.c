@@ -1063,6 +1063,18 @@ void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occlude
         occluded[i] = ray->valid[i] && r.tfar[i] == -INFINITY;
 }
 
+void nc_rt_occluded_dirs(struct nc_rt *rt, const struct nc_vec3 *dir, int n, double tfar_m, int *occluded)
+{
+    struct nc_ray16 ray;
+    memset(&ray, 0, sizeof ray);
+    for (int i = 0; i < n && i < NC_PACKET; i++) {
+        ray.dx[i] = (float)dir[i].x, ray.dy[i] = (float)dir[i].y, ray.dz[i] = (float)dir[i].z;
+        ray.tfar[i] = (float)tfar_m;
+        ray.valid[i] = -1;
+    }
+    nc_rt_occluded16(rt, &ray, occluded);
+}
+
 void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced)
 {
     atomic_fetch_add_explicit(&rt->shadow_culled, culled, memory_order_relaxed);

@@ -267,20 +267,13 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
     }
     long drawn = 0;
     for (size_t i0 = 0; i0 < m; i0 += NC_PACKET) {
-        struct nc_ray16 ray;
         int occ[NC_PACKET] = {0};
-        memset(&ray, 0, sizeof ray);
-        for (int l = 0; l < NC_PACKET; l++) {
-            const int ok = i0 + (size_t)l < m;
-            const struct nc_vec3 d = ok ? p[in[i0 + (size_t)l]].dir : nc_v3(0, 0, 1);
-            ray.valid[l] = ok ? -1 : 0;
-            ray.dx[l] = (float)d.x;
-            ray.dy[l] = (float)d.y;
-            ray.dz[l] = (float)d.z;
-            ray.tfar[l] = INFINITY;
-        }
+        const int nl = m - i0 < NC_PACKET ? (int)(m - i0) : NC_PACKET;
+        struct nc_vec3 dirs[NC_PACKET];
+        for (int l = 0; l < nl; l++)
+            dirs[l] = p[in[i0 + (size_t)l]].dir;
         if (occlusion)
-            nc_rt_occluded16(r->rt, &ray, occ);
+            nc_rt_occluded_dirs(r->rt, dirs, nl, INFINITY, occ);
         for (int l = 0; l < NC_PACKET && i0 + (size_t)l < m; l++) {
             const struct nc_point_source *q = &p[in[i0 + (size_t)l]];
             if (occ[l]) {
@@ -344,12 +337,7 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
             int rc = nc_rt_update(r->rt, s), occ[NC_PACKET] = {0};
             if (rc < 0)
                 return rc;
-            struct nc_ray16 ray;
-            memset(&ray, 0, sizeof ray);
-            ray.dx[0] = (float)dir.x, ray.dy[0] = (float)dir.y, ray.dz[0] = (float)dir.z;
-            ray.tfar[0] = (float)gap;
-            ray.valid[0] = -1;
-            nc_rt_occluded16(r->rt, &ray, occ);
+            nc_rt_occluded_dirs(r->rt, &dir, 1, gap, occ);
             hidden = occ[0];
         }
         struct nc_scene z = *s; /* shallow: shares meshes and materials */

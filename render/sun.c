@@ -41,25 +41,20 @@ static int sun_points(struct nc_renderer *r, const struct nc_scene *s, struct nc
                       struct nc_frame *f, struct nc_sun_view *v)
 {
     const struct nc_camera *c = &s->camera;
-    const struct nc_vec3 e1 = nc_v3_unit(nc_v3_cross(sun, fabs(sun.z) < 0.9 ? nc_v3(0, 0, 1) : nc_v3(1, 0, 0))),
-                         e2 = nc_v3_cross(sun, e1);
+    struct nc_vec3 e1, e2;
+    nc_v3_basis(sun, &e1, &e2);
     const double golden = M_PI * (3 - sqrt(5.0)), share = irr / SUN_POINTS;
     long lit = 0;
     for (int k0 = 0; k0 < SUN_POINTS; k0 += NC_PACKET) {
-        struct nc_ray16 ray;
         struct nc_vec3 w[NC_PACKET];
         int occ[NC_PACKET] = {0};
-        memset(&ray, 0, sizeof ray);
         for (int i = 0; i < NC_PACKET; i++) {
             const int k = k0 + i;
             const double rho = tan(theta) * sqrt((k + 0.5) / SUN_POINTS), phi = k * golden;
             const struct nc_vec3 off = nc_v3_add(nc_v3_scale(e1, rho * cos(phi)), nc_v3_scale(e2, rho * sin(phi)));
             w[i] = nc_v3_unit(nc_v3_add(sun, off));
-            ray.dx[i] = (float)w[i].x, ray.dy[i] = (float)w[i].y, ray.dz[i] = (float)w[i].z;
-            ray.tfar[i] = INFINITY;
-            ray.valid[i] = -1;
         }
-        nc_rt_occluded16(r->rt, &ray, occ);
+        nc_rt_occluded_dirs(r->rt, w, NC_PACKET, INFINITY, occ);
         for (int i = 0; i < NC_PACKET; i++) {
             double x, y;
             if (occ[i] || nc_camera_project(c, nc_quat_rotate(nc_quat_conj(c->attitude_q), w[i]), &x, &y) < 0)
@@ -127,28 +122,24 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
             /* the samples of this pixel inside the disk, traced 16 at a time */
-            struct nc_ray16 ray;
+            struct nc_vec3 w[NC_PACKET];
             int n = 0, open = 0;
-            memset(&ray, 0, sizeof ray);
             for (int k = 0; k <= SUB * SUB; k++) {
                 if (k < SUB * SUB) {
                     struct nc_vec3 q = nc_v3_unit(
                         nc_camera_ray(c, x - 0.5 + (k % SUB + 0.5) / SUB, y - 0.5 + (k / SUB + 0.5) / SUB));
-                    struct nc_vec3 w = nc_quat_rotate(c->attitude_q, q);
-                    if (nc_v3_dot(w, sun) < cos_theta)
+                    w[n] = nc_quat_rotate(c->attitude_q, q);
+                    if (nc_v3_dot(w[n], sun) < cos_theta)
                         continue;
-                    ray.dx[n] = (float)w.x, ray.dy[n] = (float)w.y, ray.dz[n] = (float)w.z;
-                    ray.tfar[n] = INFINITY;
-                    ray.valid[n++] = -1;
+                    n++;
                 }
                 if (n == NC_PACKET || (k == SUB * SUB && n > 0)) {
                     int occ[NC_PACKET] = {0};
-                    nc_rt_occluded16(r->rt, &ray, occ);
+                    nc_rt_occluded_dirs(r->rt, w, n, INFINITY, occ);
                     for (int i = 0; i < n; i++)
                         open += !occ[i];
                     seen += n;
                     n = 0;
-                    memset(&ray, 0, sizeof ray);
                 }
             }
             if (open == 0)
