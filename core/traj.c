@@ -52,6 +52,16 @@ static int sum_row(const char *path, size_t lineno, const double *v, struct nc_t
     return 0;
 }
 
+/* How a file's columns map to a layout's: names[i] the name of the file's
+ * column i, map[i] the layout's column it holds (its index in cols);
+ * columns min..max per row (a header that names the columns fixes both);
+ * the capture column's place in the layout is need. */
+struct layout {
+    int sum, need, min, max;
+    int map[18];
+    char names[18][24];
+};
+
 /* The name of column c (0-based) of a layout's columns, into buf. */
 static const char *col_name(const char *cols, int c, char *buf, size_t len)
 {
@@ -60,51 +70,119 @@ static const char *col_name(const char *cols, int c, char *buf, size_t len)
         p = strchr(p, ',') ? strchr(p, ',') + 1 : NULL;
     if (!p)
         return "";
-    snprintf(buf, len, "%.*s", (int)strcspn(p, ",["), p);
+    snprintf(buf, len, "%.*s", (int)strcspn(p, ",[]"), p);
     return buf;
 }
 
-/* What is wrong with a data row (k numbers read into v, s where reading
- * stopped), naming the column: an error, or 0 if nothing. */
-static int row_error(const char *path, size_t lineno, int sum, const double *v, int k, const char *s)
+/* The columns in the layout's own order: sum (1) or pose rows (0). */
+static void layout_positional(int sum, struct layout *l)
 {
+    l->sum = sum;
+    l->need = sum ? 16 : 11;
+    l->min = l->need;
+    l->max = l->need + 1;
+    for (int i = 0; i < l->max; i++) {
+        l->map[i] = i;
+        col_name(sum ? sum_cols : pose_cols, i, l->names[i], sizeof l->names[i]);
+    }
+}
+
+/* The index of name among a layout's columns, or -1. */
+static int layout_index(int sum, const char *name)
+{
+    char buf[24];
+    for (int i = 0; i < (sum ? 17 : 12); i++)
+        if (!strcmp(name, col_name(sum ? sum_cols : pose_cols, i, buf, sizeof buf)))
+            return i;
+    return -1;
+}
+
+/* The layout a header line gives (traj.h): its names, split at commas or
+ * blanks, quotes dropped. Columns go by name when the names are the
+ * layout's own, each once, with every column but capture; by place when
+ * no name is the layout's, or each of the layout's names stands at its own
+ * place (a header of other names, or of the first names only); otherwise
+ * the header is an error naming the first name out of place. */
+static int layout_header(const char *path, size_t lineno, const char *line, struct layout *l)
+{
+    char names[18][24];
+    int n = 0;
+    for (const char *s = line; *s && *s != '\n' && *s != '\r';) {
+        s += strspn(s, " \t\",");
+        const size_t len = strcspn(s, " \t\",\r\n");
+        if (!len)
+            continue;
+        if (n == 18)
+            return nc_error(NC_ECONFIG, "%s:%zu: the header names more than 17 columns", path, lineno);
+        snprintf(names[n++], sizeof names[0], "%.*s", (int)(len < 23 ? len : 23), s);
+        s += len;
+    }
+    int sum = 0, known = 0, placed = 1;
+    for (int i = 0; i < n; i++)
+        sum |= layout_index(0, names[i]) < 0 && layout_index(1, names[i]) >= 0;
+    layout_positional(sum, l);
+    int seen[18] = {0};
+    for (int i = 0; i < n; i++) {
+        const int c = layout_index(sum, names[i]);
+        if (c < 0)
+            continue;
+        if (seen[c]++)
+            return nc_error(NC_ECONFIG, "%s:%zu: the header names %s twice", path, lineno, names[i]);
+        known++;
+        placed &= c == i;
+    }
+    if (!known || placed)
+        return 0;
     const char *cols = sum ? sum_cols : pose_cols;
-    const int need = sum ? 16 : 11;
-    char name[32];
-    s += strspn(s, " \t");
-    const size_t tok = strcspn(s, ",\r\n");
-    if (tok && k < need + 1)
-        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s): '%.*s' is not a number%s", path, lineno, k + 1,
-                        col_name(cols, k, name, sizeof name), (int)tok, s,
-                        strchr(s, ';') ? " (columns are separated by commas)" : "");
-    if (*s == ',' && k < need + 1)
-        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s) is empty", path, lineno, k + 1,
-                        col_name(cols, k, name, sizeof name));
-    if (*s && *s != '\n' && *s != '\r')
-        return nc_error(NC_ECONFIG, "%s:%zu: more than %d columns: %s", path, lineno, need + 1, cols);
-    if (k < need)
-        return nc_error(NC_ECONFIG, "%s:%zu: %d columns, expected %d or %d: %s", path, lineno, k, need, need + 1, cols);
-    for (int i = 0; i < k; i++)
-        if (!isfinite(v[i]))
-            return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s) is not finite", path, lineno, i + 1,
-                            col_name(cols, i, name, sizeof name));
-    if (k == need + 1 && v[need] != 0 && v[need] != 1)
-        return nc_error(NC_ECONFIG, "%s:%zu: column %d (capture): %g, expected 0 or 1", path, lineno, need + 1,
-                        v[need]);
+    for (int i = 0; i < n; i++)
+        if (layout_index(sum, names[i]) < 0)
+            return nc_error(NC_ECONFIG,
+                            "%s:%zu: header column %d, '%s', is not a column of the layout %s; name every column "
+                            "from it (in any order) to have them taken by name, or none",
+                            path, lineno, i + 1, names[i], cols);
+    for (int c = 0; c < l->need; c++)
+        if (!seen[c])
+            return nc_error(NC_ECONFIG,
+                            "%s:%zu: the header names its columns in another order than %s but leaves out %s: "
+                            "name every column to have them taken by name",
+                            path, lineno, cols, l->names[c]);
+    l->min = l->max = n;
+    for (int i = 0; i < n; i++) {
+        l->map[i] = layout_index(sum, names[i]);
+        memcpy(l->names[i], names[i], sizeof names[i]);
+    }
     return 0;
 }
 
-/* Whether a header names the SUM-like layout: its first names t_s and
- * scobj_x_km, blanks around the comma and quotes around the names allowed. */
-static int sum_header(const char *line)
+/* What is wrong with a data row (k numbers read into v, in the file's
+ * order; s where reading stopped), naming the column: an error, or 0 if
+ * nothing. */
+static int row_error(const char *path, size_t lineno, const struct layout *l, const double *v, int k, const char *s)
 {
-    char c[32];
-    size_t n = 0;
-    for (const char *s = line; *s && n < sizeof c - 1; s++)
-        if (!isspace((unsigned char)*s) && *s != '"')
-            c[n++] = *s;
-    c[n] = 0;
-    return !strncmp(c, "t_s,scobj_x_km", 14);
+    const char *cols = l->sum ? sum_cols : pose_cols;
+    s += strspn(s, " \t");
+    const size_t tok = strcspn(s, ",\r\n");
+    if (tok && k < l->max)
+        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s): '%.*s' is not a number%s", path, lineno, k + 1,
+                        l->names[k], (int)tok, s, strchr(s, ';') ? " (columns are separated by commas)" : "");
+    if (*s == ',' && k < l->max)
+        return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s) is empty", path, lineno, k + 1, l->names[k]);
+    if (*s && *s != '\n' && *s != '\r')
+        return nc_error(NC_ECONFIG, "%s:%zu: more than %d columns: %s", path, lineno, l->max, cols);
+    if (k < l->min)
+        return l->min == l->max
+                   ? nc_error(NC_ECONFIG, "%s:%zu: %d columns, expected %d as the header names", path, lineno, k,
+                              l->max)
+                   : nc_error(NC_ECONFIG, "%s:%zu: %d columns, expected %d or %d: %s", path, lineno, k, l->min,
+                              l->max, cols);
+    for (int i = 0; i < k; i++) {
+        if (!isfinite(v[i]))
+            return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s) is not finite", path, lineno, i + 1, l->names[i]);
+        if (l->map[i] == l->need && v[i] != 0 && v[i] != 1)
+            return nc_error(NC_ECONFIG, "%s:%zu: column %d (capture): %g, expected 0 or 1", path, lineno, i + 1,
+                            v[i]);
+    }
+    return 0;
 }
 
 int nc_traj_read(const char *path, struct nc_traj_row **out)
@@ -117,17 +195,18 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
     struct nc_traj_row *rows = NULL;
     size_t n = 0, cap = 0, lineno = 0;
     char line[2048];
-    int rc = 0, sum = 0, header = 0;
+    int rc = 0, header = 0;
+    struct layout l;
+    layout_positional(0, &l);
     while (fgets(line, sizeof line, f)) {
         lineno++;
         if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
             continue;
-        const int need = sum ? 16 : 11;
-        double v[17];
+        double raw[18], v[17];
         int k = 0;
         char *s = line, *end;
-        for (; k < need + 1; k++) {
-            v[k] = strtod(s, &end);
+        for (; k < l.max; k++) {
+            raw[k] = strtod(s, &end);
             const char *after = end + strspn(end, " \t");
             if (end == s || (after == end && *after && !strchr(",\r\n", *after)))
                 break; /* not a number, or one run into other characters: the field is reported whole */
@@ -137,12 +216,16 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         }
         const char *f0 = line + strspn(line, " \t\"");
         if (k == 0 && n == 0 && !header && !(isdigit((unsigned char)*f0) || strchr("+-.,", *f0))) {
-            header = 1; /* a header: which layout */
-            sum = sum_header(line);
+            header = 1; /* a header: which layout, and the columns by name or by place */
+            if ((rc = layout_header(path, lineno, line, &l)) < 0)
+                break;
             continue;
         }
-        if ((rc = row_error(path, lineno, sum, v, k, s)) < 0)
+        if ((rc = row_error(path, lineno, &l, raw, k, s)) < 0)
             break;
+        v[l.need] = 1; /* capture, unless given */
+        for (int i = 0; i < k; i++)
+            v[l.map[i]] = raw[i];
         if (n == cap) {
             cap = cap ? 2 * cap : 256;
             struct nc_traj_row *r2 = realloc(rows, cap * sizeof *rows);
@@ -154,10 +237,10 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         }
         struct nc_traj_row *r = &rows[n];
         r->t_s = v[0];
-        r->capture = k == need + 1 ? v[need] != 0 : 1;
+        r->capture = v[l.need] != 0;
         r->line = (int)lineno;
         r->body_frame = 0;
-        if (sum) {
+        if (l.sum) {
             if ((rc = sum_row(path, lineno, v, r)) < 0)
                 break;
         } else {

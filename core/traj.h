@@ -6,7 +6,8 @@
  * the camera position in the scene frame (m), its attitude (scalar-first
  * quaternion, camera -> scene), the Sun direction in bodies[0]'s frame;
  * capture 0 skips the row's frame (default 1).
- * SUM-like rows (the header required, its first two names t_s,scobj_x_km):
+ * SUM-like rows (the header required: its first two names t_s,scobj_x_km,
+ * or every column named):
  *   t_s, scobj_x_km, scobj_y_km, scobj_z_km, cx_x, cx_y, cx_z, cy_x, cy_y,
  *   cy_z, cz_x, cz_y, cz_z, sz_x, sz_y, sz_z[, capture]
  * an SPC SUM file's geometry (core/sumfile.h) per row: SCOBJ (km,
@@ -14,6 +15,10 @@
  * direction SZ, all in bodies[0]'s body-fixed frame (body_frame set: a
  * user that knows the scene moves the pose with bodies[0], as
  * camera.sumfile does). The intrinsics are the scene's camera.
+ * A header whose names are a layout's own, each once, with every column
+ * but capture, in any order, has the columns taken by name (SUM-like when
+ * one is a SUM-like column); one with no such name, or each at its own
+ * place, leaves them in order; any other header is an error.
  * "builtin:approach" names the default scene's built-in approach.
  */
 #ifndef NC_TRAJ_H

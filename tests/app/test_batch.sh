@@ -198,6 +198,34 @@ grep -q "bad.csv:2: column 4 (cam_z_m): 'x' is not a number" err.txt || fail "tr
 printf '0,1,2,3,1,0,0,0,0,1,0,0.5\n' > bad.csv
 "$navcam" batch bad.csv -o x 2> err.txt && fail "capture 0.5 accepted"
 grep -q "bad.csv:1: column 12 (capture): 0.5, expected 0 or 1" err.txt || fail "trajectory error: $(cat err.txt)"
+# Columns by name: the first pose with its columns in another order (a scalar-last
+# quaternion, capture among them) and the first SUM-like row with its Sun first
+# give the same frames as in the layouts' own order.
+python3 - <<'PY'
+import csv
+for src, dst, order in (("traj.csv", "named.csv", [8, 9, 10, 0, 1, 2, 3, 5, 6, 7, 4]),
+                        ("traj_sum.csv", "named_sum.csv", [13, 14, 15] + list(range(13)))):
+    rows = list(csv.reader(open(src)))
+    head = [rows[0][i] for i in order] + ["capture"]
+    with open(dst, "w") as f:
+        f.write(",".join(head[:5] + head[-1:] + head[5:-1]) + "\n")
+        for r in rows[1:3]:
+            v = [r[i] for i in order] + ["1"]
+            f.write(",".join(v[:5] + v[-1:] + v[5:-1]) + "\n")
+PY
+"$navcam" batch named.csv -o named "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "columns by name"
+cmp named/frame_000001.fits ref/frame_000001.fits || fail "columns by name: not the reference frame"
+"$navcam" batch named_sum.csv -o named_sum "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "SUM columns by name"
+cmp named_sum/frame_000001.fits sum/frame_000001.fits || fail "SUM columns by name: not the frame of ordered rows"
+row="0,1,2,3,1,0,0,0,0,1,0" named="cam_x_m,cam_y_m,cam_z_m,q_w,q_x,q_y,q_z,sun_x,sun_y,sun_z"
+for c in "t_s,qx,$named|bad.csv:1: header column 2, 'qx', is not a column" \
+         "t_s,cam_y_m,cam_x_m|bad.csv:1: the header names its columns in another order than t_s,cam_x_m" \
+         "t_s,cam_x_m,cam_x_m|bad.csv:1: the header names cam_x_m twice" \
+         "capture,t_s,$named|bad.csv:2: 11 columns, expected 12 as the header names"; do
+  printf '%s\n%s\n' "${c%%|*}" "$row" > bad.csv
+  "$navcam" batch bad.csv -o x 2> err.txt && fail "accepted: ${c%%|*}"
+  grep -qF "${c#*|}" err.txt || fail "trajectory error for ${c%%|*}: $(cat err.txt)"
+done
 # a number run into letters, an empty field, semicolons, no rows: each named for what it is
 for c in "0,1,2,3x,1,0,0,0,0,1,0|bad.csv:1: column 4 (cam_z_m): '3x' is not a number" \
          "0,1,,3,1,0,0,0,0,1,0|bad.csv:1: column 3 (cam_y_m) is empty" \
