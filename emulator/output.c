@@ -90,6 +90,13 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
                  r->sun_in_field ? "sun in field" : "sun near field", r->sun_off_axis_deg, r->sun_edge_deg,
                  r->sun_hidden ? "true" : "false");
     }
+    if (r->back_samples > r->hit_samples / 2) { /* most samples met a back side: a camera inside a body? */
+        size_t k = strlen(stars);
+        snprintf(stars + k, sizeof stars - k,
+                 "\"inside\": {\"warning\": \"camera inside a body?\", \"back_samples\": %lu, "
+                 "\"hit_samples\": %lu}, ",
+                 r->back_samples, r->hit_samples);
+    }
     /* the Sun as the frame used it: a direction is made a unit vector */
     const struct nc_vec3 sun = p->sun_is_position ? p->sun : nc_v3_unit(p->sun);
     int n = snprintf(

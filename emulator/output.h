@@ -38,6 +38,7 @@ struct nc_frame_record {
     long stars_drawn, stars_hidden; /* stars in the frame, and hidden by bodies */
     double sun_off_axis_deg, sun_edge_deg; /* the Sun from the boresight, and from the frame's edge (< 0: in it) */
     int sun_in_field, sun_near_field, sun_hidden;
+    unsigned long hit_samples, back_samples; /* camera samples that met a surface, and its back side */
     double render_ms, camera_ms; /* render (incl. smear) and camera model time */
     int width_px, height_px, adc_bits;
     const uint16_t *dn;          /* the digitised frame */

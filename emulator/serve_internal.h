@@ -99,6 +99,7 @@ struct nc__emu {
     int queue_frames, drop_oldest, stale_render, no_pose_scene;
     int overlap; /* the camera model of frame N runs while N+1 renders (never in lock-step) */
     atomic_llong readout_end_ns; /* CLOCK_MONOTONIC the frame being rendered should be done (0: none) */
+    int inside_warned;           /* the render thread's: the last frame's samples mostly met a back side */
     int64_t last_trigger_mono_ns; /* of the trigger or tick before (under jlock) */
     int job_cap; /* jobs that may wait for the render: queue_frames (lock-step) or 1 (the sensor holds one frame) */
     char bind[64];

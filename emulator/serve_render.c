@@ -147,11 +147,31 @@ struct staged {
     enum nc_pose_quality q;
     int64_t gap, t0, t1; /* render start and end, CLOCK_MONOTONIC */
     int rc, ts, buf;
+    unsigned long hits, back_hits; /* camera samples that met a surface, and its back side */
     double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg;
     struct nc_sky_stats stars;
     struct nc_sun_view sun;
     struct nc_render_settings used; /* render.quality: auto's choice, or the scene's */
 };
+
+/* A frame whose camera samples mostly met the back, inner side of a
+ * surface (a camera inside a body) is warned of in the log when it begins
+ * and when it ends, not at every frame; each such frame's record says so. */
+static void inside_warning(struct nc__emu *e, const struct staged *x)
+{
+    const int inside = x->rc >= 0 && x->back_hits > x->hits / 2;
+    if (inside && !e->inside_warned)
+        nc_log_warn("emulator/render",
+                    "frame of request %u: %lu of the %lu camera-ray samples that met a surface met its back, inner "
+                    "side: is the camera inside a body (or a mesh wound inward)? Logged again when this ends; every "
+                    "such frame's record holds \"inside\"",
+                    x->j.sequence, x->back_hits, x->hits);
+    else if (!inside && e->inside_warned && x->rc >= 0)
+        nc_log_info("emulator/render", "frame of request %u: the camera samples no longer meet back sides mostly",
+                    x->j.sequence);
+    if (x->rc >= 0)
+        e->inside_warned = inside;
+}
 
 /* The camera-model stage: in free-run and trigger modes (unless
  * serve.overlap_camera_model is false) its own thread, so that the camera
@@ -222,7 +242,7 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .stars_on = e->sky.on, .star_limit_mag = x->stars.limit_mag, .stars_drawn = x->stars.drawn,
         .stars_hidden = x->stars.hidden, .sun_off_axis_deg = x->sun.off_axis_deg, .sun_edge_deg = x->sun.edge_deg,
         .sun_in_field = x->sun.in_field, .sun_near_field = x->sun.near_field, .sun_hidden = x->sun.hidden,
-        .render_ms = (x->t1 - x->t0) * 1e-6,
+        .hit_samples = x->hits, .back_samples = x->back_hits, .render_ms = (x->t1 - x->t0) * 1e-6,
         .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
         .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
     fill_slot(e);
@@ -316,8 +336,14 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         struct nc_quality_choice qc; /* render.quality: auto, per frame (its pilots count as render time) */
         x.rc = at.render.quality_auto ? nc_quality_auto(&e->renderer, &at, &e->cs, j.exposure_s, &qc) : 0;
         x.used = at.render;
+        struct nc_rt_stats st0, st1;
+        nc_rt_get_stats(e->renderer.rt, &st0);
         if (x.rc >= 0)
             x.rc = nc_render_exposure(&e->renderer, &at, &ex, f, &x.ts);
+        nc_rt_get_stats(e->renderer.rt, &st1);
+        x.hits = st1.camera_hits - st0.camera_hits;
+        x.back_hits = st1.camera_back_hits - st0.camera_back_hits;
+        inside_warning(e, &x);
         if (x.rc >= 0 && e->sky.on) /* stars at the mid-exposure time, through this frame's exposure */
             x.rc = nc_sky_draw(&e->sky, &e->renderer, &e->cs, &at, j.mid_sim_ns * 1e-9, j.exposure_s, f, &x.stars);
         if (x.rc >= 0) /* the Sun drawn if its disk reaches the frame; in the record if in or near it */

@@ -65,6 +65,21 @@ cmp -s <(strip "$tmp/lock1/frames/frames.jsonl") <(strip "$tmp/lock2/frames/fram
 [ "$(wc -l < "$tmp/lock1/frames/frames.jsonl")" -eq 8 ] && ok || bad "sidecar lines"
 [ "$(json "$tmp/lock1/stats.json" "d['frames_delivered']")" = 8 ] && ok || bad "stats: frames_delivered"
 
+# A camera inside the body (two poses) and then outside it: those frames'
+# records say so, and the log warns once when it begins and once when it ends.
+printf '0,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n1,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n' > "$tmp/inside.csv"
+printf '2,0,-3000,0,0.70710678,-0.70710678,0,0,1,0,0\n' >> "$tmp/inside.csv"
+start inside 14 --set serve.mode=lockstep
+"$navcam" replay "$tmp/inside.csv" --lockstep --port "$tcp" > "$tmp/inside/replay.out" 2>&1 && ok \
+  || bad "replay inside.csv: $(cat "$tmp/inside/replay.out")"
+stop
+[ "$(grep -c '"inside": {"warning": "camera inside a body?"' "$tmp/inside/frames/frames.jsonl")" = 2 ] \
+  && [ "$(sed -n 3p "$tmp/inside/frames/frames.jsonl" | grep -c inside)" = 0 ] && ok \
+  || bad "inside: frame records: $(cut -c1-300 "$tmp/inside/frames/frames.jsonl")"
+[ "$(grep -c 'met its back, inner side' "$tmp/inside/serve.log")" = 1 ] \
+  && [ "$(grep -c 'no longer meet back sides' "$tmp/inside/serve.log")" = 1 ] && ok \
+  || bad "inside: log: $(cat "$tmp/inside/serve.log")"
+
 # 2. Every rejection reason, sent on purpose over UDP, is counted; serving goes on.
 start reject 2 --set serve.mode=lockstep
 python3 - "$src/examples" "$udp" <<'PY'
