@@ -79,7 +79,7 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
                  (long long)r->trigger_mono_ns, (long long)r->exposure_start_mono_ns, (long long)r->exposure_end_mono_ns);
         snprintf(ms, sizeof ms, "\"render_ms\": %.3f, \"camera_ms\": %.3f, ", r->render_ms, r->camera_ms);
     }
-    char stars[320] = "";
+    char stars[512] = "";
     if (r->stars_on)
         snprintf(stars, sizeof stars, "\"stars\": {\"limit_mag\": %.4g, \"drawn\": %ld, \"hidden\": %ld}, ",
                  r->star_limit_mag, r->stars_drawn, r->stars_hidden);
