@@ -48,6 +48,43 @@ double nc_boulders_expected(const struct nc_boulder_params *p, double area_km2)
     return area_km2 * p->c_per_km2 * (pow(p->d_min_m, -p->slope) - pow(p->d_max_m, -p->slope));
 }
 
+int nc_rock_shape_corners(const struct nc_rock_shape *sh, float (*v)[3], int max)
+{
+    int n = 0, P = sh->nplanes;
+    for (int a = 0; a < P; a++)
+        for (int b = a + 1; b < P; b++)
+            for (int c = b + 1; c < P && n < max; c++) {
+                const int id[3] = {a, b, c};
+                double m[3][4];
+                for (int i = 0; i < 3; i++)
+                    m[i][0] = sh->nx[id[i]], m[i][1] = sh->ny[id[i]], m[i][2] = sh->nz[id[i]], m[i][3] = sh->d[id[i]];
+                double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                             m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                             m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+                if (fabs(det) < 1e-9)
+                    continue;
+                double x[3]; /* Cramer's rule */
+                for (int k = 0; k < 3; k++) {
+                    double q[3][3];
+                    for (int i = 0; i < 3; i++)
+                        for (int j = 0; j < 3; j++)
+                            q[i][j] = j == k ? m[i][3] : m[i][j];
+                    x[k] = (q[0][0] * (q[1][1] * q[2][2] - q[1][2] * q[2][1]) -
+                            q[0][1] * (q[1][0] * q[2][2] - q[1][2] * q[2][0]) +
+                            q[0][2] * (q[1][0] * q[2][1] - q[1][1] * q[2][0])) / det;
+                }
+                int inside = 1;
+                for (int k = 0; k < P && inside; k++)
+                    inside = sh->nx[k] * x[0] + sh->ny[k] * x[1] + sh->nz[k] * x[2] <= sh->d[k] + 1e-5;
+                if (inside) {
+                    for (int k = 0; k < 3; k++)
+                        v[n][k] = (float)x[k];
+                    n++;
+                }
+            }
+    return n;
+}
+
 /* Shape i: an ellipsoid of half-axes 1 >= b >= c, cut by its three pairs of
  * axis planes and by planes tangent to it in random directions pushed in by
  * up to 20 %: faceted, flat-sided rocks of distinct outlines. */
@@ -76,6 +113,19 @@ static void rock_shape(uint64_t seed, int i, struct nc_rock_shape *r)
     }
     for (; n < NC_ROCK_PLANES; n++) /* padding: plane 0 again */
         r->nx[n] = r->nx[0], r->ny[n] = r->ny[0], r->nz[n] = r->nz[0], r->d[n] = r->d[0];
+    /* The tangent planes' corners reach past the ellipsoid: the solid is
+     * scaled so that its two farthest corners are 2 units (D) apart. */
+    float v[NC_ROCK_CORNERS_MAX][3];
+    const int nv = nc_rock_shape_corners(r, v, NC_ROCK_CORNERS_MAX);
+    double far2 = 0;
+    for (int a = 0; a < nv; a++)
+        for (int b = a + 1; b < nv; b++) {
+            const double dx = v[a][0] - v[b][0], dy = v[a][1] - v[b][1], dz = v[a][2] - v[b][2];
+            far2 = fmax(far2, dx * dx + dy * dy + dz * dz);
+        }
+    const double scale = far2 > 0 ? 2 / sqrt(far2) : 1;
+    for (n = 0; n < NC_ROCK_PLANES; n++)
+        r->d[n] = (float)(r->d[n] * scale);
     for (int k = 0; k < 3; k++) /* the farther of the two axis planes */
         r->half[k] = fmaxf(r->d[2 * k], r->d[2 * k + 1]);
 }

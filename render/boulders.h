@@ -24,9 +24,10 @@
 #define NC_ROCK_SHAPES_MAX 256
 #define NC_ROCK_RELIEF_OCTAVES 3 /* nc_boulder_relief */
 
-/* A rock in its own frame, in units of half its longest dimension: the
- * points x with n . x <= d for every plane k (n = (nx[k], ny[k], nz[k])
- * unit), inside the box of half-extents half (half[0] = 1, the longest).
+/* A rock in its own frame, in units of half its longest dimension (its two
+ * farthest corners are 2 units apart): the points x with n . x <= d for
+ * every plane k (n = (nx[k], ny[k], nz[k]) unit), inside the box of
+ * half-extents half (half[0] the longest).
  * Planes are stored by component, and every slot from nplanes on repeats
  * plane 0, so that a loop may run over all NC_ROCK_PLANES. */
 struct nc_rock_shape {
@@ -34,6 +35,12 @@ struct nc_rock_shape {
     float half[3];
     int nplanes;
 };
+
+/* The corners of shape sh (rock units): every point where three of its
+ * planes meet inside the others (within 1e-5), into v. Returns how many
+ * (at most max; NC_ROCK_CORNERS_MAX holds any shape's). */
+#define NC_ROCK_CORNERS_MAX 256
+int nc_rock_shape_corners(const struct nc_rock_shape *sh, float (*v)[3], int max);
 
 /* Octaves of diameter [2^j, 2^(j+1)) m that a population may use. */
 #define NC_BOULDER_OCTAVE_MIN (-20) /* 1 um: below anything a camera resolves */

@@ -98,7 +98,7 @@ void nc_material_free(struct nc_material *m);
  * on two scenes (docs/terrain.md); test_boulders checks them on others.
  * Only models with a roughness parameter named theta_bar (degrees) can fold:
  * the index of that parameter, or -1. */
-#define NC_ROCK_FOLD_TAN 0.55
+#define NC_ROCK_FOLD_TAN 0.52
 #define NC_ROCK_FOLD_C 4.0
 int nc_material_roughness_param(const struct nc_material *m);
 /* out = m with the rocks folded in (sharing m's albedo map: never free

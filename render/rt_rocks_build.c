@@ -13,46 +13,7 @@
 
 #include "core/error.h"
 
-/* The corners of shape sh (rock units): every point where three of its
- * planes meet inside the others. Returns how many (at most max). */
-static int corners(const struct nc_rock_shape *sh, float (*v)[3], int max)
-{
-    int n = 0, P = sh->nplanes;
-    for (int a = 0; a < P; a++)
-        for (int b = a + 1; b < P; b++)
-            for (int c = b + 1; c < P && n < max; c++) {
-                const int id[3] = {a, b, c};
-                double m[3][4];
-                for (int i = 0; i < 3; i++)
-                    m[i][0] = sh->nx[id[i]], m[i][1] = sh->ny[id[i]], m[i][2] = sh->nz[id[i]], m[i][3] = sh->d[id[i]];
-                double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                             m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                             m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-                if (fabs(det) < 1e-9)
-                    continue;
-                double x[3]; /* Cramer's rule */
-                for (int k = 0; k < 3; k++) {
-                    double q[3][3];
-                    for (int i = 0; i < 3; i++)
-                        for (int j = 0; j < 3; j++)
-                            q[i][j] = j == k ? m[i][3] : m[i][j];
-                    x[k] = (q[0][0] * (q[1][1] * q[2][2] - q[1][2] * q[2][1]) -
-                            q[0][1] * (q[1][0] * q[2][2] - q[1][2] * q[2][0]) +
-                            q[0][2] * (q[1][0] * q[2][1] - q[1][1] * q[2][0])) / det;
-                }
-                int inside = 1;
-                for (int k = 0; k < P && inside; k++)
-                    inside = sh->nx[k] * x[0] + sh->ny[k] * x[1] + sh->nz[k] * x[2] <= sh->d[k] + 1e-5;
-                if (inside) {
-                    for (int k = 0; k < 3; k++)
-                        v[n][k] = (float)x[k];
-                    n++;
-                }
-            }
-    return n;
-}
-
-#define MAX_CORNERS 256
+#define MAX_CORNERS NC_ROCK_CORNERS_MAX
 
 /* The traced record of rock b, whose shape has the nv corners v: R^T / s
  * for its rotation q (renormalised, as the generator placed it) and half
@@ -167,7 +128,7 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
     }
     for (int i = 0; i < f->nshapes; i++) {
         float(*c)[3] = v + (size_t)i * MAX_CORNERS;
-        nv[i] = corners(&f->shape[i], c, MAX_CORNERS);
+        nv[i] = nc_rock_shape_corners(&f->shape[i], c, MAX_CORNERS);
         if (nv[i] < 4 || nv[i] == MAX_CORNERS) { /* not a proper solid: its box's corners bound it */
             const float *h = f->shape[i].half;
             for (int j = 0; j < 8; j++)

@@ -322,10 +322,12 @@ static void check_frames(const struct nc_scene *s, int rock_bins)
         }
     }
     /* a sample on another facet at a shared edge changes its pixel by a
-     * few per cent at most */
+     * few per cent at most; one whose shadow ray starts an ulp away, on the
+     * other side of a shadow's edge, by a quarter (4 samples): a few of them
+     * move a 256x256 frame's total by up to 3e-5 */
     printf("frames: %ld pixels on the body, %ld differ by over 0.1 %%, total %.3g, %ld coverages differ\n", px, off,
            sa / sb - 1, cov);
-    CHECK(px > 10000 && off <= px / 1000 && fabs(sa / sb - 1) < 1e-5 && cov <= px / 10000, "frames differ");
+    CHECK(px > 10000 && off <= px / 1000 && fabs(sa / sb - 1) < 3e-5 && cov <= px / 10000, "frames differ");
     nc_frame_free(&a);
     nc_frame_free(&b);
     nc_renderer_free(&ra);

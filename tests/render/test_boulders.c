@@ -112,6 +112,29 @@ static void check_determinism(const struct nc_mesh *m)
     nc_boulders_free(&b);
 }
 
+/* Every shape's longest dimension is its rock's diameter: its two farthest
+ * corners are 2 units (D) apart, and no point of it lies farther than that
+ * from another (the corners bound it). */
+static void check_shapes(const struct nc_mesh *m)
+{
+    struct nc_boulder_params p = {.c_per_km2 = 2e3, .slope = 2.9, .d_min_m = 1, .d_max_m = 64, .burial_max = 0.5,
+                                  .shapes = NC_ROCK_SHAPES_MAX, .seed = 5};
+    struct nc_boulder_field f;
+    CHECK(nc_boulders_generate(m, &p, 20000000, &f) == 0, "%s", nc_errmsg());
+    double lo = INFINITY, hi = 0;
+    for (int i = 0; i < f.nshapes; i++) {
+        float v[NC_ROCK_CORNERS_MAX][3];
+        const int n = nc_rock_shape_corners(&f.shape[i], v, NC_ROCK_CORNERS_MAX);
+        double far = 0;
+        for (int a = 0; a < n; a++)
+            for (int b = a + 1; b < n; b++)
+                far = fmax(far, hypot(hypot(v[a][0] - v[b][0], v[a][1] - v[b][1]), v[a][2] - v[b][2]));
+        lo = fmin(lo, far), hi = fmax(hi, far);
+    }
+    printf("shapes: %d, their longest dimension %.7f to %.7f (2: the diameter)\n", f.nshapes, lo, hi);
+    CHECK(fabs(lo - 2) < 1e-5 && fabs(hi - 2) < 1e-5, "longest dimensions %.7f to %.7f, not 2", lo, hi);
+    nc_boulders_free(&f);
+}
 
 /* The frame with boulders: darker spots (shadows) and bright faces appear,
  * the same bytes on 1 and 2 threads; a ray down onto the largest rock
@@ -469,6 +492,7 @@ int main(void)
     nc_test_asteroid_mesh(5, 40, &m);
     check_population(&m);
     check_determinism(&m);
+    check_shapes(&m);
     nc_mesh_free(&m);
     check_render();
     check_cut();
