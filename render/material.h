@@ -94,7 +94,7 @@ void nc_material_free(struct nc_material *m);
  *   tan^2 theta_bar' = tan^2 theta_bar + TAN^2 (1 - exp(-C cover)),
  * at most the parameter's upper bound. For a small cover the added term is
  * TAN^2 C cover, linear in the area as a slope variance is; a surface wholly
- * of rocks adds atan(TAN) = 28.8 deg. TAN and C were fitted to rendered rocks
+ * of rocks adds atan(TAN) = 27.5 deg. TAN and C were fitted to rendered rocks
  * on two scenes (docs/terrain.md); test_boulders checks them on others.
  * Only models with a roughness parameter named theta_bar (degrees) can fold:
  * the index of that parameter, or -1. */
