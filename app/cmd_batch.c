@@ -152,7 +152,7 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
             for (size_t k = 0; k < bf->n; k++)
                 if (px[k]) {
                     const struct nc_boulder *r = &bf->rock[k];
-                    fprintf(f, "%d,%zu,%.9g,%.9g,%.9g,%.6g,%u\n", b, k, r->centre_m[0], r->centre_m[1], r->centre_m[2],
+                    fprintf(f, "%d,%zu,%.9g,%.9g,%.9g,%.9g,%u\n", b, k, r->centre_m[0], r->centre_m[1], r->centre_m[2],
                             2.0 * r->half_m, px[k]);
                     (*nrocks)++;
                 }
@@ -193,7 +193,7 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
                        dz = geom[NC_GEOM_Z * plane + o] - cb.z;
                 if (geom[NC_GEOM_BODY * plane + o] != b || sqrt(dx * dx + dy * dy + dz * dz) > 0.5 * cr->d_m)
                     continue;
-                fprintf(f, "%d,%zu,%.9g,%.9g,%.9g,%.6g,%.6g,%.3f,%.3f\n", b, k, cb.x, cb.y, cb.z, cr->d_m, cr->age, x,
+                fprintf(f, "%d,%zu,%.9g,%.9g,%.9g,%.9g,%.6g,%.3f,%.3f\n", b, k, cb.x, cb.y, cb.z, cr->d_m, cr->age, x,
                         y);
                 (*ncraters)++;
             }

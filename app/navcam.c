@@ -32,6 +32,7 @@ static const char main_help[] =
     "  compare REAL RENDER          a real image against a render: errors, NCC, limb IoU, shift\n"
     "  texture IMAGE...             texture statistics: FAST corners, spectrum slope, gradients\n"
     "  batch TRAJ.csv -o DIR        render a trajectory to a dataset (resumable, shardable)\n"
+    "  population [SCENE.yaml]      every boulder and crater a scene generates, as CSV\n"
     "\n"
     "Options:\n"
     "  -h, --help      this help; `navcam COMMAND --help` for a command\n"
@@ -44,7 +45,7 @@ static const char main_help[] =
     "\n"
     "Configuration keys and units: docs/config.md.\n";
 
-static const char *const commands[] = {"render", "expose", "serve", "replay", "pose", "scene", "brdf", "bench", "stars", "compare", "texture", "batch", NULL};
+static const char *const commands[] = {"render", "expose", "serve", "replay", "pose", "scene", "brdf", "bench", "stars", "compare", "texture", "batch", "population", NULL};
 
 /* The command's executable: DIR/libexec/navcam (a build tree) or
  * DIR/../libexec/navcam (an installed tree), DIR being this program's. */

@@ -186,6 +186,48 @@ print("stars in batch: Sirius moved %.3f px in 100 years (13.39 expected)" % mov
 assert s0 > 0 and abs(s1 / s0 - 1) < 1e-3 and abs(moved - 13.39) < 0.05, (s0, s1, moved)
 PY
 
+# navcam population: every rock and crater of the scene, the same as the rows
+# the frames list (index, centre, diameter); on a denser population (50 000
+# rocks) the slope and density fitted on the list (a truncated power law,
+# maximum likelihood) within 5 % of the configured ones.
+"$navcam" population "${scene[@]}" -b pop_rocks.csv -c pop_craters.csv > pop.txt 2> pop.err || fail "population: $(cat pop.err)"
+"$navcam" population "${scene[@]}" -b pop_dense.csv \
+  --set 'bodies.0.boulders={density_per_km2: 3e5, slope: 2.2, min_diameter_m: 2, max_diameter_m: 20}' > /dev/null 2>&1 ||
+  fail "population, dense"
+python3 - <<'PY' || fail "population"
+import csv, glob, math
+def rows(path):
+    return list(csv.DictReader(l for l in open(path) if not l.startswith("#")))
+rocks, craters = rows("pop_rocks.csv"), rows("pop_craters.csv")
+by = {int(r["index"]): r for r in rocks}
+seen = 0
+for f in glob.glob("ref/frame_*_boulders.csv"):
+    for r in csv.DictReader(open(f)):
+        p = by[int(r["index"])]
+        assert all(abs(float(r[k]) - float(p[k])) <= 1e-6 * max(1, abs(float(p[k]))) for k in ("x_m", "y_m", "z_m", "diameter_m")), (r, p)
+        seen += 1
+head = [l for l in open("pop_dense.csv") if l.startswith("#")][0]
+area = float(head.split(" on ")[1].split(" km^2")[0])
+d = [float(r["diameter_m"]) for r in rows("pop_dense.csv")]
+lo, hi = 2.0, 20.0
+assert len(d) > 20000 and min(d) >= lo and max(d) < hi, (len(d), min(d), max(d))
+s = sum(math.log(x / lo) for x in d) / len(d)
+def score(b):  # d/db of the truncated power law's log-likelihood, per rock
+    r = (hi / lo) ** -b
+    return 1 / b - s - math.log(hi / lo) * r / (1 - r)
+a, c = 0.5, 6.0
+for _ in range(100):
+    m = (a + c) / 2
+    a, c = (m, c) if score(m) > 0 else (a, m)
+b = (a + c) / 2
+C = len(d) / area / (lo ** -b - hi ** -b)  # N(>1 m) per km^2 of the law
+print("population: %d rocks (%d seen in the frames, the same); dense: %d rocks, slope %.4f (2.2), C %.0f per km^2 (3e5); "
+      "%d craters" % (len(rocks), seen, len(d), b, C, len(craters)))
+assert seen > 0 and abs(b / 2.2 - 1) < 0.05 and abs(C / 3e5 - 1) < 0.05 and len(craters) > 0, (b, C)
+PY
+"$navcam" population "${scene[@]}" -b /nonexistent/x.csv > /dev/null 2> err.txt && fail "population into a missing directory"
+grep -q "/nonexistent/x.csv" err.txt || fail "population error: $(cat err.txt)"
+
 # Errors: bad shard, bad row.
 "$navcam" batch traj.csv -o x --shard 3/3 2> err.txt && fail "--shard 3/3 accepted"
 grep -q "0 <= K < N" err.txt || fail "shard error: $(cat err.txt)"

@@ -60,7 +60,7 @@ done
 # OpenImageIO (and the 260 libraries it pulls in: about 0.4 s to load) is the
 # module navcam-oiio.so, loaded only by a command that reads or writes EXR,
 # TIFF or PNG files.
-for c in render expose serve batch bench compare texture stars brdf scene; do
+for c in render expose serve batch bench compare texture stars brdf scene population; do
   case "$(needed "$libexec/navcam-$c")" in *OpenImageIO*) bad "navcam-$c links OpenImageIO itself" ;; *) ok ;; esac
 done
 case "$(needed "$libexec/navcam-oiio.so")" in *OpenImageIO*) ok ;; *) bad "navcam-oiio.so does not link OpenImageIO" ;; esac
