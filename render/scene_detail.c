@@ -165,7 +165,9 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b, int
     if ((rc = nc_cfg_seed(map, "seed", &p.seed)) < 0 || dry)
         return rc;
     if ((rc = nc_boulders_generate(&b->mesh, &p, MAX_BOULDERS, &b->boulders)) < 0) {
-        return nc__scene_error_at(map);
+        /* too many rocks: where the smallest diameter was given (a --set, say) */
+        struct nc_cfg_node *at = rc == NC_ERANGE ? nc_cfg_get(map, "min_diameter_m") : NULL;
+        return nc__scene_error_at(at ? at : map);
     }
     /* rocks standing out past the mesh's farthest vertex widen the body */
     b->bounding_radius_m = fmax(b->bounding_radius_m, nc_boulders_bounding_radius(&b->boulders));
