@@ -21,6 +21,7 @@
 #include "core/fs.h"
 #include "core/traj.h"
 #include "render/image_io.h"
+#include "render/rt.h"
 
 static const char batch_help[] =
     "Usage: navcam batch TRAJ.csv -o DIR [--scene SCENE.yaml] [--set KEY=VALUE]... [options]\n"
@@ -204,9 +205,15 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
     return 0;
 }
 
+/* The detail a frame was rendered with, as the emulator's frame records
+ * give it (docs/emulator.md). */
+struct detail {
+    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg;
+};
+
 static int truth(const char *dir, const char *stem, const char *ext, int geometry, long row,
                  const struct nc_traj_row *tr, const struct nc_scene *s, enum nc_quantity q, double exposure,
-                 const char *quality, int nrocks, int ncraters)
+                 const char *quality, const struct detail *d, int nrocks, int ncraters)
 {
     char tmp[4200], name[80];
     snprintf(name, sizeof name, "%s.json", stem);
@@ -266,7 +273,9 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
             s->render.soft_shadows ? "true" : "false", (unsigned long long)s->render.seed);
     if (quality[0])
         fprintf(f, ", \"quality_choice\": \"%s\"", quality);
-    fprintf(f, "}}\n");
+    fprintf(f, "},\n \"lod_error_m\": %.17g, \"boulder_min_m\": %.17g, \"boulder_mesh_px\": %.17g, "
+               "\"rock_fold_theta_bar_deg\": %.17g}\n",
+            d->lod_error_m, d->boulder_min_m, d->boulder_mesh_px, d->rock_fold_theta_bar_deg);
     return commit(f, 0, tmp, dir, name);
 }
 
@@ -313,6 +322,8 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
     if ((rc = nc_shot(r, &s, cs, sky, q, exposure, row->t_s, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
         (rc = nc_commit_file(tmp, path)) < 0)
         return rc;
+    const struct detail det = {nc_rt_lod_error_m(r->rt), nc_rt_boulder_min_m(r->rt), nc_rt_boulder_mesh_px(r->rt),
+                               nc_render_fold_theta_bar_deg(r, s.nbodies)};
     int nrocks = -1, ncraters = -1;
     if (geometry) {
         snprintf(tmp, sizeof tmp, "%s/.%s_geometry.tmp.fits", dir, stem);
@@ -323,7 +334,7 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
             (rc = nc_commit_file(tmp, path)) < 0 || (rc = lists(dir, stem, &s, geom, rock, &nrocks, &ncraters)) < 0)
             return rc;
     }
-    if ((rc = truth(dir, stem, ext, geometry, i, row, &s, q, exposure, info.quality, nrocks, ncraters)) < 0)
+    if ((rc = truth(dir, stem, ext, geometry, i, row, &s, q, exposure, info.quality, &det, nrocks, ncraters)) < 0)
         return rc;
     printf("%s (row %ld, t = %.6g s): %.0f ms\n", stem, i, row->t_s, 1e3 * (now_s() - t0));
     if (info.sun_warning[0])

@@ -69,6 +69,11 @@ for j in sorted(glob.glob("ref/frame_*.json")):
     cards = [head[i:i + 80] for i in range(0, len(head), 80)]
     assert any(c.startswith("NAXIS3  =                   11") for c in cards), "11 planes"
     assert any(c.startswith("PLANE1  = 'range_m ") for c in cards) and any(c.startswith("PLANE11 = 'body ") for c in cards)
+    # the detail used, as in the frame's own metadata (FITS ROCKMIN, LODERR)
+    head = open(j.replace(".json", ".fits"), "rb").read(2880 * 4).decode("ascii", "replace")
+    card = {head[i:i + 8].strip(): head[i + 10:i + 80].split("/")[0].strip() for i in range(0, len(head), 80)}
+    assert float(card["ROCKMIN"]) == d["boulder_min_m"] and float(card["LODERR"]) == d["lod_error_m"], (j, card["ROCKMIN"], d)
+    assert d["boulder_mesh_px"] >= 0 and (d["rock_fold_theta_bar_deg"] == -1) == ("ROCKFOLD" not in card), j
 print("ground truth ok")
 PY
 
