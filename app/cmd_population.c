@@ -21,7 +21,8 @@ static const char population_help[] =
     "drawn, whatever a camera would trace or see. A line per body on standard output\n"
     "(its surface, the populations' counts and parameters) and, with -b and -c, the\n"
     "lists as CSV, each after comment lines (#) giving every body's surface area and\n"
-    "parameters, so that N(>D) = C D^-b per km^2 can be fitted on the list:\n"
+    "parameters (or saying that no body has any), so that N(>D) = C D^-b per km^2\n"
+    "can be fitted on the list:\n"
     "  BOULDERS.csv  body,index,x_m,y_m,z_m,diameter_m,shape,q_w,q_x,q_y,q_z\n"
     "                index: in the body's list (largest octave first), as rock_id\n"
     "                shows it; the centre in the body-fixed frame, m; diameter_m the\n"
@@ -39,9 +40,15 @@ static const char population_help[] =
     "\n"
     "Example: navcam population --set 'bodies.0.boulders={preset: bennu, min_diameter_m: 1}' -b rocks.csv\n";
 
-/* Each body's surface and parameters, as comment lines. */
+/* Each body's surface and parameters, as comment lines (a line saying so
+ * where no body has any). */
 static void comments(FILE *f, const struct nc_scene *s, int rocks)
 {
+    int any = 0;
+    for (int b = 0; b < s->nbodies; b++)
+        any |= rocks ? s->body[b].boulders.n > 0 : s->body[b].craters.n > 0;
+    if (!any)
+        fprintf(f, "# no body has %s\n", rocks ? "boulders" : "craters");
     for (int b = 0; b < s->nbodies; b++) {
         const struct nc_body *y = &s->body[b];
         if (rocks && y->boulders.n) {
@@ -66,7 +73,7 @@ static int write_list(const char *path, const struct nc_scene *s, int rocks)
     snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "w");
     if (!f)
-        return nc_error(-errno, "%s: %s", tmp, strerror(errno));
+        return nc_error(-errno, "%s: cannot write a file there: %s", path, strerror(errno));
     comments(f, s, rocks);
     fputs(rocks ? "body,index,x_m,y_m,z_m,diameter_m,shape,q_w,q_x,q_y,q_z\n" : "body,index,x_m,y_m,z_m,diameter_m,age\n",
           f);
@@ -91,12 +98,16 @@ static int write_list(const char *path, const struct nc_scene *s, int rocks)
     if (fclose(f) != 0 || bad) {
         const int err = errno ? errno : EIO;
         unlink(tmp);
-        return nc_error(-err, "%s: write failed: %s", tmp, strerror(err));
+        return nc_error(-err, "%s: write failed: %s", path, strerror(err));
     }
     int rc = nc_commit_file(tmp, path);
-    if (rc < 0)
+    if (rc < 0) {
+        char why[512];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
         unlink(tmp);
-    return rc;
+        return nc_error(rc, "%s: not written (%s)", path, why);
+    }
+    return 0;
 }
 
 int main(int argc, char **argv)

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "core/error.h"
 #include "core/pose.h"
@@ -87,22 +88,25 @@ static void layout_positional(int sum, struct layout *l)
     }
 }
 
-/* The index of name among a layout's columns, or -1. */
+/* The index of name among a layout's columns (case aside), or -1. */
 static int layout_index(int sum, const char *name)
 {
     char buf[24];
     for (int i = 0; i < (sum ? 17 : 12); i++)
-        if (!strcmp(name, col_name(sum ? sum_cols : pose_cols, i, buf, sizeof buf)))
+        if (!strcasecmp(name, col_name(sum ? sum_cols : pose_cols, i, buf, sizeof buf)))
             return i;
     return -1;
 }
 
 /* The layout a header line gives (traj.h): its names, split at commas or
- * blanks, quotes dropped. Columns go by name when the names are the
- * layout's own, each once, with every column but capture; by place when
- * no name is the layout's, or each of the layout's names stands at its own
- * place (a header of other names, or of the first names only); otherwise
- * the header is an error naming the first name out of place. */
+ * blanks, quotes dropped, case aside. Columns go by place when no name is
+ * the layout's (a header of other names), or when every name is the
+ * layout's at its own place (all of them, or the first ones); by name when
+ * the names are the layout's own, each once, with every column but
+ * capture; otherwise (the layout's names mixed with others, or out of place
+ * with some left out) the header is an error naming the first name that
+ * does not fit: a header that names some columns as NavCam does and others
+ * not (qx for q_x) is a mistake read either way. */
 static int layout_header(const char *path, size_t lineno, const char *line, struct layout *l)
 {
     char names[18][24];
@@ -131,7 +135,7 @@ static int layout_header(const char *path, size_t lineno, const char *line, stru
         known++;
         placed &= c == i;
     }
-    if (!known || placed)
+    if (!known || (placed && known == n))
         return 0;
     const char *cols = sum ? sum_cols : pose_cols;
     for (int i = 0; i < n; i++)
@@ -168,7 +172,10 @@ static int row_error(const char *path, size_t lineno, const struct layout *l, co
     if (*s == ',' && k < l->max)
         return nc_error(NC_ECONFIG, "%s:%zu: column %d (%s) is empty", path, lineno, k + 1, l->names[k]);
     if (*s && *s != '\n' && *s != '\r')
-        return nc_error(NC_ECONFIG, "%s:%zu: more than %d columns: %s", path, lineno, l->max, cols);
+        return l->min == l->max
+                   ? nc_error(NC_ECONFIG, "%s:%zu: more than %d columns, the %d the header names", path, lineno,
+                              l->max, l->max)
+                   : nc_error(NC_ECONFIG, "%s:%zu: more than %d columns: %s", path, lineno, l->max, cols);
     if (k < l->min)
         return l->min == l->max
                    ? nc_error(NC_ECONFIG, "%s:%zu: %d columns, expected %d as the header names", path, lineno, k,
@@ -200,6 +207,8 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
     layout_positional(0, &l);
     while (fgets(line, sizeof line, f)) {
         lineno++;
+        if (lineno == 1 && !memcmp(line, "\xef\xbb\xbf", 3)) /* a UTF-8 byte-order mark (spreadsheets write one) */
+            memmove(line, line + 3, strlen(line + 3) + 1);
         if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
             continue;
         double raw[18], v[17];

@@ -261,6 +261,10 @@ for src, dst, order in (("traj.csv", "named.csv", [8, 9, 10, 0, 1, 2, 3, 5, 6, 7
             f.write(",".join(v[:5] + v[-1:] + v[5:-1]) + "\n")
 PY
 "$navcam" batch named.csv -o named "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "columns by name"
+# the same file in capitals, with a UTF-8 byte-order mark and CRLF line ends: the same frames
+printf '\xef\xbb\xbf' > named_bom.csv && tr 'a-z' 'A-Z' < named.csv | sed 's/$/\r/' >> named_bom.csv
+"$navcam" batch named_bom.csv -o named_bom "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "BOM, capitals, CRLF"
+cmp named_bom/frame_000001.fits named/frame_000001.fits || fail "BOM, capitals, CRLF: not the same frame"
 cmp named/frame_000001.fits ref/frame_000001.fits || fail "columns by name: not the reference frame"
 "$navcam" batch named_sum.csv -o named_sum "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "SUM columns by name"
 cmp named_sum/frame_000001.fits sum/frame_000001.fits || fail "SUM columns by name: not the frame of ordered rows"
@@ -268,6 +272,7 @@ row="0,1,2,3,1,0,0,0,0,1,0" named="cam_x_m,cam_y_m,cam_z_m,q_w,q_x,q_y,q_z,sun_x
 for c in "t_s,qx,$named|bad.csv:1: header column 2, 'qx', is not a column" \
          "t_s,cam_y_m,cam_x_m|bad.csv:1: the header names its columns in another order than t_s,cam_x_m" \
          "t_s,cam_x_m,cam_x_m|bad.csv:1: the header names cam_x_m twice" \
+         "t_s,cam_x_m,cam_y_m,cam_z_m,qx,qy,qz,qw,sun_x,sun_y,sun_z|bad.csv:1: header column 5, 'qx', is not a column" \
          "capture,t_s,$named|bad.csv:2: 11 columns, expected 12 as the header names"; do
   printf '%s\n%s\n' "${c%%|*}" "$row" > bad.csv
   "$navcam" batch bad.csv -o x 2> err.txt && fail "accepted: ${c%%|*}"
