@@ -75,7 +75,8 @@ static int write_list(const char *path, const struct nc_scene *s, int rocks)
     if (!f)
         return nc_error(-errno, "%s: cannot write a file there: %s", path, strerror(errno));
     comments(f, s, rocks);
-    fputs(rocks ? "body,index,x_m,y_m,z_m,diameter_m,shape,q_w,q_x,q_y,q_z\n" : "body,index,x_m,y_m,z_m,diameter_m,age\n",
+    fputs(rocks ? "body,index,x_m,y_m,z_m,diameter_m,shape,q_w,q_x,q_y,q_z\n"
+                : "body,index,x_m,y_m,z_m,diameter_m,age\n",
           f);
     for (int b = 0; b < s->nbodies; b++) {
         if (rocks) {

@@ -45,7 +45,8 @@ static const char main_help[] =
     "\n"
     "Configuration keys and units: docs/config.md.\n";
 
-static const char *const commands[] = {"render", "expose", "serve", "replay", "pose", "scene", "brdf", "bench", "stars", "compare", "texture", "batch", "population", NULL};
+static const char *const commands[] = {"render", "expose", "serve",   "replay",  "pose",  "scene",      "brdf",
+                                       "bench",  "stars",  "compare", "texture", "batch", "population", NULL};
 
 /* The command's executable: DIR/libexec/navcam (a build tree) or
  * DIR/../libexec/navcam (an installed tree), DIR being this program's. */
