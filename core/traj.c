@@ -207,7 +207,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
     layout_positional(0, &l);
     while (fgets(line, sizeof line, f)) {
         lineno++;
-        if (lineno == 1 && !memcmp(line, "\xef\xbb\xbf", 3)) /* a UTF-8 byte-order mark (spreadsheets write one) */
+        if (lineno == 1 && !strncmp(line, "\xef\xbb\xbf", 3)) /* a UTF-8 byte-order mark (spreadsheets write one) */
             memmove(line, line + 3, strlen(line + 3) + 1);
         if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
             continue;
