@@ -114,6 +114,15 @@ int main(void)
     expect_fail("mesh.stl", "solid\n", "unknown mesh format");
     rc = nc_mesh_load(nc_test_path("missing.obj"), 1.0, &m);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "missing.obj: cannot open mesh"), "missing: %s", nc_errmsg());
+    /* a NUL byte: the rest of its line would be lost unseen */
+    static const char nul[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\0 5\nf 1 2 3\n";
+    FILE *nf = fopen(nc_test_path("nul.obj"), "wb");
+    CHECK(nf && fwrite(nul, 1, sizeof nul - 1, nf) == sizeof nul - 1 && fclose(nf) == 0, "writing nul.obj");
+    rc = nc_mesh_load(nc_test_path("nul.obj"), 1.0, &m);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "nul.obj:3: a NUL byte at column 8"), "NUL: %s",
+          rc < 0 ? nc_errmsg() : "loaded");
+    if (rc >= 0)
+        nc_mesh_free(&m);
 
     /* PLY, ASCII with an extra element and property, then binary little and
      * big endian with double vertices and int indices. */
