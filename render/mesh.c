@@ -114,17 +114,14 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
     /* Faces may reference vertices defined later; check indices at the end
      * but remember the line of each face for the message. */
     size_t *face_line = NULL, flcap = 0;
-    ssize_t len;
-    while ((len = getline(&line, &linecap, f)) > 0) {
+    for (ssize_t len; (len = getline(&line, &linecap, f)) > 0;) {
         lineno++;
         if (strlen(line) != (size_t)len) { /* the line would end there, unseen: not a text OBJ */
             rc = nc_error(NC_EMESH, "%s:%zu: a NUL byte at column %zu (a binary or damaged file?)", path, lineno,
                           strlen(line) + 1);
             goto out;
         }
-        const char *s = line;
-        while (isspace((unsigned char)*s))
-            s++;
+        const char *s = line + strspn(line, " \t\n\v\f\r");
         if (s[0] == 'v' && isspace((unsigned char)s[1])) {
             if (nc_grow((void **)&m.v, &vcap, 3 * (m.nv + 1), sizeof *m.v) < 0)
                 goto nomem;
