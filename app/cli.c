@@ -2,6 +2,7 @@
 #include "app/cli.h"
 
 #include <errno.h>
+#include <libgen.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +26,16 @@ int nc_cli_fail(void)
 {
     fprintf(stderr, "%s: %s\n", name, nc_errmsg());
     return 1;
+}
+
+int nc_cli_dir_writable(const char *path)
+{
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", path);
+    if (access(dirname(dir), W_OK) == 0)
+        return 0;
+    fprintf(stderr, "%s: %s: cannot write into directory '%s': %s\n", name, path, dir, strerror(errno));
+    return -1;
 }
 
 int nc_cli_long(const char *opt, const char *s, long lo, long hi, long *out)

@@ -34,6 +34,11 @@ void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const 
 int nc_cli_out_open(const char *path, FILE **f);
 int nc_cli_out_close(FILE *f, const char *path);
 
+/* Whether the directory path would be written into is writable: 0, or -1
+ * after "navcam CMD: PATH: cannot write into directory 'DIR': why" on
+ * stderr (a command checks before its work, not after). */
+int nc_cli_dir_writable(const char *path);
+
 /* gnuplot SCRIPT run in directory dir (no shell: any directory name is
  * safe), its output to stderr; 0 if it ran and succeeded. */
 int nc_cli_gnuplot(const char *dir, const char *script);

@@ -3,7 +3,6 @@
  * size-frequency distribution or to use as ground truth (docs/terrain.md). */
 #include <errno.h>
 #include <getopt.h>
-#include <libgen.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -144,16 +143,9 @@ int main(int argc, char **argv)
     }
     /* Fail before the build (seconds for a large population), not after,
      * when an output cannot be written. */
-    const char *outs[2] = {rocks_out, craters_out};
-    for (int k = 0; k < 2; k++) {
-        char dir[4096];
-        snprintf(dir, sizeof dir, "%s", outs[k] ? outs[k] : "");
-        if (outs[k] && access(dirname(dir), W_OK) != 0) {
-            fprintf(stderr, "navcam population: %s: cannot write into directory '%s': %s\n", outs[k], dir,
-                    strerror(errno));
-            free(sets);
-            return 1;
-        }
+    if ((rocks_out && nc_cli_dir_writable(rocks_out) < 0) || (craters_out && nc_cli_dir_writable(craters_out) < 0)) {
+        free(sets);
+        return 1;
     }
     struct nc_scene s;
     struct nc_camsys cs;

@@ -3,7 +3,6 @@
  * renderer and the camera model, never the emulator. */
 #include <errno.h>
 #include <getopt.h>
-#include <libgen.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -157,11 +156,7 @@ int main(int argc, char **argv)
         return 2;
     }
     const struct nc_image_attr row_attr = {"navcam:fits_row_order", rows ? rows : "top_down"};
-    /* Fail before rendering, not after, when OUT cannot be written. */
-    char dir[4096];
-    snprintf(dir, sizeof dir, "%s", out);
-    if (access(dirname(dir), W_OK) != 0) {
-        fprintf(stderr, "navcam render: %s: cannot write into directory '%s': %s\n", out, dir, strerror(errno));
+    if (nc_cli_dir_writable(out) < 0) { /* fail before rendering, not after */
         free(sets);
         return 1;
     }

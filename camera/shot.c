@@ -12,6 +12,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "render/image_io.h"
+#include "render/rt.h"
 
 static double now_ms(void) { return (double)nc_mono_ns() * 1e-6; }
 
@@ -158,7 +159,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
         rc = nc_render_exposure(r, &drawn, &ex, &f, &info->time_samples);
     nc_rt_get_stats(r->rt, &st1);
     const unsigned long hits = st1.camera_hits - st0.camera_hits, back = st1.camera_back_hits - st0.camera_back_hits;
-    if (rc >= 0 && back > hits / 2)
+    if (rc >= 0 && nc_rt_mostly_back(hits, back))
         snprintf(info->inside_warning, sizeof info->inside_warning,
                  "%lu of the %lu camera-ray samples that met a surface met its back, inner side: is the camera "
                  "inside a body (or a mesh wound inward)?", back, hits);

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/le.h"
+#include "render/rt.h"
 
 static const struct nc_param common_params[] = {
     NC_P_STRING("driver", NULL, "the output (`navcam serve --help` lists them)"),
@@ -90,7 +91,7 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
                  r->sun_in_field ? "sun in field" : "sun near field", r->sun_off_axis_deg, r->sun_edge_deg,
                  r->sun_hidden ? "true" : "false");
     }
-    if (r->back_samples > r->hit_samples / 2) { /* most samples met a back side: a camera inside a body? */
+    if (nc_rt_mostly_back(r->hit_samples, r->back_samples)) { /* a camera inside a body? */
         size_t k = strlen(stars);
         snprintf(stars + k, sizeof stars - k,
                  "\"inside\": {\"warning\": \"camera inside a body?\", \"back_samples\": %lu, "

@@ -159,7 +159,7 @@ struct staged {
  * and when it ends, not at every frame; each such frame's record says so. */
 static void inside_warning(struct nc__emu *e, const struct staged *x)
 {
-    const int inside = x->rc >= 0 && x->back_hits > x->hits / 2;
+    const int inside = x->rc >= 0 && nc_rt_mostly_back(x->hits, x->back_hits);
     if (inside && !e->inside_warned)
         nc_log_warn("emulator/render",
                     "frame of request %u: %lu of the %lu camera-ray samples that met a surface met its back, inner "

@@ -131,6 +131,10 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from,
  * worth at a time: the counters are shared by every render thread). */
 void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced);
 void nc_rt_count_camera_hits(struct nc_rt *rt, unsigned long hits, unsigned long back_hits);
+/* Whether back of a frame's hits camera samples that met a surface met its
+ * back, inner side: most of them (a camera inside a body, or a mesh wound
+ * inward), what render, batch and serve warn of. */
+static inline int nc_rt_mostly_back(unsigned long hits, unsigned long back) { return back > hits / 2; }
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
 /* The largest error bound of the levels of detail shown at the last update,
  * metres (0: every body at full resolution). */
