@@ -301,9 +301,14 @@ int nc_cfg_load_file(struct nc_cfg *cfg, const char *path)
         return nc_error(-EIO, "%s: read error", path);
     }
     buf[len] = '\0';
-    if (memchr(buf, '\0', len)) {
+    const char *nul = memchr(buf, '\0', len);
+    if (nul) {
+        size_t line = 1, col = 1;
+        for (const char *p = buf; p < nul; p++, col++)
+            if (*p == '\n')
+                line++, col = 0;
         free(buf);
-        return nc_error(NC_ECONFIG, "%s: not a text file (contains NUL bytes)", path);
+        return nc_error(NC_ECONFIG, "%s:%zu: a NUL byte at column %zu (a binary or damaged file?)", path, line, col);
     }
     int rc = nc_cfg_load_string(cfg, buf, path);
     free(buf);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/lines.h"
 #include "core/pose.h"
 
 enum { IT_SIZE, IT_MMFL, IT_SCOBJ, IT_CX, IT_CY, IT_CZ, IT_SZ, IT_K, IT_DIST, IT_SIGMA_VSO, IT_SIGMA_PTG, IT_N };
@@ -164,14 +165,16 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
     FILE *f = fopen(path, "r");
     if (!f)
         return nc_error(-errno, "%s: %s", path, strerror(errno));
-    char line[1024];
-    int lineno = 0, seen[IT_N] = {0}, rc = 0;
+    struct nc_lines ln;
+    nc_lines_init(&ln, f, path, NC_ECONFIG);
+    int lineno = 0, seen[IT_N] = {0}, rc;
     double dist[4] = {0};
-    while (fgets(line, sizeof line, f)) {
-        lineno++;
-        if (!strchr(line, '\n') && !feof(f)) {
-            rc = nc_error(NC_ECONFIG, "%s:%d: line longer than %zu characters: not a SUM file", path, lineno,
-                          sizeof line - 2);
+    while ((rc = nc_lines_next(&ln)) > 0) {
+        rc = 0; /* a line read; an error below sets it */
+        char *line = ln.line;
+        lineno = (int)ln.no;
+        if (ln.len > 1024) {
+            rc = nc_error(NC_ECONFIG, "%s:%d: line longer than 1024 bytes: not a SUM file", path, lineno);
             break;
         }
         trim(line);
@@ -237,6 +240,7 @@ int nc_sumfile_read(const char *path, struct nc_sumfile *out)
             memcpy(dst[it], v, (size_t)items[it].count * sizeof *v);
         }
     }
+    nc_lines_free(&ln);
     fclose(f);
     if (rc < 0)
         return rc;

@@ -10,6 +10,7 @@
 #include <strings.h>
 
 #include "core/error.h"
+#include "core/lines.h"
 #include "core/pose.h"
 #include "core/sumfile.h"
 
@@ -201,12 +202,14 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         return nc_error(-errno, "%s: %s", path, strerror(errno));
     struct nc_traj_row *rows = NULL;
     size_t n = 0, cap = 0, lineno = 0;
-    char line[2048];
-    int rc = 0, header = 0;
+    struct nc_lines ln;
+    nc_lines_init(&ln, f, path, NC_ECONFIG);
+    int rc, header = 0;
     struct layout l;
     layout_positional(0, &l);
-    while (fgets(line, sizeof line, f)) {
-        lineno++;
+    while ((rc = nc_lines_next(&ln)) > 0) {
+        char *line = ln.line;
+        lineno = ln.no;
         if (lineno == 1 && !strncmp(line, "\xef\xbb\xbf", 3)) /* a UTF-8 byte-order mark (spreadsheets write one) */
             memmove(line, line + 3, strlen(line + 3) + 1);
         if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
@@ -275,6 +278,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         }
         n++;
     }
+    nc_lines_free(&ln);
     fclose(f);
     if (rc < 0) {
         free(rows);

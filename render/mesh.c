@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
+#include "core/lines.h"
 #include "core/grow.h"
 
 void nc_mesh_free(struct nc_mesh *m)
@@ -107,21 +108,16 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
     if (!f)
         return nc_error(-errno, "%s: cannot open mesh: %s", path, strerror(errno));
     struct nc_mesh m = {0};
-    size_t vcap = 0, tcap = 0, lineno = 0;
-    char *line = NULL;
-    size_t linecap = 0;
+    size_t vcap = 0, tcap = 0;
+    struct nc_lines ln;
+    nc_lines_init(&ln, f, path, NC_EMESH);
     int rc = 0;
     /* Faces may reference vertices defined later; check indices at the end
      * but remember the line of each face for the message. */
     size_t *face_line = NULL, flcap = 0;
-    for (ssize_t len; (len = getline(&line, &linecap, f)) > 0;) {
-        lineno++;
-        if (strlen(line) != (size_t)len) { /* the line would end there, unseen: not a text OBJ */
-            rc = nc_error(NC_EMESH, "%s:%zu: a NUL byte at column %zu (a binary or damaged file?)", path, lineno,
-                          strlen(line) + 1);
-            goto out;
-        }
-        const char *s = line + strspn(line, " \t\n\v\f\r");
+    while ((rc = nc_lines_next(&ln)) > 0) {
+        const size_t lineno = ln.no;
+        const char *s = ln.line + strspn(ln.line, " \t\n\v\f\r");
         if (s[0] == 'v' && isspace((unsigned char)s[1])) {
             if (nc_grow((void **)&m.v, &vcap, 3 * (m.nv + 1), sizeof *m.v) < 0)
                 goto nomem;
@@ -187,10 +183,8 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
         }
         /* Comments, normals, texture coordinates, groups, materials: not needed. */
     }
-    if (ferror(f)) {
-        rc = nc_error(-EIO, "%s: read error", path);
+    if (rc < 0)
         goto out;
-    }
     for (size_t t = 0; t < m.nt; t++)
         for (int k = 0; k < 3; k++)
             if (m.tri[3 * t + k] >= m.nv) {
@@ -206,7 +200,7 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
 nomem:
     rc = nc_error(-ENOMEM, "%s: out of memory", path);
 out:
-    free(line);
+    nc_lines_free(&ln);
     free(face_line);
     nc_mesh_free(&m);
     fclose(f);
@@ -255,10 +249,8 @@ struct ply_reader {
     FILE *f;
     const char *path;
     enum ply_format fmt;
-    size_t line; /* ASCII: current line */
-    char *buf;
-    size_t cap;
-    char *cur; /* ASCII: cursor in buf */
+    struct nc_lines ln; /* the header's lines, and an ASCII body's */
+    char *cur;          /* ASCII: cursor in ln.line */
 };
 
 /* Read one number of type t; ASCII reads the next token (continuing lines). */
@@ -270,15 +262,15 @@ static int ply_read(struct ply_reader *r, enum ply_type t, double *out)
                 r->cur++;
             if (r->cur && *r->cur)
                 break;
-            if (getline(&r->buf, &r->cap, r->f) <= 0)
-                return nc_error(NC_EMESH, "%s:%zu: unexpected end of file", r->path, r->line);
-            r->line++;
-            r->cur = r->buf;
+            const int got = nc_lines_next(&r->ln);
+            if (got <= 0)
+                return got < 0 ? got : nc_error(NC_EMESH, "%s:%zu: unexpected end of file", r->path, r->ln.no);
+            r->cur = r->ln.line;
         }
         char *end;
         *out = strtod(r->cur, &end);
         if (end == r->cur)
-            return nc_error(NC_EMESH, "%s:%zu: expected a number", r->path, r->line);
+            return nc_error(NC_EMESH, "%s:%zu: expected a number", r->path, r->ln.no);
         r->cur = end;
         return 0;
     }
@@ -311,20 +303,18 @@ static int ply_read(struct ply_reader *r, enum ply_type t, double *out)
 
 static int ply_header(struct ply_reader *r, struct ply_elem *el, int *nel)
 {
-    char *line = NULL;
-    size_t cap = 0;
     int rc = 0, seen_format = 0;
     *nel = 0;
     for (;;) {
-        if (getline(&line, &cap, r->f) <= 0) {
-            rc = nc_error(NC_EMESH, "%s: PLY header has no end_header", r->path);
+        if ((rc = nc_lines_next(&r->ln)) <= 0) {
+            rc = rc < 0 ? rc : nc_error(NC_EMESH, "%s: PLY header has no end_header", r->path);
             break;
         }
-        r->line++;
+        char *line = r->ln.line;
         line[strcspn(line, "\r\n")] = '\0';
         char a[64] = "", b[64] = "", c[64] = "", d[64] = "", e[64] = "";
         int n = sscanf(line, "%63s %63s %63s %63s %63s", a, b, c, d, e);
-        if (r->line == 1) {
+        if (r->ln.no == 1) {
             if (strcmp(a, "ply") != 0) {
                 rc = nc_error(NC_EMESH, "%s:1: not a PLY file (no 'ply' magic)", r->path);
                 break;
@@ -342,12 +332,12 @@ static int ply_header(struct ply_reader *r, struct ply_elem *el, int *nel)
             else if (strcmp(b, "binary_big_endian") == 0)
                 r->fmt = PLY_BE;
             else {
-                rc = nc_error(NC_EMESH, "%s:%zu: unknown PLY format '%s'", r->path, r->line, b);
+                rc = nc_error(NC_EMESH, "%s:%zu: unknown PLY format '%s'", r->path, r->ln.no, b);
                 break;
             }
         } else if (strcmp(a, "element") == 0 && n == 3) {
             if (*nel == 16) {
-                rc = nc_error(NC_EMESH, "%s:%zu: too many PLY elements", r->path, r->line);
+                rc = nc_error(NC_EMESH, "%s:%zu: too many PLY elements", r->path, r->ln.no);
                 break;
             }
             struct ply_elem *x = &el[(*nel)++];
@@ -357,14 +347,14 @@ static int ply_header(struct ply_reader *r, struct ply_elem *el, int *nel)
             errno = 0;
             unsigned long long cnt = strtoull(c, &end, 10);
             if (*end || errno || cnt > (1ull << 32)) {
-                rc = nc_error(NC_EMESH, "%s:%zu: bad element count '%s'", r->path, r->line, c);
+                rc = nc_error(NC_EMESH, "%s:%zu: bad element count '%s'", r->path, r->ln.no, c);
                 break;
             }
             x->count = (size_t)cnt;
         } else if (strcmp(a, "property") == 0 && *nel > 0) {
             struct ply_elem *x = &el[*nel - 1];
             if (x->nprop == 32) {
-                rc = nc_error(NC_EMESH, "%s:%zu: too many properties", r->path, r->line);
+                rc = nc_error(NC_EMESH, "%s:%zu: too many properties", r->path, r->ln.no);
                 break;
             }
             struct ply_prop *p = &x->prop[x->nprop++];
@@ -373,7 +363,7 @@ static int ply_header(struct ply_reader *r, struct ply_elem *el, int *nel)
                 p->type = ply_type_of(d);
                 snprintf(p->name, sizeof p->name, "%s", e);
                 if (!p->count_type || !p->type) {
-                    rc = nc_error(NC_EMESH, "%s:%zu: unknown property type", r->path, r->line);
+                    rc = nc_error(NC_EMESH, "%s:%zu: unknown property type", r->path, r->ln.no);
                     break;
                 }
             } else if (n == 3) {
@@ -381,11 +371,11 @@ static int ply_header(struct ply_reader *r, struct ply_elem *el, int *nel)
                 p->count_type = PLY_NONE;
                 snprintf(p->name, sizeof p->name, "%s", c);
                 if (!p->type) {
-                    rc = nc_error(NC_EMESH, "%s:%zu: unknown property type '%s'", r->path, r->line, b);
+                    rc = nc_error(NC_EMESH, "%s:%zu: unknown property type '%s'", r->path, r->ln.no, b);
                     break;
                 }
             } else {
-                rc = nc_error(NC_EMESH, "%s:%zu: malformed property line", r->path, r->line);
+                rc = nc_error(NC_EMESH, "%s:%zu: malformed property line", r->path, r->ln.no);
                 break;
             }
         } else if (strcmp(a, "end_header") == 0) {
@@ -393,21 +383,20 @@ static int ply_header(struct ply_reader *r, struct ply_elem *el, int *nel)
                 rc = nc_error(NC_EMESH, "%s: PLY header has no format line", r->path);
             break;
         } else {
-            rc = nc_error(NC_EMESH, "%s:%zu: unexpected PLY header line '%s'", r->path, r->line, line);
+            rc = nc_error(NC_EMESH, "%s:%zu: unexpected PLY header line '%s'", r->path, r->ln.no, line);
             break;
         }
     }
-    free(line);
-    return rc;
+    return rc < 0 ? rc : 0;
 }
 
 int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
 {
     memset(out, 0, sizeof *out);
-    struct ply_reader r = {.path = path};
-    r.f = fopen(path, "rb");
+    struct ply_reader r = {.path = path, .f = fopen(path, "rb")};
     if (!r.f)
         return nc_error(-errno, "%s: cannot open mesh: %s", path, strerror(errno));
+    nc_lines_init(&r.ln, r.f, path, NC_EMESH);
     struct ply_elem el[16];
     int nel = 0, rc;
     struct nc_mesh m = {0};
@@ -513,7 +502,7 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
 nomem:
     rc = nc_error(-ENOMEM, "%s: out of memory", path);
 out:
-    free(r.buf);
+    nc_lines_free(&r.ln);
     nc_mesh_free(&m);
     fclose(r.f);
     return rc;

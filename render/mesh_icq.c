@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/lines.h"
 #include "render/mesh.h"
 
 /* Face F's axes (docs/sumfiles.md): outward, I's and J's directions, each
@@ -56,16 +57,17 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
     FILE *f = fopen(path, "r");
     if (!f)
         return nc_error(NC_EMESH, "%s: %s", path, strerror(errno));
-    char line[512];
+    struct nc_lines ln;
+    nc_lines_init(&ln, f, path, NC_EMESH);
     long q = 0;
-    size_t lineno = 0, nv = 0, want = 0;
+    size_t nv = 0, want = 0;
     double *v = NULL;
     uint32_t *tri = NULL, *order = NULL, *weld = NULL, *vline = NULL;
     uint64_t *cube = NULL;
-    int rc = 0;
-    while (fgets(line, sizeof line, f)) {
-        lineno++;
-        char *s = line + strspn(line, " \t\r\n");
+    int rc;
+    while ((rc = nc_lines_next(&ln)) > 0) {
+        const size_t lineno = ln.no;
+        char *s = ln.line + strspn(ln.line, " \t\r\n");
         if (!*s)
             continue;
         if (!want) {
@@ -106,6 +108,7 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
         vline[nv] = (uint32_t)lineno;
         nv++;
     }
+    nc_lines_free(&ln);
     fclose(f);
     if (rc == 0 && !want)
         rc = nc_error(NC_EMESH, "%s: empty: no Q line", path);

@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/le.h"
+#include "core/lines.h"
 #include "render/rt.h"
 #include "render/scene.h"
 
@@ -46,10 +47,13 @@ int nc_star_cat_read_kstars(const char *path, struct nc_star_cat *c)
     if (!f)
         return nc_error(-errno, "%s: %s", path, strerror(errno));
     size_t cap = 0;
-    char line[512];
-    int rc = 0;
-    for (long no = 1; rc == 0 && fgets(line, sizeof line, f); no++) {
-        size_t len = strlen(line);
+    struct nc_lines ln;
+    nc_lines_init(&ln, f, path, NC_ECONFIG);
+    int rc;
+    while ((rc = nc_lines_next(&ln)) > 0) {
+        const char *line = ln.line;
+        const long no = (long)ln.no;
+        const size_t len = ln.len;
         if (line[0] == '#' || len < 8)
             continue;
         double hh, mm, ss, dd, dm, ds, pa, pd, v, bv;
@@ -79,6 +83,7 @@ int nc_star_cat_read_kstars(const char *path, struct nc_star_cat *c)
                                            .dec_rad = dec * M_PI / 180, .pm_ra_mas_yr = (float)pa,
                                            .pm_dec_mas_yr = (float)pd, .v_mag = (float)v, .b_v = (float)bv};
     }
+    nc_lines_free(&ln);
     fclose(f);
     if (rc == 0 && c->n == 0)
         rc = nc_error(NC_ECONFIG, "%s: no stars", path);

@@ -41,8 +41,13 @@ const char *nc_test_path(const char *name)
 
 void nc_test_write(const char *path, const char *text)
 {
-    FILE *f = fopen(path, "w");
-    if (!f || fputs(text, f) < 0 || fclose(f) != 0) {
+    nc_test_write_bytes(path, text, strlen(text));
+}
+
+void nc_test_write_bytes(const char *path, const void *data, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(data, 1, len, f) != len || fclose(f) != 0) {
         fprintf(stderr, "cannot write %s\n", path);
         exit(2);
     }

@@ -32,6 +32,8 @@ extern const char nc_test_asteroid_yaml[];
 const char *nc_test_tmp(void);
 const char *nc_test_path(const char *name);
 void nc_test_write(const char *path, const char *text);
+/* len bytes (NUL bytes too) to path */
+void nc_test_write_bytes(const char *path, const void *data, size_t len);
 /* The bytes of a file (NUL-terminated, malloc'd; its length in *len), or
  * NULL if it cannot be read. */
 char *nc_test_read(const char *path, size_t *len);

@@ -286,6 +286,10 @@ for c in "0,1,2,3x,1,0,0,0,0,1,0|bad.csv:1: column 4 (cam_z_m): '3x' is not a nu
   "$navcam" batch bad.csv -o x 2> err.txt && fail "accepted: ${c%%|*}"
   grep -qF "${c#*|}" err.txt || fail "trajectory error for ${c%%|*}: $(cat err.txt)"
 done
+# a NUL byte: the rest of its line (here a capture column) would be lost unseen
+printf '0,1,2,3,1,0,0,0,0,1,0\0,0\n' > bad.csv
+"$navcam" batch bad.csv -o x 2> err.txt && fail "accepted a NUL byte"
+grep -qF "bad.csv:1: a NUL byte at column 22" err.txt || fail "trajectory NUL: $(cat err.txt)"
 
 # Slurm: a job array of 4 tasks into one directory.
 slurm=$(mktemp -d /tmp/nc_slurm.XXXXXX)

@@ -173,6 +173,10 @@ int main(void)
     nc_test_write(dat, "064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\nnot a star\n");
     CHECK(nc_star_cat_read_kstars(dat, &c) < 0 && nc_test_contains(nc_errmsg(), "stars.dat:2"),
           "a bad row names its line: %s", nc_errmsg());
+    static const char nul[] = "064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\0\n";
+    nc_test_write_bytes(dat, nul, sizeof nul - 1);
+    CHECK(nc_star_cat_read_kstars(dat, &c) < 0 && nc_test_contains(nc_errmsg(), "stars.dat:1: a NUL byte at column 61"),
+          "a NUL byte: %s", nc_errmsg());
 
     /* 2. Proper motion: 1000 mas/yr north for 10 years is 10 arcsec. */
     struct nc_star s0 = {.ra_rad = 0.3, .dec_rad = 0.2, .pm_dec_mas_yr = 1000, .v_mag = 5};

@@ -291,6 +291,10 @@ int main(void)
     nc_test_write(path, "base: builtin:nothing\n");
     rc = nc_scene_load(path, NULL, 0, &s);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:1: base: unknown base"), "bad base: %s", nc_errmsg());
+    static const char nul[] = "base: builtin:default\ncamera:\n  width_px: 64\0 # and the rest\n";
+    nc_test_write_bytes(path, nul, sizeof nul - 1);
+    rc = nc_scene_load(path, NULL, 0, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:3: a NUL byte at column 15"), "NUL: %s", nc_errmsg());
 
     /* YAML aliases of aliases (nine times a level: a few lines, billions of values) are refused once the
      * tree passes the limit; nesting too deep is refused before libyaml's scanner, slow at depth, goes on. */

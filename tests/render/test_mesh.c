@@ -114,15 +114,29 @@ int main(void)
     expect_fail("mesh.stl", "solid\n", "unknown mesh format");
     rc = nc_mesh_load(nc_test_path("missing.obj"), 1.0, &m);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "missing.obj: cannot open mesh"), "missing: %s", nc_errmsg());
-    /* a NUL byte: the rest of its line would be lost unseen */
-    static const char nul[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\0 5\nf 1 2 3\n";
-    FILE *nf = fopen(nc_test_path("nul.obj"), "wb");
-    CHECK(nf && fwrite(nul, 1, sizeof nul - 1, nf) == sizeof nul - 1 && fclose(nf) == 0, "writing nul.obj");
-    rc = nc_mesh_load(nc_test_path("nul.obj"), 1.0, &m);
-    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "nul.obj:3: a NUL byte at column 8"), "NUL: %s",
-          rc < 0 ? nc_errmsg() : "loaded");
-    if (rc >= 0)
-        nc_mesh_free(&m);
+    /* a NUL byte in a text format: the rest of its line would be lost unseen */
+    static const struct {
+        const char *name, *needle;
+        char text[128];
+        size_t len;
+    } nul[] = {
+#define NUL_CASE(name, needle, text) {name, needle, text, sizeof text - 1}
+        NUL_CASE("nul.obj", "nul.obj:3: a NUL byte at column 8", "v 0 0 0\nv 1 0 0\nv 1 1 0\0 5\nf 1 2 3\n"),
+        NUL_CASE("nul.ply", "nul.ply:8: a NUL byte at column 6",
+                 "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                 "end_header\n0 0 0\0 7\n"),
+        NUL_CASE("nulh.ply", "nulh.ply:2: a NUL byte at column 7", "ply\nformat\0ascii 1.0\nend_header\n"),
+        NUL_CASE("nul.icq", "nul.icq:2: a NUL byte at column 6", "1\n0 0 1\0 2\n"),
+#undef NUL_CASE
+    };
+    for (size_t i = 0; i < sizeof nul / sizeof nul[0]; i++) {
+        nc_test_write_bytes(nc_test_path(nul[i].name), nul[i].text, nul[i].len);
+        rc = nc_mesh_load(nc_test_path(nul[i].name), 1.0, &m);
+        CHECK(rc < 0 && nc_test_contains(nc_errmsg(), nul[i].needle), "%s: %s", nul[i].name,
+              rc < 0 ? nc_errmsg() : "loaded");
+        if (rc >= 0)
+            nc_mesh_free(&m);
+    }
 
     /* PLY, ASCII with an extra element and property, then binary little and
      * big endian with double vertices and int indices. */

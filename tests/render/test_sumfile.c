@@ -293,6 +293,15 @@ int main(void)
           "D notation: %s", nc_errmsg());
 
     char bad[2048];
+    /* a NUL byte after a label: the rest of the line would be lost unseen */
+    const size_t glen = strlen(good), at = (size_t)(strstr(good, "SCOBJ\n") - good) + 5;
+    memcpy(bad, good, glen);
+    memmove(bad + at + 4, bad + at, glen - at);
+    memcpy(bad + at, "\0 .1", 4);
+    nc_test_write_bytes(nc_test_path("nul.SUM"), bad, glen + 4);
+    CHECK(nc_sumfile_read(nc_test_path("nul.SUM"), &sum) < 0 &&
+              nc_test_contains(nc_errmsg(), "nul.SUM:5: a NUL byte at column 68"),
+          "NUL: %s", nc_errmsg());
     snprintf(bad, sizeof bad, "%.*s", (int)(strstr(good, "   -0.8728") - good), good); /* no CZ and after */
     expect_error(bad, NULL, 0, "no CZ line");
     replaced(bad, sizeof bad, good, "   -0.8728715609D+00    0.4364357805D+00   -0.2182178902D+00",

@@ -1,0 +1,38 @@
+/* lines.c - a text file read a line at a time (lines.h). */
+#include "core/lines.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/types.h>
+
+#include "core/error.h"
+
+void nc_lines_init(struct nc_lines *l, FILE *f, const char *path, int code)
+{
+    *l = (struct nc_lines){.f = f, .path = path, .code = code};
+}
+
+int nc_lines_next(struct nc_lines *l)
+{
+    errno = 0;
+    const ssize_t n = getline(&l->line, &l->cap, l->f);
+    if (n <= 0) {
+        if (ferror(l->f))
+            return nc_error(-EIO, "%s:%zu: cannot read: %s", l->path, l->no + 1, strerror(errno ? errno : EIO));
+        return 0;
+    }
+    l->no++;
+    l->len = (size_t)n;
+    const size_t c = strlen(l->line);
+    if (c != l->len)
+        return nc_error(l->code, "%s:%zu: a NUL byte at column %zu (a binary or damaged file?)", l->path, l->no, c + 1);
+    return 1;
+}
+
+void nc_lines_free(struct nc_lines *l)
+{
+    free(l->line);
+    l->line = NULL;
+    l->cap = 0;
+}
