@@ -11,6 +11,8 @@
 #include <yaml.h>
 
 #include "core/error.h"
+#include "core/grow.h"
+#include "core/lines.h"
 
 static void node_free(struct nc_cfg_node *n)
 {
@@ -115,15 +117,27 @@ void nc_cfg_where(const struct nc_cfg_node *node, char *buf, size_t len)
  * lines would take gigabytes). */
 #define NC_CFG_MAX_VALUES 200000
 
-static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, const char *origin, int depth,
-                   long *left, struct nc_cfg_node **out)
+/* ":LINE" of a text with lines (a file), "" for one without (a --set value) */
+static const char *at_line(char buf[16], int line)
 {
-    int line = (int)yn->start_mark.line + 1;
+    if (line > 0)
+        snprintf(buf, 16, ":%d", line);
+    else
+        buf[0] = '\0';
+    return buf;
+}
+
+/* A YAML node of a text with lines (with_line) or of a --set value. */
+static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, const char *origin, int with_line,
+                   int depth, long *left, struct nc_cfg_node **out)
+{
+    int line = with_line ? (int)yn->start_mark.line + 1 : 0;
+    char at[16];
     if (depth > 32)
-        return nc_error(NC_ECONFIG, "%s:%d: nesting deeper than 32 levels", origin, line);
+        return nc_error(NC_ECONFIG, "%s%s: nesting deeper than 32 levels", origin, at_line(at, line));
     if (--*left < 0)
-        return nc_error(NC_ECONFIG, "%s:%d: the configuration expands to more than %d values (YAML aliases that "
-                        "repeat large parts?)", origin, line, NC_CFG_MAX_VALUES);
+        return nc_error(NC_ECONFIG, "%s%s: the configuration expands to more than %d values (YAML aliases that "
+                        "repeat large parts?)", origin, at_line(at, line), NC_CFG_MAX_VALUES);
     struct nc_cfg_node *n = NULL;
     int rc = 0;
     switch (yn->type) {
@@ -138,7 +152,7 @@ static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, co
             goto nomem;
         for (yaml_node_item_t *it = yn->data.sequence.items.start; it < yn->data.sequence.items.top; it++) {
             struct nc_cfg_node *c;
-            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, *it), origin, depth + 1, left, &c)) < 0)
+            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, *it), origin, with_line, depth + 1, left, &c)) < 0)
                 goto fail;
             if ((rc = node_append(n, c)) < 0) {
                 node_free(c);
@@ -152,9 +166,9 @@ static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, co
             goto nomem;
         for (yaml_node_pair_t *p = yn->data.mapping.pairs.start; p < yn->data.mapping.pairs.top; p++) {
             yaml_node_t *k = yaml_document_get_node(doc, p->key);
-            int kline = (int)k->start_mark.line + 1;
+            int kline = with_line ? (int)k->start_mark.line + 1 : 0;
             if (k->type != YAML_SCALAR_NODE) {
-                rc = nc_error(NC_ECONFIG, "%s:%d: map keys must be plain words", origin, kline);
+                rc = nc_error(NC_ECONFIG, "%s%s: map keys must be plain words", origin, at_line(at, kline));
                 goto fail;
             }
             const char *ks = (const char *)k->data.scalar.value;
@@ -162,13 +176,15 @@ static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, co
                 if (strcmp(n->child[i]->key, ks) == 0) {
                     char path[256];
                     nc_cfg_path(n->child[i], path, sizeof path);
-                    rc = nc_error(NC_ECONFIG, "%s:%d: key '%s' appears twice in the same map (first at line %d)",
-                                  origin, kline, ks, n->child[i]->line);
+                    rc = with_line ? nc_error(NC_ECONFIG, "%s:%d: key '%s' appears twice in the same map (first at "
+                                              "line %d)", origin, kline, ks, n->child[i]->line)
+                                   : nc_error(NC_ECONFIG, "%s: key '%s' appears twice in the same map", origin, ks);
                     goto fail;
                 }
             }
             struct nc_cfg_node *c;
-            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, p->value), origin, depth + 1, left, &c)) < 0)
+            if ((rc = convert(cfg, doc, yaml_document_get_node(doc, p->value), origin, with_line, depth + 1, left,
+                              &c)) < 0)
                 goto fail;
             c->line = kline;
             if (!(c->key = strdup(ks)) || node_append(n, c) < 0) {
@@ -178,7 +194,7 @@ static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, co
         }
         break;
     default:
-        rc = nc_error(NC_ECONFIG, "%s:%d: empty YAML node", origin, line);
+        rc = nc_error(NC_ECONFIG, "%s%s: empty YAML node", origin, at_line(at, line));
         goto fail;
     }
     *out = n;
@@ -195,8 +211,9 @@ fail:
  * quadratic in the nesting (100 000 brackets: half a minute), so it is
  * stopped at the first level too deep. 0 also for a syntax error (the
  * loader reports it). */
-static int too_deep(const char *text, size_t len, const char *origin)
+static int too_deep(const char *text, size_t len, const char *origin, int with_line)
 {
+    char at[16];
     yaml_parser_t parser;
     if (!yaml_parser_initialize(&parser))
         return 0;
@@ -207,7 +224,8 @@ static int too_deep(const char *text, size_t len, const char *origin)
         if (!yaml_parser_parse(&parser, &ev))
             break;
         if ((ev.type == YAML_SEQUENCE_START_EVENT || ev.type == YAML_MAPPING_START_EVENT) && ++depth > 33)
-            rc = nc_error(NC_ECONFIG, "%s:%d: nesting deeper than 32 levels", origin, (int)ev.start_mark.line + 1);
+            rc = nc_error(NC_ECONFIG, "%s%s: nesting deeper than 32 levels", origin,
+                          at_line(at, with_line ? (int)ev.start_mark.line + 1 : 0));
         depth -= ev.type == YAML_SEQUENCE_END_EVENT || ev.type == YAML_MAPPING_END_EVENT;
         done = ev.type == YAML_STREAM_END_EVENT;
         yaml_event_delete(&ev);
@@ -222,17 +240,16 @@ static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const ch
 {
     yaml_parser_t parser;
     yaml_document_t doc;
-    int rc = too_deep(text, len, origin);
+    int rc = too_deep(text, len, origin, with_line);
     if (rc < 0)
         return rc;
     if (!yaml_parser_initialize(&parser))
         return nc_error(-ENOMEM, "%s: cannot initialise the YAML parser", origin);
     yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
     if (!yaml_parser_load(&parser, &doc)) {
-        char where[32] = "";
-        if (with_line)
-            snprintf(where, sizeof where, ":%d", (int)parser.problem_mark.line + 1);
-        rc = nc_error(NC_ECONFIG, "%s%s: YAML syntax error: %s%s%s", origin, where,
+        char at[16];
+        rc = nc_error(NC_ECONFIG, "%s%s: YAML syntax error: %s%s%s", origin,
+                      at_line(at, with_line ? (int)parser.problem_mark.line + 1 : 0),
                       parser.problem ? parser.problem : "unknown", parser.context ? " " : "",
                       parser.context ? parser.context : "");
         yaml_parser_delete(&parser);
@@ -243,7 +260,7 @@ static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const ch
     if (!root)
         *out = NULL;
     else
-        rc = convert(cfg, &doc, root, origin, 0, &left, out);
+        rc = convert(cfg, &doc, root, origin, with_line, 0, &left, out);
     yaml_document_delete(&doc);
     yaml_parser_delete(&parser);
     return rc;
@@ -276,41 +293,23 @@ int nc_cfg_load_file(struct nc_cfg *cfg, const char *path)
     FILE *f = fopen(path, "rb");
     if (!f)
         return nc_error(-errno, "%s: cannot open: %s", path, strerror(errno));
+    struct nc_lines ln; /* a NUL byte named by its line and column */
+    nc_lines_init(&ln, f, path, NC_ECONFIG);
     char *buf = NULL;
     size_t len = 0, cap = 0;
-    for (;;) {
-        if (len + 4096 + 1 > cap) {
-            cap = cap ? 2 * cap : 65536;
-            char *b = realloc(buf, cap);
-            if (!b) {
-                free(buf);
-                fclose(f);
-                return nc_error(-ENOMEM, "%s: out of memory", path);
-            }
-            buf = b;
-        }
-        size_t got = fread(buf + len, 1, cap - len - 1, f);
-        len += got;
-        if (got == 0)
+    int rc;
+    while ((rc = nc_lines_next(&ln)) > 0) {
+        if (nc_grow((void **)&buf, &cap, len + ln.len + 1, 1) < 0) {
+            rc = nc_error(-ENOMEM, "%s: out of memory", path);
             break;
+        }
+        memcpy(buf + len, ln.line, ln.len + 1);
+        len += ln.len;
     }
-    int err = ferror(f);
+    nc_lines_free(&ln);
     fclose(f);
-    if (err) {
-        free(buf);
-        return nc_error(-EIO, "%s: read error", path);
-    }
-    buf[len] = '\0';
-    const char *nul = memchr(buf, '\0', len);
-    if (nul) {
-        size_t line = 1, col = 1;
-        for (const char *p = buf; p < nul; p++, col++)
-            if (*p == '\n')
-                line++, col = 0;
-        free(buf);
-        return nc_error(NC_ECONFIG, "%s:%zu: a NUL byte at column %zu (a binary or damaged file?)", path, line, col);
-    }
-    int rc = nc_cfg_load_string(cfg, buf, path);
+    if (rc == 0)
+        rc = nc_cfg_load_string(cfg, buf ? buf : "", path);
     free(buf);
     return rc;
 }

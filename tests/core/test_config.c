@@ -316,6 +316,16 @@ int main(void)
                   nc_test_contains(nc_errmsg(), "deep.yaml:1: nesting deeper than 32 levels"),
               "deep nesting: %s", nc_errmsg());
         nc_cfg_free(&cfg);
+        /* a --set value has no lines: its errors name the --set alone */
+        const char *set[] = {"camera={a: [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[1]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]}",
+                             "camera={a: 1, a: 2}"};
+        const char *needle[] = {"]}: nesting deeper than 32 levels", "2}: key 'a' appears twice in the same map"};
+        for (int i = 0; i < 2; i++) {
+            nc_cfg_init(&cfg);
+            CHECK(nc_cfg_set(&cfg, set[i]) < 0 && nc_test_contains(nc_errmsg(), needle[i]), "--set %s: %s", set[i],
+                  nc_errmsg());
+            nc_cfg_free(&cfg);
+        }
     }
     free(bomb), free(deep);
 
