@@ -71,6 +71,9 @@ struct v4l2_out {
     long tries;
     unsigned long written, lost, reopened;
     unsigned long lost_at_close; /* lost when the device was closed: the outage's own count is lost less this */
+    /* the frame interval the driver kept (0/0: it keeps none), and how often a reader changed it */
+    struct v4l2_fract interval;
+    unsigned long interval_resets;
 };
 
 static int xioctl(int fd, unsigned long req, void *arg)
@@ -240,6 +243,7 @@ static int setup(struct v4l2_out *v)
     p.parm.output.timeperframe.denominator = (uint32_t)lround(v->fps * 1000);
     if (xioctl(v->fd, VIDIOC_S_PARM, &p) < 0 && errno != ENOTTY && errno != EINVAL)
         return fail_setup(v, -errno, "VIDIOC_S_PARM: %s", strerror(errno));
+    v->interval = xioctl(v->fd, VIDIOC_G_PARM, &p) == 0 ? p.parm.output.timeperframe : (struct v4l2_fract){0, 0};
     /* write() for v4l2loopback (its mmap output tears frames) and for
      * devices without streaming I/O; mmap streaming otherwise (the vb2
      * write() emulation of Linux 6.1 queues output buffers with a zero
@@ -426,6 +430,24 @@ static int put_mmap(struct v4l2_out *v, const struct nc_frame_record *r)
     return 0;
 }
 
+/* v4l2loopback keeps one frame interval for the device, which any reader may set (VIDIOC_S_PARM on the capture
+ * side) for every reader: it is read back after each frame and set again where it changed. */
+static void keep_interval(struct v4l2_out *v)
+{
+    struct v4l2_streamparm p = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT};
+    if (!v->interval.numerator || !v->interval.denominator || xioctl(v->fd, VIDIOC_G_PARM, &p) < 0)
+        return;
+    const struct v4l2_fract got = p.parm.output.timeperframe;
+    if (got.numerator == v->interval.numerator && got.denominator == v->interval.denominator)
+        return;
+    if (!v->interval_resets++)
+        nc_log_warn("output/v4l2", "%s: a reader set the frame interval to %u/%u s; set back to %u/%u s (%g Hz), as "
+                    "whenever it changes", v->path, got.numerator, got.denominator, v->interval.numerator,
+                    v->interval.denominator, (double)v->interval.denominator / v->interval.numerator);
+    p.parm.output.timeperframe = v->interval;
+    xioctl(v->fd, VIDIOC_S_PARM, &p);
+}
+
 static int v4l2_submit(void *priv, const struct nc_frame_record *r)
 {
     struct v4l2_out *v = priv;
@@ -456,6 +478,7 @@ static int v4l2_submit(void *priv, const struct nc_frame_record *r)
     int rc = v->io == IO_MMAP ? put_mmap(v, r) : put_write(v, r);
     if (rc == 0) {
         v->written++;
+        keep_interval(v);
         return 0;
     }
     v->lost++;
@@ -477,9 +500,9 @@ static void v4l2_close(void *priv)
 {
     struct v4l2_out *v = priv;
     disconnect(v);
-    if (v->lost || v->reopened)
-        nc_log_info("output/v4l2", "%lu frames written, %lu lost, %lu reopens", v->written, v->lost,
-                v->reopened);
+    if (v->lost || v->reopened || v->interval_resets)
+        nc_log_info("output/v4l2", "%lu frames written, %lu lost, %lu reopens, frame interval set back %lu times",
+                    v->written, v->lost, v->reopened, v->interval_resets);
     free(v->buf);
 }
 

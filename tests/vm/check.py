@@ -197,6 +197,11 @@ size = row * (dframes[0][1] + 1) if dframes else 0
 got = [raw[i:i + size] for i in range(0, len(raw), size)] if size else []
 check(len(got) == 5 and len(raw) == 5 * size, f"D: v4l2-ctl wrote {len(raw)} bytes: {len(got)} frames of {size}")
 check("'Y16 '" in open(os.path.join(out, "d/fmt.log")).read(), "D: the reader negotiated Y16")
+dlog = open(os.path.join(out, "d/serve.log")).read()
+check("30.000" in open(os.path.join(out, "d/parm_set.log")).read() and
+      "Frames per second: 10.000" in open(os.path.join(out, "d/parm.log")).read() and
+      "a reader set the frame interval to" in dlog and "(10 Hz), as whenever it changes" in dlog,
+      "D: a reader's 30 fps for the device was set back to the camera's 10 fps (and logged)")
 by_number = {r["frame"]: (r, dn) for r, (_, _, dn) in zip(drecs, dframes)}
 matched = []
 for g in got:

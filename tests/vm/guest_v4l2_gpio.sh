@@ -134,6 +134,14 @@ done
 timeout 60 v4l2-ctl -d /dev/video3 --stream-mmap --stream-count 5 --stream-to d/frames.raw >d/ctl.log 2>&1 ||
     { echo "v4l2-ctl failed"; cat d/ctl.log; }
 v4l2-ctl -d /dev/video3 --get-fmt-video >d/fmt.log 2>&1 || true
+# A reader sets another frame rate for the device (v4l2loopback keeps one
+# for every reader): NavCam sets its own back with its next frame.
+v4l2-ctl -d /dev/video3 --set-parm=30 >d/parm_set.log 2>&1 || true
+for _ in $(seq 50); do
+    v4l2-ctl -d /dev/video3 --get-parm >d/parm.log 2>&1 || true
+    grep -q "Frames per second: 10.000" d/parm.log && break
+    sleep 0.1
+done
 stop_serve d
 
 step "checks"
