@@ -1,6 +1,7 @@
 /* cli.c - the commands' shared start-up, error reporting and JSON members (cli.h). */
 #include "app/cli.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
 #include <libgen.h>
 #include <math.h>
@@ -64,15 +65,13 @@ int nc_cli_threads(const char *s, int *out)
     return 0;
 }
 
-void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const char *path,
-                    const char *const *extra, int n_extra)
+void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const char *path)
 {
     snprintf(buf, len, "camera={sumfile: '%s'}", path);
-    memmove(sets + 1 + n_extra, sets, (size_t)*nsets * sizeof *sets);
+    memmove(sets + 2, sets, (size_t)*nsets * sizeof *sets);
     sets[0] = buf;
-    for (int i = 0; i < n_extra; i++)
-        sets[1 + i] = extra[i];
-    *nsets += 1 + n_extra;
+    sets[1] = "sun.direction=null"; /* the SUM file's SZ gives it */
+    *nsets += 2;
 }
 
 int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out)
@@ -85,6 +84,16 @@ int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *
     }
     *out = v;
     return 0;
+}
+
+int nc_cli_host(const char *s)
+{
+    struct in_addr a;
+    if (inet_pton(AF_INET, s, &a) == 1)
+        return 0;
+    fprintf(stderr, "%s: --host expects a numeric IPv4 address such as 127.0.0.1 (names are not looked up), got '%s'\n",
+            name, s);
+    return -1;
 }
 
 int nc_cli_gnuplot(const char *dir, const char *script)

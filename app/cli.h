@@ -16,16 +16,18 @@ int nc_cli_fail(void);
  * "navcam CMD: --opt expects lo..hi, got 's'" on stderr and -1. */
 int nc_cli_long(const char *opt, const char *s, long lo, long hi, long *out);
 int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out);
+/* --host: 0 for a numeric IPv4 address; -1 with the option named on stderr
+ * for anything else (names are never looked up). */
+int nc_cli_host(const char *s);
 /* -j, --threads: 1 to 1024, or 0 for every online core (as render.threads:
  * 0), which then overrides render.threads; as nc_cli_long otherwise. */
 int nc_cli_threads(const char *s, int *out);
 
-/* --sumfile X.SUM: "camera={sumfile: 'X.SUM'}" put before the other
- * --set arguments (so that a --set camera.KEY still adds to it), then the
- * n_extra texts of extra; buf (len bytes) holds the first. sets has room
- * for them. */
-void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const char *path,
-                    const char *const *extra, int n_extra);
+/* --sumfile X.SUM: "camera={sumfile: 'X.SUM'}" and "sun.direction=null"
+ * (the SUM file's SZ gives the Sun's direction) put before the other --set
+ * arguments, so that a --set camera.KEY still adds to them; buf (len bytes)
+ * holds the first. sets has room for two more. */
+void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const char *path);
 
 /* Where a command writes its results: *f is the file path (opened for
  * writing), or standard output when path is NULL; 0 or a negative error

@@ -24,10 +24,12 @@
 #include "render/rt.h"
 
 static const char batch_help[] =
-    "Usage: navcam batch TRAJ.csv -o DIR [--scene SCENE.yaml] [--set KEY=VALUE]... [options]\n"
+    "Usage: navcam batch TRAJ.csv|builtin:approach -o DIR [--scene SCENE.yaml] [--set KEY=VALUE]...\n"
+    "                    [options]\n"
     "\n"
     "Render every row of TRAJ.csv (the layouts of `navcam replay --help`: pose rows,\n"
-    "or SPC SUM-like rows) with SCENE.yaml (default: the built-in scene) into DIR.\n"
+    "or SPC SUM-like rows; builtin:approach is replay's built-in approach of 8 poses)\n"
+    "with SCENE.yaml (default: the built-in scene) into DIR.\n"
     "Row i (0-based, counting data rows; rows with capture 0 are skipped) gives:\n"
     "  DIR/frame_NNNNNN.EXT            the frame (--quantity, --format); the camera\n"
     "                                  model's noise is keyed by i, so a frame's\n"
@@ -50,7 +52,7 @@ static const char batch_help[] =
     "  -s, --set KEY=VALUE   override a scene key (as navcam render); repeatable\n"
     "  -q, --quantity Q      dn (default), electrons, radiance, iof, range or rock_id\n"
     "  -F, --format EXT      fits (default), tif, exr or png\n"
-    "  -e, --exposure T      exposure time, s (default: exposure.time_s)\n"
+    "  -e, --exposure T      exposure time, s, 0..3600 (default: exposure.time_s)\n"
     "      --shard K/N       render only rows i with i mod N = K (0 <= K < N): N\n"
     "                        processes, e.g. a Slurm job array with\n"
     "                        --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT,\n"
@@ -60,8 +62,8 @@ static const char batch_help[] =
     "                        each row gives the pose and the Sun): replaces the camera\n"
     "                        section with {sumfile: X.SUM} and takes sun.direction out\n"
     "                        (docs/sumfiles.md)\n"
-    "  -j, --threads N       render threads (default: render.threads, else all cores;\n"
-    "                        0: all cores)\n"
+    "  -j, --threads N       render threads, 0..1024 (default: render.threads, else all\n"
+    "                        cores; 0: all cores)\n"
     "  -h, --help            this help\n";
 
 static void json_vec(FILE *f, const char *key, const double *v, int n, const char *sep)
@@ -357,7 +359,7 @@ int main(int argc, char **argv)
         {"sumfile", required_argument, NULL, 'U'},  {NULL, 0, NULL, 0},
     };
     const char *dir = NULL, *scene_path = NULL, *ext = "fits";
-    const char **sets = calloc((size_t)argc + 2, sizeof *sets);
+    const char **sets = calloc(2 * (size_t)argc + 2, sizeof *sets); /* --sumfile=X adds two */
     char sumset[4200];
     int nsets = 0, threads = 0, geometry = 1, c;
     long shard_k = 0, shard_n = 1;
@@ -374,7 +376,7 @@ int main(int argc, char **argv)
         case 's': sets[nsets++] = optarg; break;
         case 'G': geometry = 0; break;
         case 'U': /* the rows give the pose and the Sun: the file's SZ and the scene's direction are not used */
-            nc_cli_sumfile(sets, &nsets, sumset, sizeof sumset, optarg, (const char *[]){"sun.direction=null"}, 1);
+            nc_cli_sumfile(sets, &nsets, sumset, sizeof sumset, optarg);
             break;
         case 'F':
             ext = optarg;
@@ -385,7 +387,7 @@ int main(int argc, char **argv)
             break;
         case 'q':
             if (nc_quantity_parse(optarg, &q) < 0) {
-                fprintf(stderr, "navcam batch: %s\n", nc_errmsg());
+                fprintf(stderr, "navcam batch: --quantity: %s\n", nc_errmsg());
                 goto usage;
             }
             break;

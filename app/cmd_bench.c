@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <sys/stat.h>
 
 #include "app/bench_accuracy.h"
@@ -285,7 +286,12 @@ int main(int argc, char **argv)
     fclose(gp);
     if (rc < 0)
         return nc_cli_fail();
-    if (!nplots) {
+    if (!nplots) { /* no empty results left behind */
+        static const char *const made[] = {"accuracy.csv", "accuracy_front.csv", "accuracy.gp"};
+        for (int i = 0; i < 3; i++) {
+            snprintf(path, sizeof path, "%s/%s", dir, made[i]);
+            unlink(path);
+        }
         fprintf(stderr, "navcam bench: every scene asked for was skipped: nothing measured, no chart\n");
         return 1;
     }

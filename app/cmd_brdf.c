@@ -43,7 +43,9 @@ static const char brdf_help[] =
     "\n"
     "Examples:\n"
     "  navcam brdf --model hapke --param w=0.3 --param b=0.25 --param theta_bar=20 --geometry 30,0,30\n"
-    "  printf 'i,e,g\\n30,30,0\\n60,0,60\\n' | navcam brdf --preset comet_67p\n";
+    "  printf 'i,e,g\\n30,30,0\\n60,0,60\\n' | navcam brdf --preset comet_67p\n"
+    "\n"
+    "Exit status: 0 done, 1 a bad line of standard input, 2 a bad option or option value.\n";
 
 static void describe_models(char *buf, size_t len)
 {
@@ -152,17 +154,20 @@ int main(int argc, char **argv)
         fprintf(stderr, "navcam brdf: give --model NAME or --preset NAME\nTry 'navcam brdf --help'.\n");
         goto out;
     }
-    rc = 1;
+    /* a bad option value exits 2, naming the option; a bad line of standard input, 1 */
+    const char *opt = preset ? "--preset" : "--model";
     if (preset) {
         if (nc_material_preset(&m, preset) < 0)
             goto fail;
         if (model && strcmp(model, m.model->name) != 0) {
-            fprintf(stderr, "navcam brdf: preset '%s' is a %s material, not %s\n", preset, m.model->name, model);
+            fprintf(stderr, "navcam brdf: --preset '%s' is a %s material, not --model %s\n", preset, m.model->name,
+                    model);
             goto out;
         }
     } else if (nc_material_init(&m, model) < 0) {
         goto fail;
     }
+    opt = "--param";
     for (int k = 0; k < nparams; k++) {
         const char *eq = strchr(params[k], '=');
         char key[64], *end;
@@ -181,6 +186,7 @@ int main(int argc, char **argv)
     }
     if (nc_material_finish(&m) < 0)
         goto fail;
+    opt = "--geometry";
     if (geometry) {
         double v[3];
         const int bad = parse_geometry(geometry, v);
@@ -189,7 +195,7 @@ int main(int argc, char **argv)
                     field_names[-1 - bad]);
             goto out;
         }
-        rc = print_brdf_row(&m, v[0], v[1], v[2], "--geometry") < 0 ? 1 : 0;
+        rc = print_brdf_row(&m, v[0], v[1], v[2], "--geometry") < 0 ? 2 : 0;
         goto out;
     }
     char *line = NULL;
@@ -221,7 +227,7 @@ int main(int argc, char **argv)
     free(line);
     goto out;
 fail:
-    fprintf(stderr, "navcam brdf: %s\n", nc_errmsg());
+    fprintf(stderr, "navcam brdf: %s: %s\n", opt, nc_errmsg());
 out:
     free(params);
     return rc;

@@ -28,9 +28,10 @@ static const char expose_help[] =
     "  CAMERA.yaml            camera (intrinsics), optics, sensor and exposure sections;\n"
     "                         a whole scene file works too (its pose, bodies and Sun\n"
     "                         are ignored)\n"
-    "  -L, --radiance L       uniform scene radiance, W m^-2 sr^-1\n"
+    "  -L, --radiance L       uniform scene radiance, W m^-2 sr^-1 (0 or more)\n"
     "  -e, --exposure T       exposure time, seconds, 0 to 3600 (default: exposure.time_s)\n"
-    "  -n, --frames N         number of frames (default 1), numbered from --first-frame\n"
+    "  -n, --frames N         number of frames, 1 to 100000 (default 1), numbered from\n"
+    "                         --first-frame\n"
     "      --first-frame K    frame number of the first frame (keys the noise; default 0)\n"
     "  -d, --dark             dark frames: no light (radiance 0)\n"
     "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N), 16-bit unsigned (8-bit\n"
@@ -71,9 +72,12 @@ int main(int argc, char **argv)
             v = strtod(optarg, &end);
             if (*end || !isfinite(v) || v < 0 || ((c == 'n' || c == 'F') && v != floor(v)) ||
                 (c == 'n' && (v < 1 || v > 100000)) || (c == 'e' && v > 3600)) {
-                fprintf(stderr, "navcam expose: bad value '%s' for --%s%s\n", optarg,
+                fprintf(stderr, "navcam expose: bad value '%s' for --%s (%s)\n", optarg,
                         c == 'L' ? "radiance" : c == 'e' ? "exposure" : c == 'n' ? "frames" : "first-frame",
-                        c == 'e' ? " (seconds, 0 to 3600, as exposure.time_s)" : "");
+                        c == 'L'   ? "W m^-2 sr^-1, 0 or more"
+                        : c == 'e' ? "seconds, 0 to 3600, as exposure.time_s"
+                        : c == 'n' ? "a whole number, 1 to 100000"
+                                   : "a whole number, 0 or more");
                 goto out;
             }
         }

@@ -29,6 +29,7 @@ static const char pose_help[] =
     "      --tcp              over TCP, waiting for the FRAME answer when capturing\n"
     "  -H, --host ADDR        numeric IPv4 address (default 127.0.0.1)\n"
     "  -p, --port N           1 to 65535 (default 5750 for UDP, 5751 for TCP)\n"
+    "  -h, --help             this help\n"
     "Values the protocol refuses (docs/protocol.md) are refused here, naming the option.\n"
     "Exit status: 0 sent (and, with --tcp --capture, the frame delivered), 1 not\n"
     "sent or no answer, 2 a bad option, 3 the frame dropped (the answer's status).\n";
@@ -106,7 +107,12 @@ int main(int argc, char **argv)
             m.gain_db = v, m.flags |= NC_MSG_GAIN;
             break;
         case 'C': tcp = 1; break;
-        case 'H': host = optarg; break;
+        case 'H':
+            if (nc_cli_host(host = optarg) < 0) {
+                fputs("Try 'navcam pose send --help'.\n", stderr);
+                return 2;
+            }
+            break;
         case 'p':
             if (parse_vec(optarg, &v, 1, &why) < 0 ||
                 (why = "not a port, 1 to 65535", !(v >= 1 && v <= 65535 && v == floor(v))))

@@ -26,8 +26,8 @@ static const char render_help[] =
     "\n"
     "Render one frame of SCENE.yaml (or of the built-in default scene) to OUT.\n"
     "\n"
-    "  -o, --output FILE      output image; the extension picks the format:\n"
-    "                           .exr .tif .fits  float32 physical values\n"
+    "  -o, --output FILE      output image; the extension (any case) picks the format:\n"
+    "                           .exr .tif/.tiff .fits/.fit/.fts  float32 physical values\n"
     "                           .png             16-bit linear preview, 65535 = the\n"
     "                                            brightest pixel; the scale is in the\n"
     "                                            file's metadata (navcam:preview_scale)\n"
@@ -41,8 +41,10 @@ static const char render_help[] =
     "                         electrons  noise-free photo-electrons through the optics\n"
     "                                    and PSF: the ground truth of a DN frame\n"
     "                         dn         the digitised frame: noise, full well, gain,\n"
-    "                                    bias, ADC (16-bit files; 8-bit for an 8-bit ADC)\n"
-    "  -e, --exposure T       exposure time in seconds (default: exposure.time_s)\n"
+    "                                    bias, ADC (16-bit PNG, TIFF and FITS, 8-bit\n"
+    "                                    for an 8-bit ADC; float32 EXR)\n"
+    "  -e, --exposure T       exposure time in seconds, 0 to 3600 (default:\n"
+    "                         exposure.time_s)\n"
     "  -f, --frame N          frame number: keys the noise (default 0)\n"
     "  -s, --set KEY=VALUE    override any configuration key by its dotted path;\n"
     "                         VALUE is YAML. Repeatable. Lists index by number;\n"
@@ -51,12 +53,13 @@ static const char render_help[] =
     "                           --set bodies.0.material.w=0.07\n"
     "                           --set render.samples_per_pixel=16\n"
     "                           --set optics.f_number=null --set optics.aperture_diameter_m=0.01\n"
-    "  -j, --threads N        render threads (default: render.threads, else all\n"
-    "                         cores; 0: all cores); the image does not depend on N\n"
+    "  -j, --threads N        render threads, 0 to 1024 (default: render.threads, else\n"
+    "                         all cores; 0: all cores); the image does not depend on N\n"
     "      --sumfile X.SUM    the camera and pose of an SPC SUM file: replaces the\n"
-    "                         camera section with {sumfile: X.SUM}; the Sun's direction\n"
-    "                         comes from it too, give its distance with\n"
-    "                         --set sun={distance_au: D} (docs/sumfiles.md)\n"
+    "                         camera section with {sumfile: X.SUM} and takes\n"
+    "                         sun.direction out (the Sun's direction comes from it\n"
+    "                         too); give its distance with --set sun.distance_au=D\n"
+    "                         (docs/sumfiles.md)\n"
     "      --fits-rows ORDER  .fits only: top_down (default: row 1 is the top image\n"
     "                         row, y = 0) or bottom_up (row 1 at the bottom, as FITS\n"
     "                         viewers and mission archives show it); the keyword\n"
@@ -83,7 +86,7 @@ int main(int argc, char **argv)
     const char *out = NULL, *scene_path = NULL, *rows = NULL;
     double exposure = -1;
     unsigned long long frame_no = 0;
-    const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+    const char **sets = calloc(2 * (size_t)argc + 2, sizeof *sets); /* --sumfile=X adds two */
     char sumset[4200];
     int nsets = 0, threads = 0, c;
     enum nc_quantity q = NC_Q_RADIANCE;
@@ -95,7 +98,7 @@ int main(int argc, char **argv)
         case 'o': out = optarg; break;
         case 'R': rows = optarg; break;
         case 'S': /* first, so that --set camera.X=... can still add to it */
-            nc_cli_sumfile(sets, &nsets, sumset, sizeof sumset, optarg, NULL, 0);
+            nc_cli_sumfile(sets, &nsets, sumset, sizeof sumset, optarg);
             break;
         case 'e':
         case 'f': {
@@ -123,7 +126,7 @@ int main(int argc, char **argv)
         case 'q':
             if (nc_quantity_parse(optarg, &q) < 0) {
                 free(sets);
-                fprintf(stderr, "navcam render: %s\n", nc_errmsg());
+                fprintf(stderr, "navcam render: --quantity: %s\n", nc_errmsg());
                 return 2;
             }
             break;
@@ -140,7 +143,8 @@ int main(int argc, char **argv)
         return 2;
     }
     if (!nc_image_format_ok(out, NULL)) {
-        fprintf(stderr, "navcam render: %s: unsupported output format (use .exr, .tif, .fits or .png)\n", out);
+        fprintf(stderr, "navcam render: %s: unsupported output format (use .exr, .tif or .tiff, .fits, .fit or .fts, "
+                        "or .png, in any case)\n", out);
         free(sets);
         return 2;
     }

@@ -89,7 +89,7 @@ int main(int argc, char **argv)
                 bad = 1;
             }
             break;
-        case 'H': host = optarg; break;
+        case 'H': bad = nc_cli_host(host = optarg); break;
         case 'p': bad = nc_cli_long("port", optarg, 1, 65535, &port); break;
         case 'T': bad = nc_cli_long("timeout-ms", optarg, 1, 86400000, &timeout_ms); break;
         case 'w': bad = nc_cli_double("wait", optarg, 0, 3600, &wait_s); break;

@@ -26,15 +26,17 @@ static const char serve_help[] =
     "            falling_edge, delay_s: 0.01, debounce_s: 0.001}'\n"
     "Listeners bind serve.bind (127.0.0.1) on serve.udp_port (5750) and\n"
     "serve.tcp_port (5751). SIGINT/SIGTERM: finish the frame in flight, flush the\n"
-    "outputs, print statistics (a JSON summary on stdout), exit 0.\n"
+    "outputs, print statistics (a JSON summary on stdout), exit 0. Exit status 1: the\n"
+    "configuration or a driver failed (the message says which); 2: a bad option.\n"
     "\n"
     "  -s, --set KEY=VALUE     override a configuration key (repeatable)\n"
-    "  -n, --max-frames N      stop once N frames were delivered or dropped (checked every\n"
-    "                          20 ms: a fast camera passes N by a few)\n"
-    "  -t, --max-seconds S     stop after S seconds\n"
-    "      --stats-json FILE   also write the summary to FILE\n"
-    "  -j, --threads N         render threads (default: render.threads, else all\n"
-    "                          cores; 0: all cores)\n"
+    "  -n, --max-frames N      stop once N (1 or more) frames were delivered or dropped\n"
+    "                          (checked every 20 ms: a fast camera passes N by a few)\n"
+    "  -t, --max-seconds S     stop after S seconds, 0.001 to 1e9\n"
+    "      --stats-json FILE   also write the summary to FILE (its directory is checked\n"
+    "                          at start; a failed write makes the exit status 1)\n"
+    "  -j, --threads N         render threads, 0 to 1024 (default: render.threads, else\n"
+    "                          all cores; 0: all cores)\n"
     "      --driver-docs       print the drivers' options as Markdown (docs/drivers.md) and exit\n"
     "  -h, --help              this help\n"
     "\n"
@@ -124,6 +126,10 @@ int main(int argc, char **argv)
         fputs("Try 'navcam serve --help'.\n", stderr);
         free(sets);
         return 2;
+    }
+    if (o.stats_json_path && nc_cli_dir_writable(o.stats_json_path) < 0) { /* before the run, not after it */
+        free(sets);
+        return 1;
     }
     if (optind < argc)
         o.scene_path = argv[optind++];

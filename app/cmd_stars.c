@@ -24,6 +24,7 @@ static const char stars_help[] =
     "  -o, --output INDEX   the index to write\n"
     "      --max-mag V      keep only stars of magnitude V or brighter (V included)\n"
     "info   count the stars of an index by magnitude, and time its loading.\n"
+    "  -h, --help           this help\n"
     "\n"
     "Use the index in a scene: stars: {catalogue: INDEX} (docs/stars.md).\n";
 

@@ -35,7 +35,8 @@ static const char main_help[] =
     "  population [SCENE.yaml]      every boulder and crater a scene generates, as CSV\n"
     "\n"
     "Options:\n"
-    "  -h, --help      this help; `navcam COMMAND --help` for a command\n"
+    "  -h, --help      this help; `navcam COMMAND --help` (or `navcam help COMMAND`) for a\n"
+    "                  command\n"
     "  -V, --version   print the version\n"
     "\n"
     "Examples:\n"
@@ -77,7 +78,10 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *cmd = argv[1];
-    if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
+    char **args = argv + 1, *help_args[3] = {NULL, "--help", NULL};
+    if (!strcmp(cmd, "help") && argc > 2) /* navcam help COMMAND: the command's --help */
+        cmd = argv[2], args = help_args;
+    else if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
         fputs(main_help, stdout);
         return 0;
     }
@@ -98,11 +102,11 @@ int main(int argc, char **argv)
          * messages then begin with */
         char prog[96];
         snprintf(prog, sizeof prog, "navcam %s", cmd);
-        argv[1] = prog;
-        execv(path, argv + 1);
+        args[0] = prog;
+        execv(path, args);
         fprintf(stderr, "navcam: %s: %s\n", path, strerror(errno));
         return 126;
     }
-    fprintf(stderr, "navcam: unknown command '%s'\n\n%s", cmd, main_help);
+    fprintf(stderr, "navcam: unknown %s '%s'\n\n%s", cmd[0] == '-' ? "option" : "command", cmd, main_help);
     return 2;
 }

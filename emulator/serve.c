@@ -272,10 +272,12 @@ int nc_serve(const struct nc_serve_options *opt)
         nc__serve_stats_json(e, el, stdout);
         FILE *f = opt->stats_json_path ? fopen(opt->stats_json_path, "w") : NULL;
         if (opt->stats_json_path && !f)
-            nc_log_error("emulator", "%s: %s", opt->stats_json_path, strerror(errno));
+            rc = nc_error(-errno, "--stats-json %s: %s", opt->stats_json_path, strerror(errno));
         if (f) {
             nc__serve_stats_json(e, el, f);
-            fclose(f);
+            const int bad = ferror(f);
+            if ((fclose(f) != 0 || bad) && rc >= 0)
+                rc = nc_error(-EIO, "--stats-json %s: write failed", opt->stats_json_path);
         }
     }
     teardown(e, have_scene, have_cs);

@@ -136,6 +136,14 @@ assert max(abs(a - float(b)) for a, b in zip(c['position_m'], r[1:4])) < 1e-6, (
 s = [float(v) for v in r[8:11]]; n = sum(v * v for v in s) ** 0.5
 assert max(abs(a - b / n) for a, b in zip(d['sun']['direction_body0'], s)) < 1e-9, d['sun']
 print('--sumfile: 96x64, fx 2000 px, the row pose')" || fail "--sumfile: not the SUM file's camera with the row's pose"
+# render --sumfile on a scene that gives sun.direction (the built-in one): the SUM file's SZ replaces it,
+# as docs/compare.md's example runs it
+"$navcam" render -o sumr.fits --sumfile cam.SUM --set sun.distance_au=3.6 --set render.samples_per_pixel=1 \
+  > sumr.txt 2>&1 || fail "render --sumfile with --set sun.distance_au: $(cat sumr.txt)"
+python3 -c "
+b = open('sumr.fits', 'rb').read(2880 * 4); cards = [b[i:i + 80].decode('latin-1') for i in range(0, len(b), 80)]
+n = {c[:8].strip(): c[10:30].strip() for c in cards if c[:5] == 'NAXIS'}
+assert (n['NAXIS1'], n['NAXIS2']) == ('96', '64'), n" || fail "render --sumfile: not the SUM file's size"
 
 # SUM-like rows are in bodies[0]'s frame: with the body moved and turned,
 # the camera moves with it and sees the same frame.

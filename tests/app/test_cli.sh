@@ -27,6 +27,8 @@ small=(--set camera.width_px=96 --set camera.height_px=96 --set bodies.0.shape.s
 
 expect 0 "render [SCENE.yaml] -o OUT" -- "$navcam" --help
 expect 0 "navcam 0." -- "$navcam" --version
+expect 0 "Usage: navcam render [SCENE.yaml] -o OUT" -- "$navcam" help render
+expect 2 "navcam: unknown option '--bogus'" -- "$navcam" --bogus
 expect 0 "--quantity" -- "$navcam" render --help
 expect 0 "--set KEY=VALUE" -- "$navcam" render --help
 expect 2 "Usage: navcam" -- "$navcam"
@@ -35,6 +37,9 @@ expect 2 "unknown command 'paint'" -- "$navcam" paint
 expect 0 "timer: a pulse train" -- "$navcam" serve --help
 expect 0 "rate_hz                default 10; 0.001..10000 Hz: pulses per second" -- "$navcam" serve --help
 expect 0 "strobe.active" -- "$navcam" serve --help
+# --stats-json into a directory that is not there fails at start, not after the run
+expect 1 "s.json: cannot write into directory '$tmp/none'" -- "$navcam" serve --stats-json "$tmp/none/s.json" -n 1 \
+  --set serve.udp_port=5798 --set serve.tcp_port=5799
 # docs/drivers.md is generated from the same tables (make docs).
 "$navcam" serve --driver-docs > "$tmp/drivers.md"
 diff -u "$src/docs/drivers.md" "$tmp/drivers.md" > "$tmp/drivers.diff" && ok ||
@@ -120,6 +125,9 @@ expect 2 "--gain abc: expected a number" -- "$navcam" pose send -P 0,-6000,0 -g 
 expect 2 "--attitude 0,0,0,0: not a unit quaternion" -- "$navcam" pose send -P 0,-6000,0 -A 0,0,0,0
 expect 2 "--sun 0,0,0: a zero vector" -- "$navcam" pose send -P 0,-6000,0 -S 0,0,0
 expect 2 "--exposure -1: not within 0 to 3600 s" -- "$navcam" pose send -P 0,-6000,0 -e -1
+# a host name is refused as a bad option (names are never looked up)
+expect 2 "--host expects a numeric IPv4 address such as 127.0.0.1" -- "$navcam" pose send -P 0,-6000,0 -H localhost
+expect 2 "--host expects a numeric IPv4 address such as 127.0.0.1" -- "$navcam" replay builtin:approach -H localhost
 expect 2 "--port 99999: not a port" -- "$navcam" pose send -P 0,-6000,0 -p 99999
 expect 1 "outputs[0].pattern: expected a file name with one %llu conversion" -- "$navcam" serve \
   --set "outputs=[{driver: file, pattern: 'x%s_llu.png'}]"
@@ -247,16 +255,19 @@ expect 1 "(field e)" -- sh -c "printf '30,x,0\n' | '$navcam' brdf --model lamber
 # a run refused at its first geometry prints no header
 out=$("$navcam" brdf --preset moon --geometry 30,20,50.0000015 2> /dev/null)
 [ -z "$out" ] && ok || bad "brdf: a refused geometry printed '$out'"
-expect 1 "phase angle g = 50.0000015 deg cannot occur with i = 30 and e = 20 (it must be within 10..50, give or take 1e-6" \
+expect 2 "phase angle g = 50.0000015 deg cannot occur with i = 30 and e = 20 (it must be within 10..50, give or take 1e-6" \
   -- "$navcam" brdf --preset moon --geometry 30,20,50.0000015
-expect 1 "parameter w must be in [0, 1], got 1.5" -- "$navcam" brdf --model hapke --param w=1.5 --geometry 0,0,0
-expect 1 "theta_bar must be in [0, 60]" -- "$navcam" brdf --model hapke --param w=0.5 --param theta_bar=70 --geometry 0,0,0
-expect 1 "phi must be in [0, 0.752]" -- "$navcam" brdf --model hapke --param w=0.5 --param phi=0.8 --geometry 0,0,0
-expect 1 "h_S must be > 0 when B_S0 > 0" -- "$navcam" brdf --model hapke --param w=0.5 --param B_S0=1 --param h_S=0 --geometry 0,0,0
-expect 1 "parameter w is required" -- "$navcam" brdf --model hapke --geometry 0,0,0
-expect 1 "no parameter named 'w'" -- "$navcam" brdf --model lambert --param w=0.5 --geometry 0,0,0
-expect 1 "angles must be within 0..180" -- "$navcam" brdf --model lambert --param A=0.5 --geometry 190,0,190
+expect 2 "parameter w must be in [0, 1], got 1.5" -- "$navcam" brdf --model hapke --param w=1.5 --geometry 0,0,0
+expect 2 "theta_bar must be in [0, 60]" -- "$navcam" brdf --model hapke --param w=0.5 --param theta_bar=70 --geometry 0,0,0
+expect 2 "phi must be in [0, 0.752]" -- "$navcam" brdf --model hapke --param w=0.5 --param phi=0.8 --geometry 0,0,0
+expect 2 "h_S must be > 0 when B_S0 > 0" -- "$navcam" brdf --model hapke --param w=0.5 --param B_S0=1 --param h_S=0 --geometry 0,0,0
+expect 2 "parameter w is required" -- "$navcam" brdf --model hapke --geometry 0,0,0
+expect 2 "no parameter named 'w'" -- "$navcam" brdf --model lambert --param w=0.5 --geometry 0,0,0
+expect 2 "angles must be within 0..180" -- "$navcam" brdf --model lambert --param A=0.5 --geometry 190,0,190
 expect 2 "give --model NAME or --preset NAME" -- "$navcam" brdf --geometry 0,0,0
+# a bad option value exits 2 and names the option (a bad line of standard input exits 1)
+expect 2 "navcam brdf: --model: unknown reflectance model 'foo'" -- "$navcam" brdf --model foo
+expect 2 "navcam brdf: --preset: unknown preset 'mars'" -- "$navcam" brdf --preset mars
 
 # The camera model: DN and electrons from a render; navcam expose.
 expect 0 "dn [DN]" -- "$navcam" render -o "$tmp/dn.png" -q dn "${small[@]}"
