@@ -67,6 +67,28 @@ static int corner_normals(const struct nc_mesh *m, int16_t *cn)
     return 0;
 }
 
+/* The detailed surfaces are one-sided, as the planes' test is: a shadow ray
+ * whose origin lies within float rounding under the surface (it starts 4e-6
+ * of its camera distance off the point, and the rock's record is placed to a
+ * few 1e-5 m in a tile up to kilometres across) leaves through the surface's
+ * back, which does not stop it. Outward is away from the rock's centre, the
+ * origin of its frame (the surface is the relief on a convex polyhedron). */
+static void front_faces(const struct RTCFilterFunctionNArguments *a)
+{
+    const unsigned N = a->N;
+    const float *ray = (const float *)a->ray, *hit = (const float *)a->hit; /* RTCRayN, RTCHitN: N-wide SOA */
+    for (unsigned i = 0; i < N; i++) {
+        if (!a->valid[i])
+            continue;
+        const float t = ray[8 * N + i], *d = ray + 4 * N + i, *o = ray + i, *ng = hit + i;
+        float out = 0, dn = 0;
+        for (unsigned k = 0; k < 3; k++)
+            out += ng[k * N] * (o[k * N] + t * d[k * N]), dn += ng[k * N] * d[k * N];
+        if ((out > 0) == (dn > 0)) /* leaving: the back */
+            a->valid[i] = 0;
+    }
+}
+
 int nc__rt_rock_meshes(RTCDevice dev, struct nc__rt_rocks *r)
 {
     const struct nc_boulder_field *f = r->field;
@@ -106,6 +128,7 @@ int nc__rt_rock_meshes(RTCDevice dev, struct nc__rt_rocks *r)
         r->mesh_triangles = m.nt;
         nc_mesh_free(&m);
         rtcSetSceneFlags(sf->scene, RTC_SCENE_FLAG_COMPACT);
+        rtcSetGeometryOccludedFilterFunction(g, front_faces);
         rtcCommitGeometry(g);
         rtcAttachGeometry(sf->scene, g);
         rtcReleaseGeometry(g);
