@@ -342,14 +342,16 @@ int nc_quality_auto(struct nc_renderer *r, struct nc_scene *s, const struct nc_c
 
 void nc_quality_describe(const struct nc_quality_choice *q, int timing, char *buf, size_t len)
 {
-    char ms[32] = "";
+    char ms[32] = "", pen[64] = "unbounded (the camera within a body's bounding sphere)";
     if (timing)
         snprintf(ms, sizeof ms, " %.1f ms", q->pilot_ms);
+    if (isfinite(q->penumbra_px))
+        snprintf(pen, sizeof pen, "%.3g px", q->penumbra_px);
     snprintf(buf, len,
              "spp=%d bounces=%d soft=%d%s%s (MC/noise variance at 1 spp %.3g falling as spp^-%.2f, bounce light %.3g sigma "
-             "and %.3g of direct, penumbra bound %.3g px, hard shadows off by %.3g sigma RMS, boulder cut %.3g, "
+             "and %.3g of direct, penumbra bound %s, hard shadows off by %.3g sigma RMS, boulder cut %.3g, "
              "level of detail %.3g, pilots%s over %d tiles)",
              q->samples_per_pixel, q->bounces, q->soft_shadows, q->all_rocks ? " rocks=all" : "",
              q->full_mesh ? " lod=off" : "", q->mc_to_noise_var, q->strata_beta, q->indirect_sigma,
-             q->indirect_ratio, q->penumbra_px, q->hard_shadow_rms, q->cut_rms, q->lod_rms, ms, q->pilot_tiles);
+             q->indirect_ratio, pen, q->hard_shadow_rms, q->cut_rms, q->lod_rms, ms, q->pilot_tiles);
 }
