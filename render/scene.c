@@ -198,7 +198,7 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const st
         return nc_cfg_key_error(map, "position_m", "camera.sumfile gives the Sun's direction (SZ): give "
                                                    "sun.distance_au or sun.irradiance_w_m2 instead of "
                                                    "sun.position_m");
-    if ((hdist = nc_cfg_double(map, "distance_au", 1e-3, 1e4, &dist_au)) < 0)
+    if ((hdist = nc_cfg_double(map, "distance_au", 0.005, 1e4, &dist_au)) < 0) /* beyond the Sun's radius */
         return hdist;
     if ((rc = nc_cfg_double(map, "irradiance_w_m2", 0, 1e9, &sun->irradiance_w_m2)) < 0)
         return rc;
@@ -224,8 +224,9 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const st
         d_m = dist_au * NC_AU_M;
     } else {
         d_m = nc_v3_norm(sun->position_m);
-        if (d_m < 1e3)
-            return nc_cfg_key_error(map, "position_m", "the Sun is closer than 1 km to the body");
+        if (!(d_m > NC_SUN_RADIUS_M))
+            return nc_cfg_key_error(map, "position_m", "the Sun's centre lies %.4g m from bodies[0]'s origin, within "
+                                    "its own radius (%.4g m)", d_m, NC_SUN_RADIUS_M);
         sun->has_position = 1;
     }
     sun->distance_m = d_m;

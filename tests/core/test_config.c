@@ -120,6 +120,8 @@ int main(void)
     expect_error("YAML syntax", "  height_px: 48\n", "  height_px: [48\n", NULL, 0, "test.yaml:", "YAML syntax error");
     expect_error("sun both ways", "  direction: [1, 0, 0]\n", "  direction: [1, 0, 0]\n  position_m: [1e11, 0, 0]\n",
                  NULL, 0, "sun.position_m", "not both");
+    expect_error("Sun inside its radius", "  direction: [1, 0, 0]\n", "  position_m: [5000, -3000, 0]\n", NULL, 0,
+                 "sun.position_m", "within its own radius");
     expect_error("missing mesh file", "{type: sphere, radius_m: 500}", "{type: mesh, file: nowhere.obj, unit: km}",
                  NULL, 0, "test.yaml:2: bodies[0].shape.file", "nowhere.obj: cannot open mesh");
     expect_error("mesh without unit", "{type: sphere, radius_m: 500}", "{type: mesh, file: x.obj}", NULL, 0,
