@@ -41,7 +41,7 @@ static const char bench_help[] =
     "      --shapes DIR     the shape models (default ../shared/data/shapes); a scene\n"
     "                       whose model is missing is skipped with a note\n"
     "      --quick          fewer methods (what the tests run)\n"
-    "  -j, --threads N      render threads (default: all cores)\n"
+    "  -j, --threads N      render threads, 0 to 1024 (default and 0: all cores)\n"
     "  -h, --help           this help\n"
     "\n"
     "CSV columns: scene, method, spp, bounces, soft_shadows, lod_error_px,\n"
@@ -194,7 +194,7 @@ int main(int argc, char **argv)
         case 'b': bad = parse_int("ref-bounces", optarg, 0, 64, &o.ref_bounces); break;
         case 'd': o.shapes_dir = optarg; break;
         case 'Q': o.quick = 1; break;
-        case 'j': bad = parse_int("threads", optarg, 1, 1024, &o.threads); break;
+        case 'j': bad = nc_cli_threads(optarg, &o.threads) < 0; break;
         case 'h': fputs(bench_help, stdout); return 0;
         default: fputs("Try 'navcam bench --help'.\n", stderr); return 2;
         }
