@@ -159,10 +159,16 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
         rc = nc_render_exposure(r, &drawn, &ex, &f, &info->time_samples);
     nc_rt_get_stats(r->rt, &st1);
     const unsigned long hits = st1.camera_hits - st0.camera_hits, back = st1.camera_back_hits - st0.camera_back_hits;
+    int rock_body = 0;
+    const long rock = nc_rt_camera_in_rock(&st1, drawn.nbodies, &rock_body);
     if (rc >= 0 && nc_rt_mostly_back(hits, back))
         snprintf(info->inside_warning, sizeof info->inside_warning,
                  "%lu of the %lu camera-ray samples that met a surface met its back, inner side: is the camera "
                  "inside a body (or a mesh wound inward)?", back, hits);
+    else if (rc >= 0 && rock >= 0)
+        snprintf(info->inside_warning, sizeof info->inside_warning,
+                 "the camera is inside boulder %ld of body %d: rocks are one-sided, so it sees out of the rock as if "
+                 "it were not there", rock, rock_body);
     /* Stars (the `stars` section), drawn before the camera model's PSF. */
     char starinfo[120] = "";
     double ts0 = now_ms();

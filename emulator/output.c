@@ -97,6 +97,11 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
                  "\"inside\": {\"warning\": \"camera inside a body?\", \"back_samples\": %lu, "
                  "\"hit_samples\": %lu}, ",
                  r->back_samples, r->hit_samples);
+    } else if (r->in_rock1 > 0) { /* rocks are one-sided: it sees out of the rock */
+        size_t k = strlen(stars);
+        snprintf(stars + k, sizeof stars - k,
+                 "\"inside\": {\"warning\": \"camera inside a boulder\", \"body\": %d, \"boulder\": %ld}, ",
+                 r->in_rock_body, r->in_rock1 - 1);
     }
     /* the Sun as the frame used it: a direction is made a unit vector */
     const struct nc_vec3 sun = p->sun_is_position ? p->sun : nc_v3_unit(p->sun);

@@ -39,6 +39,8 @@ struct nc_frame_record {
     double sun_off_axis_deg, sun_edge_deg; /* the Sun from the boresight, and from the frame's edge (< 0: in it) */
     int sun_in_field, sun_near_field, sun_hidden;
     unsigned long hit_samples, back_samples; /* camera samples that met a surface, and its back side */
+    long in_rock1; /* the boulder the camera is inside (of body in_rock_body), plus 1 (0: none) */
+    int in_rock_body;
     double render_ms, camera_ms; /* render (incl. smear) and camera model time */
     int width_px, height_px, adc_bits;
     const uint16_t *dn;          /* the digitised frame */

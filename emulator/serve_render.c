@@ -148,6 +148,8 @@ struct staged {
     int64_t gap, t0, t1; /* render start and end, CLOCK_MONOTONIC */
     int rc, ts, buf;
     unsigned long hits, back_hits; /* camera samples that met a surface, and its back side */
+    long in_rock;                  /* the rock the camera is inside (of body in_rock_body), -1: none */
+    int in_rock_body;
     double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg;
     struct nc_sky_stats stars;
     struct nc_sun_view sun;
@@ -159,8 +161,13 @@ struct staged {
  * and when it ends, not at every frame; each such frame's record says so. */
 static void inside_warning(struct nc__emu *e, const struct staged *x)
 {
-    const int inside = x->rc >= 0 && nc_rt_mostly_back(x->hits, x->back_hits);
-    if (inside && !e->inside_warned)
+    const int inside = x->rc >= 0 && (nc_rt_mostly_back(x->hits, x->back_hits) || x->in_rock >= 0);
+    if (inside && !e->inside_warned && x->in_rock >= 0)
+        nc_log_warn("emulator/render",
+                    "frame of request %u: the camera is inside boulder %ld of body %d (rocks are one-sided: it sees "
+                    "out of the rock as if it were not there). Logged again when this ends; every such frame's "
+                    "record holds \"inside\"", x->j.sequence, x->in_rock, x->in_rock_body);
+    else if (inside && !e->inside_warned)
         nc_log_warn("emulator/render",
                     "frame of request %u: %lu of the %lu camera-ray samples that met a surface met its back, inner "
                     "side: is the camera inside a body (or a mesh wound inward)? Logged again when this ends; every "
@@ -242,7 +249,8 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .stars_on = e->sky.on, .star_limit_mag = x->stars.limit_mag, .stars_drawn = x->stars.drawn,
         .stars_hidden = x->stars.hidden, .sun_off_axis_deg = x->sun.off_axis_deg, .sun_edge_deg = x->sun.edge_deg,
         .sun_in_field = x->sun.in_field, .sun_near_field = x->sun.near_field, .sun_hidden = x->sun.hidden,
-        .hit_samples = x->hits, .back_samples = x->back_hits, .render_ms = (x->t1 - x->t0) * 1e-6,
+        .hit_samples = x->hits, .back_samples = x->back_hits, .in_rock1 = x->in_rock + 1,
+        .in_rock_body = x->in_rock_body, .render_ms = (x->t1 - x->t0) * 1e-6,
         .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
         .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
     fill_slot(e);
@@ -343,6 +351,7 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         nc_rt_get_stats(e->renderer.rt, &st1);
         x.hits = st1.camera_hits - st0.camera_hits;
         x.back_hits = st1.camera_back_hits - st0.camera_back_hits;
+        x.in_rock = nc_rt_camera_in_rock(&st1, at.nbodies, &x.in_rock_body);
         inside_warning(e, &x);
         if (x.rc >= 0 && e->sky.on) /* stars at the mid-exposure time, through this frame's exposure */
             x.rc = nc_sky_draw(&e->sky, &e->renderer, &e->cs, &at, j.mid_sim_ns * 1e-9, j.exposure_s, f, &x.stars);

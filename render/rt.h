@@ -57,6 +57,10 @@ struct nc_rt_stats {
     /* ... and camera-ray samples that met a surface, and those of them that
      * met its back, inner side (a camera inside a body sees little else). */
     unsigned long camera_hits, camera_back_hits;
+    /* Per body, at the last update: the rock (its index in the body's list)
+     * the camera is inside, -1 for none. Rocks are one-sided, so such a
+     * camera sees out of the rock as if it were not there. */
+    long camera_in_rock[NC_MAX_BODIES];
 };
 
 int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out);
@@ -135,6 +139,17 @@ void nc_rt_count_camera_hits(struct nc_rt *rt, unsigned long hits, unsigned long
  * back, inner side: most of them (a camera inside a body, or a mesh wound
  * inward), what render, batch and serve warn of. */
 static inline int nc_rt_mostly_back(unsigned long hits, unsigned long back) { return back > hits / 2; }
+/* The rock the camera is inside (st->camera_in_rock), the first of nbodies'
+ * bodies: its index in the body's list with *body set, or -1. */
+static inline long nc_rt_camera_in_rock(const struct nc_rt_stats *st, int nbodies, int *body)
+{
+    for (int b = 0; b < nbodies; b++)
+        if (st->camera_in_rock[b] >= 0) {
+            *body = b;
+            return st->camera_in_rock[b];
+        }
+    return -1;
+}
 void nc_rt_get_stats(const struct nc_rt *rt, struct nc_rt_stats *st);
 /* The largest error bound of the levels of detail shown at the last update,
  * metres (0: every body at full resolution). */

@@ -483,6 +483,8 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
     int rc;
     rt->rocks_on = 0;
     rt->refine_on = 0;
+    for (int i = 0; i < NC_MAX_BODIES; i++)
+        rt->stats.camera_in_rock[i] = -1;
     for (int i = 0; i < rt->nbodies; i++) {
         struct rt_body *b = &rt->body[i];
         const struct nc_body *src = &s->body[i];
@@ -572,6 +574,7 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             rt->stats.boulder_mesh_px[i] = can_mesh ? s->render.boulder_mesh_px : 0;
             rt->stats.boulders_traced[i] = b->rocks.traced;
             rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
+            rt->stats.camera_in_rock[i] = nc__rt_rocks_camera_inside(&b->rocks);
             rt->rocks_on |= b->rocks.traced > 0;
         }
         if ((rc = update_grid(b, s)) < 0)

@@ -147,6 +147,9 @@ void nc__rt_rocks_cut(struct nc__rt_rocks *r, double min_d_m);
 /* The enabled tiles' instances for the body's pose: R body -> scene,
  * origin_rel the body origin relative to the camera (scene frame). */
 void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct nc_vec3 origin_rel);
+/* The traced rock the camera is inside at the last place (its index in the
+ * field's list), or -1. */
+long nc__rt_rocks_camera_inside(const struct nc__rt_rocks *r);
 void nc__rt_rocks_free(struct nc__rt_rocks *r);
 
 /* rt_rock_mesh.c: each shape's detailed surface (r->surf), built when the

@@ -268,6 +268,47 @@ void nc__rt_rocks_place(struct nc__rt_rocks *r, const struct nc_mat3 *R, struct 
     }
 }
 
+struct inside_query {
+    const struct nc__rt_rock_tile *tl;
+    long rank;
+};
+
+/* A rock whose box holds the point: is the point within its planes? */
+static bool inside_rock(struct RTCPointQueryFunctionArguments *a)
+{
+    struct inside_query *u = a->userPtr;
+    const struct nc__rt_rock *k = &u->tl->rec[a->primID];
+    const struct nc__rt_rocks *r = u->tl->rocks;
+    if (k->rank >= r->traced)
+        return false;
+    const struct nc_rock_shape *sh = &r->field->shape[k->shape];
+    const float rel[3] = {a->query->x - k->c[0], a->query->y - k->c[1], a->query->z - k->c[2]};
+    float p[3];
+    for (int j = 0; j < 3; j++)
+        p[j] = k->M[3 * j] * rel[0] + k->M[3 * j + 1] * rel[1] + k->M[3 * j + 2] * rel[2];
+    for (int g = 0; g < sh->nplanes; g++)
+        if (sh->nx[g] * p[0] + sh->ny[g] * p[1] + sh->nz[g] * p[2] > sh->d[g])
+            return false;
+    if (u->rank < 0 || (long)k->rank < u->rank)
+        u->rank = (long)k->rank;
+    return false;
+}
+
+long nc__rt_rocks_camera_inside(const struct nc__rt_rocks *r)
+{
+    struct inside_query u = {.rank = -1};
+    for (size_t t = 0; t < r->ntiles; t++) {
+        if (!r->tile[t].enabled)
+            continue;
+        u.tl = &r->tile[t];
+        struct RTCPointQuery q = {.x = u.tl->cam_m[0], .y = u.tl->cam_m[1], .z = u.tl->cam_m[2], .radius = 0};
+        struct RTCPointQueryContext ctx;
+        rtcInitPointQueryContext(&ctx);
+        rtcPointQuery(u.tl->scene, &q, &ctx, inside_rock, &u);
+    }
+    return u.rank;
+}
+
 void nc__rt_rocks_free(struct nc__rt_rocks *r)
 {
     for (size_t t = 0; t < r->ntiles; t++) {

@@ -79,6 +79,18 @@ stop
 [ "$(grep -c 'met its back, inner side' "$tmp/inside/serve.log")" = 1 ] \
   && [ "$(grep -c 'no longer meet back sides' "$tmp/inside/serve.log")" = 1 ] && ok \
   || bad "inside: log: $(cat "$tmp/inside/serve.log")"
+# A camera at a boulder's centre (navcam population's list): rocks are one-sided, so it sees out of
+# the rock; its frame's record and the log say so.
+rocks="bodies.0.boulders={preset: bennu, min_diameter_m: 4}"
+"$navcam" population "${small[@]}" --set "$rocks" -b "$tmp/rocks.csv" > /dev/null 2>&1 || bad "population"
+awk -F, 'NR == 3 { printf "0,%s,%s,%s,1,0,0,0,0,-1,0\n", $3, $4, $5 }' "$tmp/rocks.csv" > "$tmp/in_rock.csv"
+start in_rock 16 --set serve.mode=lockstep --set "$rocks"
+"$navcam" replay "$tmp/in_rock.csv" --lockstep --port "$tcp" > "$tmp/in_rock/replay.out" 2>&1 && ok \
+  || bad "replay in_rock.csv: $(cat "$tmp/in_rock/replay.out")"
+stop
+grep -q '"inside": {"warning": "camera inside a boulder", "body": 0, "boulder": 0}' "$tmp/in_rock/frames/frames.jsonl" \
+  && grep -q 'the camera is inside boulder 0 of body 0' "$tmp/in_rock/serve.log" && ok \
+  || bad "in_rock: $(cut -c1-300 "$tmp/in_rock/frames/frames.jsonl") $(cat "$tmp/in_rock/serve.log")"
 
 # 2. Every rejection reason, sent on purpose over UDP, is counted; serving goes on.
 start reject 2 --set serve.mode=lockstep

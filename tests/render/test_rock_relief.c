@@ -295,6 +295,22 @@ static void check_close_sun_behind(void)
     snprintf(at, sizeof at, "camera.look_at_m=[%.17g, %.17g, %.17g]", c.x, c.y, c.z);
     snprintf(upv, sizeof upv, "camera.up=[%.17g, %.17g, %.17g]", side.x, side.y, side.z);
     snprintf(sun, sizeof sun, "sun.direction=[%.17g, %.17g, %.17g]", up.x, up.y, up.z);
+    /* a camera at the rock's centre is inside it (rocks are one-sided: it would see out of it unwarned), one
+     * 1 m above its top is not */
+    const struct nc_vec3 at_c[2] = {c, cam};
+    long in[2];
+    for (int v = 0; v < 2; v++) {
+        s0.camera.position_m = at_c[v];
+        struct nc_rt *rt;
+        struct nc_rt_stats st;
+        int body = -1;
+        CHECK(nc_rt_create(&s0, 1, &rt) == 0, "%s", nc_errmsg());
+        nc_rt_get_stats(rt, &st);
+        in[v] = nc_rt_camera_in_rock(&st, s0.nbodies, &body);
+        nc_rt_destroy(rt);
+    }
+    printf("a camera at the largest rock's centre is inside rock %ld; 1 m above its top, %ld\n", in[0], in[1]);
+    CHECK(in[0] == 0 && in[1] == -1, "camera inside rock %ld at its centre, %ld above it (want 0, -1)", in[0], in[1]);
     nc_scene_free(&s0);
     double mean[2];
     size_t dark = 0, seen = 0;
