@@ -174,7 +174,8 @@ static void inside_warning(struct nc__emu *e, const struct staged *x)
                     "such frame's record holds \"inside\"",
                     x->j.sequence, x->back_hits, x->hits);
     else if (!inside && e->inside_warned && x->rc >= 0)
-        nc_log_info("emulator/render", "frame of request %u: the camera samples no longer meet back sides mostly",
+        nc_log_info("emulator/render", "frame of request %u: the camera samples no longer meet back sides mostly, nor "
+                                         "is the camera inside a boulder",
                     x->j.sequence);
     if (x->rc >= 0)
         e->inside_warned = inside;

@@ -84,12 +84,15 @@ stop
 rocks="bodies.0.boulders={preset: bennu, min_diameter_m: 4}"
 "$navcam" population "${small[@]}" --set "$rocks" -b "$tmp/rocks.csv" > /dev/null 2>&1 || bad "population"
 awk -F, 'NR == 3 { printf "0,%s,%s,%s,1,0,0,0,0,-1,0\n", $3, $4, $5 }' "$tmp/rocks.csv" > "$tmp/in_rock.csv"
+printf '1,0,-3000,0,0.70710678,-0.70710678,0,0,1,0,0\n' >> "$tmp/in_rock.csv" # then outside: the log says it ended
 start in_rock 16 --set serve.mode=lockstep --set "$rocks"
 "$navcam" replay "$tmp/in_rock.csv" --lockstep --port "$tcp" > "$tmp/in_rock/replay.out" 2>&1 && ok \
   || bad "replay in_rock.csv: $(cat "$tmp/in_rock/replay.out")"
 stop
 grep -q '"inside": {"warning": "camera inside a boulder", "body": 0, "boulder": 0}' "$tmp/in_rock/frames/frames.jsonl" \
-  && grep -q 'the camera is inside boulder 0 of body 0' "$tmp/in_rock/serve.log" && ok \
+  && grep -q 'the camera is inside boulder 0 of body 0' "$tmp/in_rock/serve.log" \
+  && [ "$(grep -c 'nor is the camera inside a boulder' "$tmp/in_rock/serve.log")" = 1 ] \
+  && [ "$(sed -n 2p "$tmp/in_rock/frames/frames.jsonl" | grep -c inside)" = 0 ] && ok \
   || bad "in_rock: $(cut -c1-300 "$tmp/in_rock/frames/frames.jsonl") $(cat "$tmp/in_rock/serve.log")"
 
 # 2. Every rejection reason, sent on purpose over UDP, is counted; serving goes on.
