@@ -3,6 +3,7 @@
 
 #include <arpa/inet.h>
 #include <errno.h>
+#include <getopt.h>
 #include <libgen.h>
 #include <math.h>
 #include <stdio.h>
@@ -27,6 +28,21 @@ int nc_cli_fail(void)
 {
     fprintf(stderr, "%s: %s\n", name, nc_errmsg());
     return 1;
+}
+
+int nc_cli_getopt(int argc, char *const argv[], const char *shortopts, const struct option *opts)
+{
+    const int c = getopt_long(argc, argv, shortopts, opts, NULL);
+    if (c == -1 || c == '?' || !optarg || strncmp(optarg, "--", 2) != 0 || !optarg[2])
+        return c;
+    const struct option *o = opts;
+    while (o->name && o->val != c)
+        o++;
+    if (o->name)
+        fprintf(stderr, "%s: --%s needs a value, got the option '%s'\n", name, o->name, optarg);
+    else
+        fprintf(stderr, "%s: -%c needs a value, got the option '%s'\n", name, c, optarg);
+    return '?';
 }
 
 int nc_cli_dir_writable(const char *path)

@@ -7,10 +7,18 @@
 
 #include <stdio.h>
 
+struct option;
+
 /* "navcam render" etc.: the log prefix and the error prefix. */
 void nc_cli_init(const char *command);
 /* Prints "navcam CMD: <last error>" and returns 1 (the exit status). */
 int nc_cli_fail(void);
+
+/* getopt_long, but an option's value that is itself a long option ("--set
+ * --set k=v", "-o --json") is refused: "navcam CMD: --set needs a value, got
+ * the option '--set'" on stderr and '?', which every command answers with
+ * its usage hint and exit status 2. */
+int nc_cli_getopt(int argc, char *const argv[], const char *shortopts, const struct option *opts);
 
 /* A number option's value: the whole of s a number in [lo, hi], else
  * "navcam CMD: --opt expects lo..hi, got 's'" on stderr and -1. */

@@ -368,7 +368,7 @@ int main(int argc, char **argv)
     if (!sets)
         return 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:s:q:F:e:j:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "o:s:q:F:e:j:h", opts)) != -1) {
         char *end;
         switch (c) {
         case 'o': dir = optarg; break;

@@ -174,7 +174,7 @@ int main(int argc, char **argv)
         return 2;
     }
     optind = 2;
-    while ((c = getopt_long(argc, argv, "o:j:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "o:j:h", opts)) != -1) {
         int bad = 0;
         switch (c) {
         case 'o': dir = optarg; break;

@@ -134,7 +134,7 @@ int main(int argc, char **argv)
         return 1;
     describe_models(models, sizeof models);
     optind = 1;
-    while ((c = getopt_long(argc, argv, "m:P:p:g:lh", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "m:P:p:g:lh", opts)) != -1) {
         switch (c) {
         case 'm': model = optarg; break;
         case 'P': preset = optarg; break;

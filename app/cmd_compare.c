@@ -132,7 +132,7 @@ int main(int argc, char **argv)
     const char *dir = NULL, *json = NULL;
     int fit = NC_FIT_SCALE, radius = 0, flip = 0, c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:f:r:j:F:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "o:f:r:j:F:h", opts)) != -1) {
         switch (c) {
         case 'o': dir = optarg; break;
         case 'j': json = optarg; break;

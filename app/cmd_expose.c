@@ -65,7 +65,7 @@ int main(int argc, char **argv)
     if (!sets)
         return 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "L:e:n:do:s:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "L:e:n:do:s:h", opts)) != -1) {
         char *end;
         double v = 0;
         if (c == 'L' || c == 'e' || c == 'n' || c == 'F') {

@@ -125,7 +125,7 @@ int main(int argc, char **argv)
     if (!sets)
         return 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "s:b:c:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "s:b:c:h", opts)) != -1) {
         switch (c) {
         case 's': sets[nsets++] = optarg; break;
         case 'b': rocks_out = optarg; break;

@@ -76,7 +76,7 @@ int main(int argc, char **argv)
     optind = 1;
     argv[1] = "navcam pose send"; /* getopt's messages begin with it */
     const char *why = NULL; /* what is wrong with the option's value */
-    while ((c = getopt_long(argc - 1, argv + 1, "P:A:S:t:ce:g:H:p:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc - 1, argv + 1, "P:A:S:t:ce:g:H:p:h", opts)) != -1) {
         switch (c) {
         case 'P': have_pos = parse_vec(optarg, pos, 3, &why) == 0; if (!have_pos) goto bad; break;
         case 'A':

@@ -93,7 +93,7 @@ int main(int argc, char **argv)
     if (!sets)
         return 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:q:s:j:e:f:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "o:q:s:j:e:f:h", opts)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
         case 'R': rows = optarg; break;

@@ -79,7 +79,7 @@ int main(int argc, char **argv)
     double speed = 1, wait_s = 30;
     const char *host = "127.0.0.1";
     optind = 1;
-    while ((c = getopt_long(argc, argv, "lx:H:p:T:w:h", opts, NULL)) != -1 && !bad) {
+    while ((c = nc_cli_getopt(argc, argv, "lx:H:p:T:w:h", opts)) != -1 && !bad) {
         switch (c) {
         case 'l': lockstep = 1; break;
         case 'x':

@@ -109,7 +109,7 @@ int main(int argc, char **argv)
     if (!sets)
         return 1;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "s:n:t:j:h", opts, NULL)) != -1 && !bad) {
+    while ((c = nc_cli_getopt(argc, argv, "s:n:t:j:h", opts)) != -1 && !bad) {
         switch (c) {
         case 's': sets[o.nsets++] = optarg; break;
         case 'n': bad = nc_cli_long("max-frames", optarg, 1, LONG_MAX, &o.max_frames); break;

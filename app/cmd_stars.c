@@ -71,7 +71,7 @@ int main(int argc, char **argv)
     double max_mag = INFINITY;
     int ch;
     optind = 2;
-    while ((ch = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
+    while ((ch = nc_cli_getopt(argc, argv, "o:h", opts)) != -1) {
         char *end;
         switch (ch) {
         case 'o': out = optarg; break;

@@ -128,7 +128,7 @@ int main(int argc, char **argv)
     double gsd = 0;
     int c, crop[4] = {0, 0, 0, 0};
     optind = 1;
-    while ((c = getopt_long(argc, argv, "t:r:R:b:g:j:c:h", opts, NULL)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "t:r:R:b:g:j:c:h", opts)) != -1) {
         char *end;
         switch (c) {
         case 't': {

@@ -137,6 +137,11 @@ expect 1 "unknown output driver 'nul'; did you mean 'null'?" -- "$navcam" serve 
 expect 2 "--position nan,0,0: not finite" -- "$navcam" pose send -P nan,0,0
 expect 2 "navcam pose send: unrecognized option '--bogus'" -- "$navcam" pose send --bogus
 expect 2 "navcam render: unrecognized option '--bogus'" -- "$navcam" render --bogus
+# an option's value that is itself an option is refused, not taken (getopt would read "--set --set k=v" as a
+# --set of "--set" and a file "k=v")
+expect 2 "navcam render: --set needs a value, got the option '--set'" -- "$navcam" render --set --set a=1 -o x.exr
+expect 2 "navcam batch: --output needs a value, got the option '--json'" -- "$navcam" batch builtin:approach -o --json
+expect 2 "navcam pose send: --host needs a value, got the option '--port'" -- "$navcam" pose send --host --port 1
 expect 0 "navcam stars info INDEX" -- "$navcam" stars info --help
 # Number options: the whole argument a number in range, else exit 2 naming it.
 expect 2 "navcam replay: --speed expects 0..1e+06, got 'abc'" -- "$navcam" replay builtin:approach --speed abc
