@@ -27,6 +27,14 @@ int nc_lines_next(struct nc_lines *l)
     const size_t c = strlen(l->line);
     if (c != l->len)
         return nc_error(l->code, "%s:%zu: a NUL byte at column %zu (a binary or damaged file?)", l->path, l->no, c + 1);
+    if (l->no == 1 && l->len >= 3 && !memcmp(l->line, "\xef\xbb\xbf", 3)) { /* a UTF-8 byte-order mark */
+        l->len -= 3;
+        memmove(l->line, l->line + 3, l->len + 1);
+    }
+    const char *cr = strchr(l->line, '\r');
+    if (cr && strcmp(cr, "\r\n") != 0 && cr[1] != '\0')
+        return nc_error(l->code, "%s:%zu: a carriage return at column %zu inside the line (classic Mac line ends? "
+                        "end lines with LF or CR LF)", l->path, l->no, (size_t)(cr - l->line) + 1);
     return 1;
 }
 

@@ -210,8 +210,6 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
     while ((rc = nc_lines_next(&ln)) > 0) {
         char *line = ln.line;
         lineno = ln.no;
-        if (lineno == 1 && !strncmp(line, "\xef\xbb\xbf", 3)) /* a UTF-8 byte-order mark (spreadsheets write one) */
-            memmove(line, line + 3, ln.len - 2); /* the rest and its NUL */
         if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
             continue;
         double raw[18], v[17];

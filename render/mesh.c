@@ -84,21 +84,18 @@ int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out)
 
 /* ---- OBJ -------------------------------------------------------------- */
 
-/* Parse one face corner "i", "i/t", "i//n" or "i/t/n"; negative = relative. */
-static int obj_index(const char **s, size_t nv, long *out)
+/* Parse one face corner "i", "i/t", "i//n" or "i/t/n" (whole numbers; a
+ * negative i counts back from the last vertex so far). */
+static int obj_index(const char **s, long *out)
 {
     char *end;
     errno = 0;
-    long v = strtol(*s, &end, 10);
-    if (end == *s || errno)
+    *out = strtol(*s, &end, 10);
+    if (end == *s || errno || (*end && *end != '/' && !isspace((unsigned char)*end)))
         return -1;
-    while (*end && !isspace((unsigned char)*end))
-        end++; /* skip /t/n */
+    end += strspn(end, "/+-0123456789");
     *s = end;
-    if (v < 0)
-        v = (long)nv + v + 1;
-    *out = v;
-    return 0;
+    return *end && !isspace((unsigned char)*end) ? -1 : 0;
 }
 
 int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
@@ -156,8 +153,10 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
                 if (!*s || *s == '#')
                     break;
                 long v;
-                if (obj_index(&s, m.nv, &v) < 0) {
-                    rc = nc_error(NC_EMESH, "%s:%zu: bad face index", path, lineno);
+                const char *at = s;
+                if (obj_index(&s, &v) < 0) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: bad face index '%.*s' (expected i, i/t, i//n or i/t/n)", path,
+                                  lineno, (int)strcspn(at, " \t\r\n"), at);
                     goto out;
                 }
                 if (n < 4)
@@ -173,11 +172,13 @@ int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)
                 nc_grow((void **)&face_line, &flcap, m.nt + 1, sizeof *face_line) < 0)
                 goto nomem;
             for (int k = 0; k < 3; k++) {
-                if (idx[k] < 1 || idx[k] > (long)UINT32_MAX) {
-                    rc = nc_error(NC_EMESH, "%s:%zu: face index %ld out of range", path, lineno, idx[k]);
+                const long a = idx[k] < 0 ? (long)m.nv + idx[k] + 1 : idx[k]; /* relative: back from the last */
+                if (a < 1 || a > (long)UINT32_MAX) {
+                    rc = nc_error(NC_EMESH, "%s:%zu: face index %ld out of range (%zu vertices before it)", path,
+                                  lineno, idx[k], m.nv);
                     goto out;
                 }
-                m.tri[3 * m.nt + k] = (uint32_t)(idx[k] - 1);
+                m.tri[3 * m.nt + k] = (uint32_t)(a - 1);
             }
             face_line[m.nt++] = lineno;
         }

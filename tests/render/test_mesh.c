@@ -110,7 +110,16 @@ int main(void)
     expect_fail("short.obj", "v 0 0\nf 1 1 1\n", "short.obj:1: vertex needs 3 numbers");
     expect_fail("empty.obj", "# nothing here\n", "mesh has no triangles");
     expect_fail("verts.obj", "v 0 0 0\nv 1 0 0\n", "mesh has no triangles");
-    expect_fail("garbage.obj", "f x y z\n", "garbage.obj:1: bad face index");
+    expect_fail("garbage.obj", "f x y z\n", "garbage.obj:1: bad face index 'x'");
+    expect_fail("idxjunk.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1abc 2 3\n", "idxjunk.obj:4: bad face index '1abc'");
+    expect_fail("idxreal.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2.5 3\n", "idxreal.obj:4: bad face index '2.5'");
+    expect_fail("relative.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf -1 -2 -7\n",
+                "relative.obj:4: face index -7 out of range (3 vertices before it)");
+    /* a byte-order mark before the first vertex: that vertex is read (every index would move otherwise) */
+    rc = nc_mesh_load(write_tmp("bom.obj", "\xef\xbb\xbfv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n"), 1.0, &m);
+    CHECK(rc == 0 && m.nv == 3 && m.v[3] == 1 && m.v[7] == 1, "bom.obj: %s", rc < 0 ? nc_errmsg() : "wrong vertices");
+    if (rc == 0)
+        nc_mesh_free(&m);
     expect_fail("mesh.stl", "solid\n", "unknown mesh format");
     rc = nc_mesh_load(nc_test_path("missing.obj"), 1.0, &m);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "missing.obj: cannot open mesh"), "missing: %s", nc_errmsg());

@@ -302,6 +302,18 @@ int main(void)
     CHECK(nc_sumfile_read(nc_test_path("nul.SUM"), &sum) < 0 &&
               nc_test_contains(nc_errmsg(), "nul.SUM:5: a NUL byte at column 68"),
           "NUL: %s", nc_errmsg());
+    /* CR LF line ends and a byte-order mark (a Windows editor's); the 1024-byte limit is of a line's text */
+    char crlf[4096], *w = crlf + sizeof "\xef\xbb\xbf" - 1;
+    memcpy(crlf, "\xef\xbb\xbf", 3);
+    w += sprintf(w, "%1024s", "EX0000000001"); /* the name padded to 1024 bytes */
+    for (const char *c = strchr(good, '\n'); *c; c++)
+        w += sprintf(w, *c == '\n' ? "\r\n" : "%c", *c);
+    nc_test_write(nc_test_path("crlf.SUM"), crlf);
+    CHECK(nc_sumfile_read(nc_test_path("crlf.SUM"), &sum) == 0 && !strcmp(sum.picture, "EX0000000001") &&
+              !strcmp(sum.utc, "2020 JAN 15 12:00:00.000") && sum.npx == 1024 && sum.k[4] == 117.647,
+          "CR LF and a byte-order mark: %s", nc_errmsg());
+    snprintf(bad, sizeof bad, "EX0000000001\r%s", strchr(good, '\n') + 1); /* a lone CR ends no line */
+    expect_error(bad, NULL, 0, "bad.SUM:1: a carriage return at column 13 inside the line");
     snprintf(bad, sizeof bad, "%.*s", (int)(strstr(good, "   -0.8728") - good), good); /* no CZ and after */
     expect_error(bad, NULL, 0, "no CZ line");
     replaced(bad, sizeof bad, good, "   -0.8728715609D+00    0.4364357805D+00   -0.2182178902D+00",
