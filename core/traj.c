@@ -265,7 +265,7 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
             }
             r->q = (struct nc_quat){r->q.w / qn, r->q.x / qn, r->q.y / qn, r->q.z / qn};
         }
-        if (!(nc_v3_norm(r->sun) > 0)) {
+        if (nc_v3_is_zero(r->sun)) {
             rc = nc_error(NC_ECONFIG, "%s:%zu: the Sun direction is zero", path, lineno);
             break;
         }

@@ -31,7 +31,7 @@ struct nc_quat nc_quat_from_mat(const struct nc_mat3 *r)
 int nc_quat_look_at(struct nc_vec3 eye, struct nc_vec3 target, struct nc_vec3 up, struct nc_quat *out)
 {
     struct nc_vec3 z = nc_v3_sub(target, eye);
-    if (nc_v3_norm(z) == 0)
+    if (nc_v3_is_zero(z))
         return nc_error(NC_ERANGE, "look-at target coincides with the camera position");
     z = nc_v3_unit(z);
     /* Image +Y is down, so the camera's -Y should lean toward `up`. */

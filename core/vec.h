@@ -8,6 +8,7 @@
 #ifndef NC_VEC_H
 #define NC_VEC_H
 
+#include <float.h>
 #include <math.h>
 
 #include "navcam/types.h"
@@ -25,10 +26,21 @@ static inline struct nc_vec3 nc_v3_cross(struct nc_vec3 a, struct nc_vec3 b)
 {
     return nc_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
+static inline int nc_v3_is_zero(struct nc_vec3 a) { return a.x == 0 && a.y == 0 && a.z == 0; }
+/* a over its length; a zero (or not finite) a as it is. Components whose
+ * squares would overflow or underflow (beyond about 1e150, below 1e-150)
+ * are scaled by the largest first, so [1e200, 1e200, 0] is a direction. */
 static inline struct nc_vec3 nc_v3_unit(struct nc_vec3 a)
 {
     double n = nc_v3_norm(a);
-    return n > 0 ? nc_v3_scale(a, 1.0 / n) : a;
+    if (!(n > 1e-150 && n < 1e150)) {
+        const double m = fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
+        if (!(m > 0 && m <= DBL_MAX))
+            return a;
+        a = nc_v3(a.x / m, a.y / m, a.z / m);
+        n = nc_v3_norm(a);
+    }
+    return nc_v3_scale(a, 1.0 / n);
 }
 static inline int nc_v3_isfinite(struct nc_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 /* Two unit axes across the unit vector a: (e1, e2, a) is right-handed. */

@@ -214,7 +214,7 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
         return NC_REJECT_NOT_FINITE;
     if (!unit_quat(&m->cam_attitude_q) || !unit_quat(&m->body_attitude_q))
         return NC_REJECT_BAD_QUATERNION;
-    if (type == NC_MSG_POSE && nc_v3_norm(m->sun) == 0)
+    if (type == NC_MSG_POSE && nc_v3_is_zero(m->sun))
         return NC_REJECT_BAD_VALUE;
     if ((flags & NC_MSG_EXPOSURE) && !(m->exposure_s >= 0 && m->exposure_s <= NC_PROTO_EXPOSURE_MAX_S))
         return NC_REJECT_BAD_VALUE;

@@ -218,7 +218,7 @@ static int sun_from_config(struct nc_cfg_node *map, struct nc_sun *sun, const st
         return nc_cfg_key_error(map, "distance_au", "distance_au goes with direction; position_m sets the distance");
     double d_m;
     if (hd) {
-        if (nc_v3_norm(sun->direction) == 0)
+        if (nc_v3_is_zero(sun->direction))
             return nc_cfg_key_error(map, "direction", "the Sun direction must not be zero");
         sun->direction = nc_v3_unit(sun->direction);
         d_m = dist_au * NC_AU_M;

@@ -226,6 +226,14 @@ int main(void)
           s.sun.irradiance_w_m2);
     CHECK(s.render.samples_per_pixel == 9, "new section created by --set");
     nc_scene_free(&s);
+    /* a direction of any length: squares beyond a double's range are not a zero vector */
+    for (int k = 0; k < 2; k++) {
+        const char *dir[] = {k ? "sun.direction=[3e-200, -4e-200, 0]" : "sun.direction=[3e200, -4e200, 0]"};
+        CHECK(nc_test_scene_rc(base, dir, 1, &s) == 0 && fabs(s.sun.direction.x - 0.6) < 1e-15 &&
+                  fabs(s.sun.direction.y + 0.8) < 1e-15,
+              "sun.direction %s: %s -> [%g, %g]", dir[0], nc_errmsg(), s.sun.direction.x, s.sun.direction.y);
+        nc_scene_free(&s);
+    }
 
     /* look_at: the target lands on the principal point. */
     const char *look[] = {"camera.attitude_q=null", "camera.look_at_m=[300, 200, 100]", "camera.up=[0, 1, 0]"};
