@@ -15,9 +15,10 @@
  * a BOTTOM-UP file back into top-down rows.
  */
 #include <ctype.h>
-#include <math.h>
 #include <errno.h>
 #include <fitsio.h>
+#include <float.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -183,6 +184,26 @@ fail:;
     return rc;
 }
 
+/* BSCALE and BZERO, where given, are numbers (cfitsio would take a bad one as 1 and 0 unseen). */
+static int scale_ok(fitsfile *f, const char *path)
+{
+    static const char *const keys[] = {"BSCALE", "BZERO"};
+    for (int i = 0; i < 2; i++) {
+        char raw[FLEN_VALUE], num[FLEN_VALUE], *end;
+        int status = 0;
+        if (fits_read_keyword(f, keys[i], raw, NULL, &status))
+            continue; /* not given */
+        snprintf(num, sizeof num, "%s", raw);
+        char *dexp = strpbrk(num, "dD"); /* Fortran's D exponent, which FITS allows */
+        if (dexp)
+            *dexp = 'E';
+        const double v = strtod(num, &end);
+        if (end == num || end[strspn(end, " ")] || !isfinite(v))
+            return nc_error(NC_EIMAGE, "%s: %s = %s is not a finite number", path, keys[i], raw);
+    }
+    return 0;
+}
+
 int nc__fits_read(const char *path, float **px, int *w, int *h)
 {
     fitsfile *f = NULL;
@@ -217,13 +238,34 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
     }
     size_t n = (size_t)naxes[0] * (size_t)naxes[1];
     float *buf = malloc((n ? n : 1) * sizeof *buf);
-    int anynul = 0;
-    if (!buf) {
+    double *row = malloc((naxes[0] ? (size_t)naxes[0] : 1) * sizeof *row);
+    if (!buf || !row) {
+        free(buf);
+        free(row);
         fits_close_file(f, &status);
         return nc_error(-ENOMEM, "%s: out of memory", path);
     }
-    if (fits_read_img(f, TFLOAT, 1, (LONGLONG)n, NULL, buf, &anynul, &status)) {
-        int rc = fits_fail(path, "read", status);
+    int rc = scale_ok(f, path);
+    /* Row by row in double: a pixel the BLANK keyword (or IEEE NaN) marks undefined becomes NaN, and a value
+     * beyond a float's range is an error (cast, it would turn into an infinity unseen). */
+    const double nul = NAN;
+    for (long y = 0; rc == 0 && y < naxes[1]; y++) {
+        int anynul = 0;
+        if (fits_read_img(f, TDOUBLE, 1 + y * naxes[0], naxes[0], (void *)&nul, row, &anynul, &status)) {
+            rc = fits_fail(path, "read", status);
+            break;
+        }
+        for (long x = 0; x < naxes[0]; x++) {
+            if (isfinite(row[x]) && fabs(row[x]) > FLT_MAX) {
+                rc = nc_error(NC_EIMAGE, "%s: the pixel at row %ld, column %ld (from 1, as FITS counts) is %g, beyond "
+                              "a 32-bit float's range", path, y + 1, x + 1, row[x]);
+                break;
+            }
+            buf[(size_t)y * (size_t)naxes[0] + (size_t)x] = (float)row[x];
+        }
+    }
+    free(row);
+    if (rc < 0) {
         free(buf);
         status = 0;
         fits_close_file(f, &status);

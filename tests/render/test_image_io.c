@@ -104,6 +104,59 @@ static void fits_rows(void)
     }
 }
 
+/* FITS from elsewhere: a pixel the BLANK keyword marks is undefined (NaN:
+ * a DEM's hole, not a height of -32768); a value no float holds, or a
+ * BSCALE that is no number, is an error, not an infinity or a scale of 1. */
+static void fits_foreign(void)
+{
+    static const struct {
+        const char *name, *key, *value, *error;
+        double big;
+    } cases[] = {
+        {"blank.fits", "BLANK", "-32768", NULL, 0},
+        {"dscale.fits", "BSCALE", "2.0D0", NULL, 0},
+        {"badscale.fits", "BSCALE", "'abc'", "badscale.fits: BSCALE = 'abc' is not a finite number", 0},
+        {"big.fits", NULL, NULL, "big.fits: the pixel at row 2, column 2 (from 1, as FITS counts) is 1e+300", 1e300},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *path = nc_test_path(cases[i].name);
+        fitsfile *ff = NULL;
+        int status = 0;
+        long ax[2] = {4, 3};
+        short v[12];
+        double d[12];
+        for (int k = 0; k < 12; k++)
+            v[k] = (short)k, d[k] = k;
+        v[5] = -32768;
+        d[5] = cases[i].big;
+        remove(path);
+        fits_create_file(&ff, path, &status);
+        fits_create_img(ff, cases[i].big ? DOUBLE_IMG : SHORT_IMG, 2, ax, &status);
+        if (cases[i].key) {
+            char card[81];
+            snprintf(card, sizeof card, "%-8s= %20s", cases[i].key, cases[i].value);
+            fits_write_record(ff, card, &status);
+            fits_set_bscale(ff, 1.0, 0.0, &status); /* the values below written raw */
+        }
+        if (cases[i].big)
+            fits_write_img(ff, TDOUBLE, 1, 12, d, &status);
+        else
+            fits_write_img(ff, TSHORT, 1, 12, v, &status);
+        fits_close_file(ff, &status);
+        float *px = NULL;
+        int w, h;
+        const int rc = nc_image_read(path, &px, &w, &h);
+        if (cases[i].error)
+            CHECK(status == 0 && rc < 0 && nc_test_contains(nc_errmsg(), cases[i].error), "%s: %s", cases[i].name,
+                  rc < 0 ? nc_errmsg() : "read");
+        else
+            CHECK(status == 0 && rc == 0 && w == 4 && h == 3 && px[4] == (i ? 8 : 4) && (i ? px[5] < 0 : isnan(px[5])),
+                  "%s: status %d, %s, pixel 5 %g", cases[i].name, status, rc < 0 ? nc_errmsg() : "read",
+                  rc == 0 ? px[5] : 0);
+        free(px);
+    }
+}
+
 /* A file is written whole or not at all, and one cut short is not read. */
 static void whole_or_nothing(void)
 {
@@ -255,6 +308,7 @@ int main(void)
               nc_test_contains(nc_errmsg(), "/nonexistent-dir/x.exr"),
           "unwritable path names the file: %s", nc_errmsg());
     fits_rows();
+    fits_foreign();
     whole_or_nothing();
     nc_frame_free(&f);
     nc_scene_free(&s);
