@@ -133,7 +133,7 @@ int main(void)
         NUL_CASE("nul.obj", "nul.obj:3: a NUL byte at column 8", "v 0 0 0\nv 1 0 0\nv 1 1 0\0 5\nf 1 2 3\n"),
         NUL_CASE("nul.ply", "nul.ply:8: a NUL byte at column 6",
                  "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                 "end_header\n0 0 0\0 7\n"),
+                 "end_header\n0 0 0\0 7\n1 0 0\n0 1 0\n"),
         NUL_CASE("nulh.ply", "nulh.ply:2: a NUL byte at column 7", "ply\nformat\0ascii 1.0\nend_header\n"),
         NUL_CASE("nul.icq", "nul.icq:2: a NUL byte at column 6", "1\n0 0 1\0 2\n"),
 #undef NUL_CASE
@@ -157,21 +157,23 @@ int main(void)
     CHECK(rc == 0 && m.nv == 4 && m.nt == 2 && m.tri[5] == 3, "ascii ply: %s", nc_errmsg());
     if (rc == 0)
         nc_mesh_free(&m);
-    for (int be = 0; be < 2; be++) {
-        const char *name = be ? "be.ply" : "le.ply";
+    /* le, be; then little-endian data under a big-endian header, and one byte more than the header announces */
+    for (int k = 0; k < 4; k++) {
+        const int be = k == 1;
+        const char *name = k == 3 ? "extra.ply" : k == 2 ? "order.ply" : be ? "be.ply" : "le.ply";
         FILE *f = fopen(nc_test_path(name), "wb");
         fprintf(f, "ply\nformat %s 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
                    "element face 1\nproperty list uchar uint vertex_indices\nend_header\n",
-                be ? "binary_big_endian" : "binary_little_endian");
+                be || k == 2 ? "binary_big_endian" : "binary_little_endian");
         for (int i = 0; i < 9; i++) {
             double d = i == 4 ? 2.5 : (double)(i % 4 == 0);
             unsigned char b[8];
             memcpy(b, &d, 8);
             if (be)
-                for (int k = 0; k < 4; k++) {
-                    unsigned char t = b[k];
-                    b[k] = b[7 - k];
-                    b[7 - k] = t;
+                for (int j = 0; j < 4; j++) {
+                    unsigned char t = b[j];
+                    b[j] = b[7 - j];
+                    b[7 - j] = t;
                 }
             fwrite(b, 1, 8, f);
         }
@@ -182,8 +184,20 @@ int main(void)
             b[be ? 3 : 0] = (unsigned char)i;
             fwrite(b, 1, 4, f);
         }
+        if (k == 3)
+            fputc('\n', f);
         fclose(f);
         rc = nc_mesh_load(nc_test_path(name), 1.0, &m);
+        if (k >= 2) {
+            CHECK(rc < 0 && nc_test_contains(nc_errmsg(), k == 2 ? "face 0 (counted from 0): vertex index 1.67772e+07 "
+                                                                   "out of range (3 vertices, counted from 0); is the "
+                                                                   "byte order right?"
+                                                                 : "extra.ply: data after the elements the header"),
+                  "%s: %s", name, rc < 0 ? nc_errmsg() : "loaded");
+            if (rc == 0)
+                nc_mesh_free(&m);
+            continue;
+        }
         CHECK(rc == 0, "%s: %s", name, nc_errmsg());
         if (rc == 0) {
             CHECK(m.nv == 3 && m.nt == 1 && m.v[4] == 2.5 && m.tri[2] == 2, "%s content", name);
@@ -194,20 +208,34 @@ int main(void)
                 "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
                 "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
                 "4 0 1 2 3\n",
-                "has 4 vertices");
+                "quad.ply:14: face 0: a face of 4 vertices");
     expect_fail("range.ply",
                 "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                 "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n3 0 1 9\n",
-                "index 9 out of range");
+                "range.ply:13: face 0: vertex index 9 out of range (3 vertices, counted from 0)");
     expect_fail("trunc.ply",
                 "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                 "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0\n",
-                "unexpected end of file");
+                "the header announces elements of at least 19 bytes, more than the 10 bytes after it hold");
+    /* ASCII: an element a line, so a value missing or extra is named at its line, not shifted into the next */
+    const char *ply3 = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    char text[512];
+    snprintf(text, sizeof text, "%s0 0 0\n1 0\n1 1 0\n3 0 1 2\n", ply3);
+    expect_fail("short.ply", text, "short.ply:11: vertex 1: the line ends before its properties do");
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0 5\n1 1 0\n3 0 1 2\n", ply3);
+    expect_fail("long.ply", text, "long.ply:11: vertex 1: more values on the line than its properties take ('5')");
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n3 0 2 1\n\n", ply3);
+    expect_fail("more.ply", text, "more.ply:14: data after the elements the header announces");
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n1 x 0\n3 0 1 2\n", ply3);
+    expect_fail("word.ply", text, "word.ply:12: vertex 2: 'x' is not a number");
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n1 1 0\n\n", ply3);
+    expect_fail("noface.ply", text, "noface.ply:13: the file ends at face 0 (counted from 0) of the 1 the header");
     expect_fail("nohdr.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", "no end_header");
     expect_fail("huge.ply", /* 4e9 vertices announced: said so, not "out of memory" */
                 "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
                 "property float z\nend_header\n0 0 0\n",
-                "the header announces 4000000000 elements, more than the 6 bytes after it hold");
+                "the header announces elements of at least 23999999999 bytes, more than the 6 bytes after it hold");
     expect_fail("notply.ply", "hello\n", "not a PLY file");
 
     /* The procedural asteroid: closed, deterministic, the requested size. */
