@@ -20,18 +20,41 @@
 
 /* ---- KStars stars.dat ------------------------------------------------------ */
 
-/* The number in columns [a, b) of line (0-based); 0 when it is not one. */
-static int field(const char *line, size_t len, int a, int b, double *v)
+/* stars.dat's numbers: columns [a, b) (0-based) and the range each takes. */
+static const struct {
+    const char *name;
+    int a, b;
+    double lo, hi;
+} cols[] = {
+    {"RA hours", 0, 2, 0, 23},          {"RA minutes", 2, 4, 0, 59},      {"RA seconds", 4, 9, 0, 60},
+    {"Dec degrees", 11, 13, 0, 90},     {"Dec minutes", 13, 15, 0, 59},   {"Dec seconds", 15, 19, 0, 60},
+    {"pmRA (mas/yr)", 20, 29, -1e5, 1e5}, {"pmDec (mas/yr)", 29, 38, -1e5, 1e5}, {"V", 45, 51, -30, 30},
+    {"B-V", 51, 56, -5, 10},
+};
+enum { NCOLS = sizeof cols / sizeof cols[0] };
+
+/* The numbers of a row into v[NCOLS]: 0, or -1 with why[] saying which
+ * column is not a decimal number in its range. */
+static int row_fields(const char *line, double *v, char *why, size_t whylen)
 {
-    char buf[32], *end;
-    if ((size_t)b > len || b - a >= (int)sizeof buf)
-        return 0;
-    memcpy(buf, line + a, (size_t)(b - a));
-    buf[b - a] = 0;
-    *v = strtod(buf, &end);
-    while (*end == ' ')
-        end++;
-    return end != buf && !*end && isfinite(*v);
+    for (int i = 0; i < NCOLS; i++) {
+        char buf[16], *end;
+        const int a = cols[i].a, b = cols[i].b;
+        if ((size_t)b > strcspn(line, "\r\n")) {
+            snprintf(why, whylen, "the row ends before %s (columns %d-%d)", cols[i].name, a + 1, b);
+            return -1;
+        }
+        memcpy(buf, line + a, (size_t)(b - a));
+        buf[b - a] = 0;
+        v[i] = strtod(buf, &end);
+        const int decimal = strspn(buf, " +-.0123456789") == (size_t)(b - a);
+        if (!decimal || end == buf || end[strspn(end, " ")] || !(v[i] >= cols[i].lo && v[i] <= cols[i].hi)) {
+            snprintf(why, whylen, "%s (columns %d-%d) '%s' is not a number in %g..%g", cols[i].name, a + 1, b, buf,
+                     cols[i].lo, cols[i].hi);
+            return -1;
+        }
+    }
+    return 0;
 }
 
 static int by_mag(const void *a, const void *b)
@@ -53,19 +76,21 @@ int nc_star_cat_read_kstars(const char *path, struct nc_star_cat *c)
     while ((rc = nc_lines_next(&ln)) > 0) {
         const char *line = ln.line;
         const long no = (long)ln.no;
-        const size_t len = ln.len;
-        if (line[0] == '#' || len < 8)
+        if (line[0] == '#' || !line[strspn(line, " \t\r\n")])
             continue;
-        double hh, mm, ss, dd, dm, ds, pa, pd, v, bv;
         /* RA hhmmss.ss (cols 1-9), Dec sddmmss.s (11-19), pmRA cos(dec)
          * (21-29) and pmDec (30-38) in mas/yr, V (46-51), B-V (52-56) */
-        if (!field(line, len, 0, 2, &hh) || !field(line, len, 2, 4, &mm) || !field(line, len, 4, 9, &ss) ||
-            !field(line, len, 11, 13, &dd) || !field(line, len, 13, 15, &dm) || !field(line, len, 15, 19, &ds) ||
-            !field(line, len, 20, 29, &pa) || !field(line, len, 29, 38, &pd) || !field(line, len, 45, 51, &v) ||
-            !field(line, len, 51, 56, &bv) || (line[10] != '+' && line[10] != '-') || hh >= 24 || dd > 90) {
-            rc = nc_error(NC_ECONFIG, "%s:%ld: not a stars.dat row (RA hhmmss.ss, Dec sddmmss.s, pmRA, pmDec, "
+        double v[NCOLS];
+        char why[160];
+        int bad = row_fields(line, v, why, sizeof why) < 0;
+        if (!bad && line[10] != '+' && line[10] != '-')
+            bad = snprintf(why, sizeof why, "the Dec's sign (column 11) is not + or -");
+        else if (!bad && v[3] + v[4] / 60 + v[5] / 3600 > 90)
+            bad = snprintf(why, sizeof why, "the Dec lies beyond 90 deg");
+        if (bad) {
+            rc = nc_error(NC_ECONFIG, "%s:%ld: %s: not a stars.dat row (RA hhmmss.ss, Dec sddmmss.s, pmRA, pmDec, "
                                      "parallax, V, B-V in fixed columns)",
-                          path, no);
+                          path, no, why);
             break;
         }
         if (c->n == cap) {
@@ -78,10 +103,10 @@ int nc_star_cat_read_kstars(const char *path, struct nc_star_cat *c)
             c->star = s;
         }
         /* Seconds written as 60.00 (rounding) are converted, not refused. */
-        double dec = (dd + dm / 60 + ds / 3600) * (line[10] == '-' ? -1 : 1);
-        c->star[c->n++] = (struct nc_star){.ra_rad = (hh + mm / 60 + ss / 3600) * 15 * M_PI / 180,
-                                           .dec_rad = dec * M_PI / 180, .pm_ra_mas_yr = (float)pa,
-                                           .pm_dec_mas_yr = (float)pd, .v_mag = (float)v, .b_v = (float)bv};
+        double dec = (v[3] + v[4] / 60 + v[5] / 3600) * (line[10] == '-' ? -1 : 1);
+        c->star[c->n++] = (struct nc_star){.ra_rad = (v[0] + v[1] / 60 + v[2] / 3600) * 15 * M_PI / 180,
+                                           .dec_rad = dec * M_PI / 180, .pm_ra_mas_yr = (float)v[6],
+                                           .pm_dec_mas_yr = (float)v[7], .v_mag = (float)v[8], .b_v = (float)v[9]};
     }
     nc_lines_free(&ln);
     fclose(f);

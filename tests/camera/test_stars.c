@@ -171,8 +171,25 @@ int main(void)
     }
     nc_star_cat_free(&c);
     nc_test_write(dat, "064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\nnot a star\n");
-    CHECK(nc_star_cat_read_kstars(dat, &c) < 0 && nc_test_contains(nc_errmsg(), "stars.dat:2"),
+    CHECK(nc_star_cat_read_kstars(dat, &c) < 0 &&
+              nc_test_contains(nc_errmsg(), "stars.dat:2: RA hours (columns 1-2) 'no' is not a number in 0..23"),
           "a bad row names its line: %s", nc_errmsg());
+    /* each number in its column's range, decimal: a Dec past the pole, 75 minutes, a hex V are named */
+    static const char *const rows[][2] = {
+        {"064508.92 +903000.0 -000546.0-001223.100379.2 -1.4400.01A0 1\n", "the Dec lies beyond 90 deg"},
+        {"067508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\n",
+         "RA minutes (columns 3-4) '75' is not a number in 0..59"},
+        {"064508.92 -164258.0 -000546.0-001223.100379.2  0x1A00.01A0 1\n",
+         "V (columns 46-51) '  0x1A' is not a number"},
+        {"064508.92 *164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\n", "the Dec's sign (column 11) is not + or -"},
+        {"0645\n", "the row ends before RA seconds (columns 5-9)"},
+    };
+    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
+        nc_test_write(dat, rows[k][0]);
+        CHECK(nc_star_cat_read_kstars(dat, &c) < 0 && nc_test_contains(nc_errmsg(), "stars.dat:1: ") &&
+                  nc_test_contains(nc_errmsg(), rows[k][1]),
+              "row %zu: %s", k, nc_errmsg());
+    }
     static const char nul[] = "064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1\0\n";
     nc_test_write_bytes(dat, nul, sizeof nul - 1);
     CHECK(nc_star_cat_read_kstars(dat, &c) < 0 && nc_test_contains(nc_errmsg(), "stars.dat:1: a NUL byte at column 61"),
