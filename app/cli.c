@@ -47,9 +47,10 @@ int nc_cli_getopt(int argc, char *const argv[], const char *shortopts, const str
 
 int nc_cli_dir_writable(const char *path)
 {
-    char dir[4096];
-    snprintf(dir, sizeof dir, "%s", path);
-    if (access(dirname(dir), W_OK) == 0)
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", path);
+    const char *dir = dirname(buf); /* "." for a bare file name: not a pointer into buf */
+    if (access(dir, W_OK) == 0)
         return 0;
     fprintf(stderr, "%s: %s: cannot write into directory '%s': %s\n", name, path, dir, strerror(errno));
     return -1;

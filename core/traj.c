@@ -210,7 +210,8 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
     while ((rc = nc_lines_next(&ln)) > 0) {
         char *line = ln.line;
         lineno = ln.no;
-        if (line[strspn(line, " \t\r\n")] == '\0' || line[0] == '#')
+        line[strcspn(line, "#")] = '\0'; /* a comment: from '#' to the line's end */
+        if (line[strspn(line, " \t\r\n")] == '\0')
             continue;
         double raw[18], v[17];
         int k = 0;

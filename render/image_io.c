@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -298,8 +299,25 @@ void nc_image_flip(void *px, size_t elem, int w, int h, int rows, int cols)
             }
 }
 
+/* A file that cannot be opened as such is said why (cfitsio and OpenImageIO
+ * say "could not open the named file" for a missing, unreadable or looping
+ * path alike, and a directory is "error reading from FITS file"). */
+static int readable(const char *path)
+{
+    struct stat st;
+    FILE *f = NULL;
+    if (stat(path, &st) < 0 || (!S_ISDIR(st.st_mode) && !(f = fopen(path, "rb"))))
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    if (f)
+        fclose(f);
+    return S_ISDIR(st.st_mode) ? nc_error(NC_EIMAGE, "%s: is a directory, not an image", path) : 0;
+}
+
 int nc_image_read(const char *path, float **px, int *w, int *h)
 {
+    int rc = readable(path);
+    if (rc < 0)
+        return rc;
     return format_of(path) == FMT_FITS ? nc__fits_read(path, px, w, h) : nc__oiio_read(path, px, w, h);
 }
 
@@ -324,6 +342,9 @@ static int json_get(const char *json, const char *name, char *buf, size_t len)
 
 int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len)
 {
+    int rc = readable(path);
+    if (rc < 0)
+        return rc;
     enum fmt f = format_of(path);
     if (f == FMT_FITS)
         return nc__fits_read_attr(path, name, buf, len);
@@ -333,7 +354,7 @@ int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len
     char *desc = malloc(65536);
     if (!desc)
         return nc_error(-ENOMEM, "out of memory");
-    int rc = nc__oiio_read_attr(path, "ImageDescription", desc, 65536);
+    rc = nc__oiio_read_attr(path, "ImageDescription", desc, 65536);
     if (rc == 0 && json_get(desc, name, buf, len) < 0)
         rc = nc_error(NC_EIMAGE, "%s: no attribute '%s' in ImageDescription", path, name);
     free(desc);

@@ -58,8 +58,12 @@ static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
         return nc__scene_error_at(nc_cfg_get(sh, "file"));
     rc = nc_mesh_dem_tile(h, w, rows, &p, &b->mesh);
     free(h);
-    if (rc < 0)
+    if (rc < 0) { /* the file named, as the read's errors do */
+        char why[1024];
+        snprintf(why, sizeof why, "%s", nc_errmsg());
+        nc_error(rc, "%s: %s", path, why);
         return nc__scene_error_at(nc_cfg_get(sh, "file"));
+    }
     b->bounding_radius_m = nc_mesh_bounding_radius(&b->mesh);
     nc_log_info("scene", "body '%s': DEM %s, %dx%d pixels of %g x %g m, %zu triangles%s", b->name, path, w, rows,
                 p.pixel_m[0], p.pixel_m[1], b->mesh.nt, p.radius_m > 0 ? ", on a sphere" : "");

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "core/le.h"
@@ -148,11 +149,24 @@ int nc_star_cat_write(const struct nc_star_cat *c, const char *path)
         nc_le_put_f32(p + 24, s->v_mag);
         nc_le_put_f32(p + 28, s->b_v);
     }
-    FILE *f = fopen(path, "wb");
-    int ok = f && fwrite(b, 1, size, f) == size;
-    ok = f && fclose(f) == 0 && ok;
+    /* under a temporary name, renamed into place once whole: a failed write leaves no partial index */
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%.4000s.%ld.tmp", path, (long)getpid());
+    FILE *f = fopen(tmp, "wb");
+    int err = f ? 0 : errno;
+    if (f) {
+        errno = 0;
+        if (fwrite(b, 1, size, f) != size)
+            err = errno ? errno : EIO;
+        if (fclose(f) != 0 && !err)
+            err = errno;
+        if (!err && rename(tmp, path) < 0)
+            err = errno;
+        if (err)
+            remove(tmp);
+    }
     free(b);
-    return ok ? 0 : nc_error(-EIO, "%s: cannot write the star index", path);
+    return err ? nc_error(-err, "%s: cannot write the star index: %s", path, strerror(err)) : 0;
 }
 
 int nc_star_cat_load(const char *path, struct nc_star_cat *c)

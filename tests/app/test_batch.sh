@@ -273,6 +273,10 @@ PY
 printf '\xef\xbb\xbf' > named_bom.csv && tr 'a-z' 'A-Z' < named.csv | sed 's/$/\r/' >> named_bom.csv
 "$navcam" batch named_bom.csv -o named_bom "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "BOM, capitals, CRLF"
 cmp named_bom/frame_000001.fits named/frame_000001.fits || fail "BOM, capitals, CRLF: not the same frame"
+# comments on lines of their own, indented, and after a row: the same frames
+{ echo "  # indented"; sed '1s/$/ # the header/; 3s/$/\t# after a row/' named.csv; } > named_cmt.csv
+"$navcam" batch named_cmt.csv -o named_cmt "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "comments"
+cmp named_cmt/frame_000001.fits named/frame_000001.fits || fail "comments: not the same frame"
 cmp named/frame_000001.fits ref/frame_000001.fits || fail "columns by name: not the reference frame"
 "$navcam" batch named_sum.csv -o named_sum "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "SUM columns by name"
 cmp named_sum/frame_000001.fits sum/frame_000001.fits || fail "SUM columns by name: not the frame of ordered rows"
