@@ -51,6 +51,9 @@ int nc_sky_from_config(struct nc_cfg *cfg, struct nc_sky *sky)
     struct nc_cfg_node *lim = nc_cfg_get(m, "limit_mag");
     if (lim && !(lim->kind == NC_CFG_SCALAR && lim->value && !strcmp(lim->value, "auto"))) {
         sky->limit_auto = 0;
+        char *end = NULL;
+        if (lim->kind == NC_CFG_SCALAR && lim->value && (strtod(lim->value, &end), end == lim->value || *end))
+            return nc_cfg_key_error(m, "limit_mag", "expected auto or a magnitude in -30..30, got '%s'", lim->value);
         if ((rc = nc_cfg_double(m, "limit_mag", -30, 30, &sky->limit_mag)) < 0)
             return rc;
     }

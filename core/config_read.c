@@ -410,6 +410,15 @@ int nc_cfg_check_unused_keys(struct nc_cfg *cfg, struct nc_cfg_node *map)
     return 0;
 }
 
+/* The document that lists a section's keys: the emulator's serve and
+ * outputs sections have theirs in docs/emulator.md, the rest config.md. */
+static const char *doc_of(const struct nc_cfg_node *n)
+{
+    while (n->parent && n->parent->parent)
+        n = n->parent;
+    return n->key && (!strcmp(n->key, "serve") || !strcmp(n->key, "outputs")) ? "docs/emulator.md" : "docs/config.md";
+}
+
 int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
 {
     struct nc_cfg_node *u = n ? first_unused(n) : NULL;
@@ -417,7 +426,7 @@ int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
         return 0;
     const struct nc_cfg_node *p = u->parent;
     if (!u->key || !p || !p->nasked)
-        return nc_cfg_error(u, "unknown key (see docs/config.md for the keys this section takes)");
+        return nc_cfg_error(u, "unknown key (see %s for the keys this section takes)", doc_of(u));
     /* The nearest key this section takes (a typo), else where the key is read
      * (a key in the wrong section), then every key this section takes. */
     char hint[1536] = "", where[512];
@@ -445,7 +454,7 @@ int nc_cfg_check_unused_in(struct nc_cfg *cfg, struct nc_cfg_node *n)
     for (size_t i = 0; i < p->nasked && (len = strlen(hint)) < sizeof hint - 80; i++)
         snprintf(hint + len, sizeof hint - len, "%s %s", i ? "," : "", p->asked[i]);
     len = strlen(hint);
-    snprintf(hint + len, sizeof hint - len, "%s; docs/config.md)", len >= sizeof hint - 80 ? ", ..." : "");
+    snprintf(hint + len, sizeof hint - len, "%s; %s)", len >= sizeof hint - 80 ? ", ..." : "", doc_of(u));
     return nc_cfg_error(u, "unknown key%s", hint);
 }
 

@@ -45,7 +45,7 @@ enum io_method { IO_AUTO, IO_WRITE, IO_MMAP };
 
 struct v4l2_out {
     /* what to look for */
-    char want_path[256], want_card[33];
+    char want_path[256], want_card[32]; /* v4l2_capability.card: 31 characters and a NUL */
     uint32_t fourcc;
     int msb;
     double fps;

@@ -33,20 +33,18 @@ static int diameters_error(struct nc_cfg_node *map, double d_min_m, double d_max
     return nc_cfg_error(at ? at : map, "max_diameter_m (%g) must exceed min_diameter_m (%g)", d_max_m, d_min_m);
 }
 
-/* `shape.craters` of a mesh or asteroid: a mean count of the default
+/* `shape.craters` of a mesh or asteroid (nc__scene_detail_from_config refuses it elsewhere): a mean count of the default
  * population (a number), or a map of its parameters. An asteroid without
  * the key gets 100. */
 static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir, int dry)
 {
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;
     if (!node && b->shape != NC_SHAPE_ASTEROID) {
-        const struct nc_cfg_node *seed = nc_body_is_mesh(b) ? nc_cfg_get(sh, "seed") : NULL;
+        const struct nc_cfg_node *seed = nc_cfg_get(sh, "seed");
         return seed ? nc_cfg_error(seed, "a mesh's seed is its craters' (docs/config.md): give shape.craters too, "
                                          "or remove the seed")
                     : 0;
     }
-    if (node && !nc_body_is_mesh(b))
-        return nc_cfg_error(node, "craters need a mesh or asteroid shape");
     struct nc_crater_params p;
     nc_crater_params_default(&b->mesh, &p);
     double area_km2 = 1e-6 * nc_mesh_area_m2(&b->mesh), count = 100;
@@ -185,8 +183,6 @@ static int relief_from_config(struct nc_cfg_node *sh, struct nc_body *b, double 
     int rc;
     if ((rc = nc_cfg_map(sh, "relief", &map)) <= 0)
         return rc;
-    if (!nc_body_is_mesh(b))
-        return nc_cfg_key_error(sh, "relief", "relief needs a mesh or asteroid shape");
     struct nc_relief_params p = {.hurst = 0.8, .amplitude = 1, .seed = 1};
     if ((rc = nc_cfg_double(map, "edge_m", 1e-6, 1e7, &p.edge_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "edge_m", "the mean edge length to subdivide down to, metres");
@@ -247,12 +243,20 @@ static int albedo_var_from_config(struct nc_cfg_node *item, struct nc_body *b, i
 
 int nc__scene_detail_from_config(struct nc_cfg_node *item, struct nc_cfg_node *shape, struct nc_body *b, int dry)
 {
+    if (!nc_body_is_mesh(b)) { /* a sphere's detail keys are refused, not asked: its key list leaves them out */
+        static const char *const mesh_only[][2] = {{"normals", "normals apply to mesh and asteroid shapes"},
+                                                   {"relief", "relief needs a mesh or asteroid shape"},
+                                                   {"craters", "craters need a mesh or asteroid shape"}};
+        for (int i = 0; i < 3; i++)
+            if (nc__cfg_find(shape, mesh_only[i][0]))
+                return nc_cfg_key_error(shape, mesh_only[i][0], "%s", mesh_only[i][1]);
+        const int rc = boulders_from_config(item, b, dry);
+        return rc < 0 ? rc : albedo_var_from_config(item, b, dry);
+    }
     static const char *const normals[] = {"flat", "smooth", NULL};
     int rc, smooth = 0;
     if ((rc = nc_cfg_enum(shape, "normals", normals, &smooth)) < 0)
         return rc;
-    if (rc && !nc_body_is_mesh(b))
-        return nc_cfg_key_error(shape, "normals", "normals apply to mesh and asteroid shapes");
     b->smooth_normals = smooth;
     /* Craters displace the relief along the surface under it, not along
      * its own rough normals (craters.h). */

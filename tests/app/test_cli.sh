@@ -52,6 +52,9 @@ expect 1 "serve.trigger.strobe.levle: unknown key for trigger driver 'gpio'" -- 
   --set "serve.trigger={driver: gpio, line: X, strobe: {line: Y, levle: low}}"
 expect 1 "trigger source 'software' gives commands, not line edges" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: software, debounce_s: 0.01}"
+# a trigger map without a driver is the software trigger, its documented default
+expect 1 "trigger source 'software' gives commands, not line edges" -- "$navcam" serve --set serve.mode=trigger \
+  --set "serve.trigger={debounce_s: 0.01}"
 # Each command is its own program and loads only the libraries it uses.
 libexec=$(dirname "$navcam")/libexec/navcam
 needed() { readelf -d "$1" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | tr '\n' ' '; }
@@ -115,6 +118,10 @@ expect 1 "serve.trigger.strobe.active" -- "$navcam" serve --set serve.mode=trigg
   --set "serve.trigger={driver: gpio, line: X, strobe: {line: Y, active: sideways}}"
 expect 1 "no video output device with card label 'NoSuchCam'" -- "$navcam" serve \
   --set "outputs=[{driver: v4l2, card: NoSuchCam}]"
+expect 1 "outputs[0].card: a V4L2 card label has at most 31 characters" -- "$navcam" serve \
+  --set "outputs=[{driver: v4l2, card: $(printf 'C%.0s' $(seq 32))}]"
+expect 1 "no video output device with card label '$(printf 'C%.0s' $(seq 31))'" -- "$navcam" serve \
+  --set "outputs=[{driver: v4l2, card: $(printf 'C%.0s' $(seq 31))}]"
 expect 1 "give either \`device\` or \`card\`" -- "$navcam" serve --set "outputs=[{driver: v4l2, device: /dev/video0, card: X}]"
 expect 1 "GREY holds 8 bits; the camera's ADC has 12" -- "$navcam" serve --set "outputs=[{driver: v4l2, format: GREY}]"
 expect 1 "v4l2 output: /dev/nonexistent-video: No such file or directory" -- "$navcam" serve \
