@@ -1,6 +1,7 @@
 /* lines.c - a text file read a line at a time (lines.h). */
 #include "core/lines.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,4 +44,21 @@ void nc_lines_free(struct nc_lines *l)
     free(l->line);
     l->line = NULL;
     l->cap = 0;
+}
+
+double nc_strtod_fortran(const char *s, char **end)
+{
+    const size_t lead = strspn(s, " \t\r\n\v\f"), len = strcspn(s + lead, " \t\r\n\v\f,");
+    char num[64], *e;
+    if (len >= sizeof num)
+        return strtod(s, end);
+    memcpy(num, s + lead, len);
+    num[len] = '\0';
+    for (char *c = num + 1; *c; c++)
+        if ((*c == 'D' || *c == 'd') && (isdigit((unsigned char)c[-1]) || c[-1] == '.'))
+            *c = 'E';
+    const double v = strtod(num, &e);
+    if (end)
+        *end = (char *)s + (e == num ? 0 : lead + (size_t)(e - num));
+    return v;
 }

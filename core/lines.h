@@ -29,4 +29,8 @@ int nc_lines_next(struct nc_lines *l);
 
 void nc_lines_free(struct nc_lines *l);
 
+/* strtod, and a Fortran D exponent (1.5D+03, as SPC's files and FITS
+ * headers write them) read as E. */
+double nc_strtod_fortran(const char *s, char **end);
+
 #endif

@@ -72,16 +72,12 @@ static int numbers(char *text, double *v, int max, char **bad)
         s += strspn(s, " \t,");
         if (!*s)
             return n;
-        char *tok = s, num[64], *end;
+        char *tok = s, *end;
         s += strcspn(s, " \t,");
         if (*s)
             *s++ = 0;
-        snprintf(num, sizeof num, "%s", tok);
-        for (char *c = num + 1; *c; c++)
-            if ((*c == 'D' || *c == 'd') && (isdigit((unsigned char)c[-1]) || c[-1] == '.'))
-                *c = 'E';
-        const double x = strtod(num, &end);
-        if (*end || end == num || strlen(tok) >= sizeof num) {
+        const double x = nc_strtod_fortran(tok, &end);
+        if (*end || end == tok) {
             *bad = tok;
             return -1;
         }

@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/lines.h"
 #include "render/image_io_impl.h"
 
 static const char *const fits_keys[][2] = {
@@ -189,16 +190,12 @@ static int scale_ok(fitsfile *f, const char *path)
 {
     static const char *const keys[] = {"BSCALE", "BZERO"};
     for (int i = 0; i < 2; i++) {
-        char raw[FLEN_VALUE], num[FLEN_VALUE], *end;
+        char raw[FLEN_VALUE], *end;
         int status = 0;
         if (fits_read_keyword(f, keys[i], raw, NULL, &status))
             continue; /* not given */
-        snprintf(num, sizeof num, "%s", raw);
-        char *dexp = strpbrk(num, "dD"); /* Fortran's D exponent, which FITS allows */
-        if (dexp)
-            *dexp = 'E';
-        const double v = strtod(num, &end);
-        if (end == num || end[strspn(end, " ")] || !isfinite(v))
+        const double v = nc_strtod_fortran(raw, &end); /* FITS allows Fortran's D exponent */
+        if (end == raw || end[strspn(end, " ")] || !isfinite(v))
             return nc_error(NC_EIMAGE, "%s: %s = %s is not a finite number", path, keys[i], raw);
     }
     return 0;

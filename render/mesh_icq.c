@@ -89,7 +89,7 @@ int nc_mesh_load_icq(const char *path, double scale, struct nc_mesh *out)
         char *end;
         int k = 0;
         for (; k < 4; k++) {
-            x[k] = strtod(s, &end);
+            x[k] = nc_strtod_fortran(s, &end);
             if (end == s)
                 break;
             s = end;

@@ -178,7 +178,7 @@ static void replaced(char *out, size_t len, const char *text, const char *from, 
  * I direction, J direction), vertices from integer cube points so that the
  * copies on the cube's edges are equal; except that face 2's copies of
  * its edge with face 1 (J = 0) are moved by shift_km along x. */
-static void write_icq(const char *path, int q, double r_km, double shift_km)
+static void write_icq(const char *path, int q, double r_km, double shift_km, int fortran)
 {
     static const int ax[6][3][3] = {{{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},  {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
                                     {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}}, {{0, 1, 0}, {-1, 0, 0}, {0, 0, -1}},
@@ -193,7 +193,12 @@ static void write_icq(const char *path, int q, double r_km, double shift_km)
                     p[k] = q * ax[face][0][k] + (2 * i - q) * ax[face][1][k] + (2 * j - q) * ax[face][2][k];
                 unit(p);
                 const double dx = face == 1 && j == 0 ? shift_km : 0;
-                fprintf(f, "%.12f %.12f %.12f\n", r_km * p[0] + dx, r_km * p[1], r_km * p[2]);
+                char line[128];
+                snprintf(line, sizeof line, fortran ? "%.12E %.12E %.12E\n" : "%.12f %.12f %.12f\n", r_km * p[0] + dx,
+                         r_km * p[1], r_km * p[2]);
+                for (char *e = line; fortran && (e = strchr(e, 'E')); e++)
+                    *e = 'D'; /* SPC's Fortran writes 0.25D+00 */
+                fputs(line, f);
             }
     fclose(f);
 }
@@ -240,16 +245,18 @@ static void check_icq(void)
 {
     const int q = 16;
     const char *path = nc_test_path("SHAPE.TXT");
-    write_icq(path, q, 0.25, 0);
+    write_icq(path, q, 0.25, 0, 0);
+    check_closed(path, q);
+    write_icq(path, q, 0.25, 0, 1);
     check_closed(path, q);
     /* Copies of an edge's vertex 0.1 mm apart (under 1e-6 of the 250 m
      * extent) are still welded: the surface stays closed. */
-    write_icq(path, q, 0.25, 1e-7);
+    write_icq(path, q, 0.25, 1e-7, 0);
     check_closed(path, q);
     /* 1 m apart: an error naming both lines, the first at fault face 2's
      * vertex I = 0, J = 0 (line 2 + (Q+1)^2), a copy of face 1's I = 0,
      * J = Q (line 2 + Q (Q+1)). */
-    write_icq(path, q, 0.25, 1e-3);
+    write_icq(path, q, 0.25, 1e-3, 0);
     struct nc_mesh m;
     char want[128];
     snprintf(want, sizeof want, "SHAPE.TXT:%d: this vertex and the one on line %d", 2 + (q + 1) * (q + 1),
