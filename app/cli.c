@@ -33,15 +33,11 @@ int nc_cli_fail(void)
 int nc_cli_getopt(int argc, char *const argv[], const char *shortopts, const struct option *opts)
 {
     const int c = getopt_long(argc, argv, shortopts, opts, NULL);
-    if (c == -1 || c == '?' || !optarg || strncmp(optarg, "--", 2) != 0 || !optarg[2])
+    /* a value of its own argument (not --output=--x or -o--x, which say what they mean) */
+    if (c == -1 || c == '?' || !optarg || optind < 2 || optarg != argv[optind - 1] || strncmp(optarg, "--", 2) != 0 ||
+        !optarg[2])
         return c;
-    const struct option *o = opts;
-    while (o->name && o->val != c)
-        o++;
-    if (o->name)
-        fprintf(stderr, "%s: --%s needs a value, got the option '%s'\n", name, o->name, optarg);
-    else
-        fprintf(stderr, "%s: -%c needs a value, got the option '%s'\n", name, c, optarg);
+    fprintf(stderr, "%s: %s needs a value, got the option '%s'\n", name, argv[optind - 2], optarg);
     return '?';
 }
 

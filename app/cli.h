@@ -14,10 +14,11 @@ void nc_cli_init(const char *command);
 /* Prints "navcam CMD: <last error>" and returns 1 (the exit status). */
 int nc_cli_fail(void);
 
-/* getopt_long, but an option's value that is itself a long option ("--set
- * --set k=v", "-o --json") is refused: "navcam CMD: --set needs a value, got
- * the option '--set'" on stderr and '?', which every command answers with
- * its usage hint and exit status 2. */
+/* getopt_long, but an option's value that is itself a long option, given
+ * as the next argument ("--set --set k=v", "-o --json"), is refused:
+ * "navcam CMD: --set needs a value, got the option '--set'" (the option as
+ * typed) on stderr and '?', which every command answers with exit status 2
+ * and a hint to its --help. --output=--x.png is taken as written. */
 int nc_cli_getopt(int argc, char *const argv[], const char *shortopts, const struct option *opts);
 
 /* A number option's value: the whole of s a number in [lo, hi], else

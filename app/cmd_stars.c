@@ -83,7 +83,7 @@ int main(int argc, char **argv)
             }
             break;
         case 'h': fputs(stars_help, stdout); return 0;
-        default: return 2;
+        default: fputs("Try 'navcam stars --help'.\n", stderr); return 2;
         }
     }
     if (!out || optind != argc - 1) {

@@ -39,9 +39,21 @@ static int sync_path(const char *path)
     return rc < 0 ? nc_error(rc, "%s: fsync: %s", path, strerror(-rc)) : 0;
 }
 
+int nc_fs_replaceable(const char *path)
+{
+    struct stat st;
+    if (lstat(path, &st) < 0 || S_ISREG(st.st_mode) || S_ISLNK(st.st_mode))
+        return 0;
+    return nc_error(-EEXIST, "%s: exists and is not a regular file (%s): not replaced", path,
+                    S_ISDIR(st.st_mode) ? "a directory" : "a device, pipe or socket");
+}
+
 int nc_commit_file(const char *tmp, const char *path)
 {
-    int rc = sync_path(tmp);
+    int rc = nc_fs_replaceable(path);
+    if (rc < 0)
+        return rc;
+    rc = sync_path(tmp);
     if (rc < 0)
         return rc;
     if (rename(tmp, path) < 0)

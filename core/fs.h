@@ -8,7 +8,13 @@
  * made. */
 int nc_mkdirs(const char *dir);
 
-/* Put the complete file tmp in place as path: its data flushed to the disk
+/* Whether a file put in place by rename may replace what is at path: 0 for
+ * nothing there, a regular file or a symbolic link (the link itself is
+ * replaced, not its target); -EEXIST with a message for a directory, a
+ * device, a pipe or a socket (as root, a rename would replace /dev/null). */
+int nc_fs_replaceable(const char *path);
+
+/* Put the complete file tmp in place as path (nc_fs_replaceable first): its data flushed to the disk
  * (fsync), renamed, and the rename flushed (fsync of path's directory), so
  * that after a crash or a power cut path is either absent or whole. 0, or
  * -errno with a message naming the file. */

@@ -32,8 +32,8 @@ int nc_lines_next(struct nc_lines *l)
         l->len -= 3;
         memmove(l->line, l->line + 3, l->len + 1);
     }
-    const char *cr = strchr(l->line, '\r');
-    if (cr && strcmp(cr, "\r\n") != 0 && cr[1] != '\0')
+    const char *cr = strchr(l->line, '\r'); /* CRs ending the line (CR LF, or CR CR LF converted twice) are fine */
+    if (cr && strcmp(cr + strspn(cr, "\r"), "\n") != 0 && cr[strspn(cr, "\r")] != '\0')
         return nc_error(l->code, "%s:%zu: a carriage return at column %zu inside the line (classic Mac line ends? "
                         "end lines with LF or CR LF)", l->path, l->no, (size_t)(cr - l->line) + 1);
     return 1;

@@ -22,8 +22,8 @@ void nc_lines_init(struct nc_lines *l, FILE *f, const char *path, int code);
 
 /* The next line into l->line: 1; 0 at the end of the file; code with
  * "PATH:NO: a NUL byte at column C (a binary or damaged file?)", or for a
- * carriage return not ending the line (CR LF and LF end lines; a lone CR,
- * classic Mac's, would run lines together); -EIO when the file cannot be
+ * carriage return not ending the line (LF, CR LF or CR CR LF end lines; a
+ * lone CR, classic Mac's, would run lines together); -EIO when the file cannot be
  * read. A UTF-8 byte-order mark opening the file is dropped. */
 int nc_lines_next(struct nc_lines *l);
 

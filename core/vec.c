@@ -36,7 +36,9 @@ int nc_quat_look_at(struct nc_vec3 eye, struct nc_vec3 target, struct nc_vec3 up
     z = nc_v3_unit(z);
     /* Image +Y is down, so the camera's -Y should lean toward `up`. */
     struct nc_vec3 x = nc_v3_cross(nc_v3_scale(up, -1.0), z);
-    if (nc_v3_norm(x) < 1e-9 * nc_v3_norm(up))
+    if (nc_v3_is_zero(up))
+        return nc_error(NC_ERANGE, "look-at 'up' vector is zero");
+    if (nc_v3_norm(nc_v3_cross(nc_v3_unit(up), z)) < 1e-9) /* of unit length: no overflow or underflow */
         return nc_error(NC_ERANGE, "look-at 'up' vector is parallel to the line of sight");
     x = nc_v3_unit(x);
     struct nc_vec3 y = nc_v3_cross(z, x);

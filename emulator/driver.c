@@ -32,7 +32,7 @@ static const void *select_driver(const void *const *list, struct nc_cfg_node *op
     if (is_builtin)
         *is_builtin = 0;
     *rc = nc_cfg_string(opts, "driver", &name);
-    if (*rc == 0 && builtin) { /* not named: the built-in one, the default */
+    if (*rc == 0 && builtin && is_builtin) { /* not named: the built-in one, the default */
         *is_builtin = 1;
         *rc = 1;
         return NULL;

@@ -243,8 +243,8 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
         return nc_error(-ENOMEM, "%s: out of memory", path);
     }
     int rc = scale_ok(f, path);
-    /* Row by row in double: a pixel the BLANK keyword (or IEEE NaN) marks undefined becomes NaN, and a value
-     * beyond a float's range is an error (cast, it would turn into an infinity unseen). */
+    /* Row by row in double: a pixel the BLANK keyword (or IEEE NaN) marks undefined becomes NaN, and so does a
+     * value beyond a float's range (a float64 file's fill value, such as -DBL_MAX), as a float TIFF's would. */
     const double nul = NAN;
     for (long y = 0; rc == 0 && y < naxes[1]; y++) {
         int anynul = 0;
@@ -252,14 +252,8 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
             rc = fits_fail(path, "read", status);
             break;
         }
-        for (long x = 0; x < naxes[0]; x++) {
-            if (isfinite(row[x]) && fabs(row[x]) > FLT_MAX) {
-                rc = nc_error(NC_EIMAGE, "%s: the pixel at row %ld, column %ld (from 1, as FITS counts) is %g, beyond "
-                              "a 32-bit float's range", path, y + 1, x + 1, row[x]);
-                break;
-            }
-            buf[(size_t)y * (size_t)naxes[0] + (size_t)x] = (float)row[x];
-        }
+        for (long x = 0; x < naxes[0]; x++)
+            buf[(size_t)y * (size_t)naxes[0] + (size_t)x] = fabs(row[x]) <= FLT_MAX ? (float)row[x] : NAN;
     }
     free(row);
     if (rc < 0) {

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/fs.h"
 #include "render/image_io_impl.h"
 
 enum fmt { FMT_NONE, FMT_EXR, FMT_TIFF, FMT_FITS, FMT_PNG };
@@ -81,7 +82,7 @@ static int write_file(const char *path, const void *px, enum nc__pixel t, int w,
 {
     char tmp[4200];
     int rc = tmp_path(path, tmp, sizeof tmp);
-    if (rc < 0)
+    if (rc < 0 || (rc = nc_fs_replaceable(path)) < 0)
         return rc;
     rc = format_of(path) == FMT_FITS ? nc__fits_write(tmp, px, t, w, h, depth, attrs, nattrs)
                                      : nc__oiio_write(tmp, px, w, h, t, attrs, nattrs, desc);
@@ -299,26 +300,27 @@ void nc_image_flip(void *px, size_t elem, int w, int h, int rows, int cols)
             }
 }
 
-/* A file that cannot be opened as such is said why (cfitsio and OpenImageIO
- * say "could not open the named file" for a missing, unreadable or looping
- * path alike, and a directory is "error reading from FITS file"). */
-static int readable(const char *path)
+/* After a failed read: why, where the path itself says it (cfitsio and
+ * OpenImageIO say "could not open the named file" for a missing,
+ * unreadable or looping path alike, and a directory is "error reading from
+ * FITS file"); the readers' own message otherwise. Asked only after the
+ * read, so that cfitsio's extended names (file.fits[1]) still reach it. */
+static int why_unread(const char *path, int rc)
 {
     struct stat st;
-    FILE *f = NULL;
-    if (stat(path, &st) < 0 || (!S_ISDIR(st.st_mode) && !(f = fopen(path, "rb"))))
+    if (stat(path, &st) < 0) /* a missing "x.fits[1]" is cfitsio's to explain */
+        return errno == ENOENT && strchr(path, '[') ? rc : nc_error(-errno, "%s: %s", path, strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return nc_error(NC_EIMAGE, "%s: is a directory, not an image", path);
+    if (access(path, R_OK) < 0)
         return nc_error(-errno, "%s: %s", path, strerror(errno));
-    if (f)
-        fclose(f);
-    return S_ISDIR(st.st_mode) ? nc_error(NC_EIMAGE, "%s: is a directory, not an image", path) : 0;
+    return rc;
 }
 
 int nc_image_read(const char *path, float **px, int *w, int *h)
 {
-    int rc = readable(path);
-    if (rc < 0)
-        return rc;
-    return format_of(path) == FMT_FITS ? nc__fits_read(path, px, w, h) : nc__oiio_read(path, px, w, h);
+    const int rc = format_of(path) == FMT_FITS ? nc__fits_read(path, px, w, h) : nc__oiio_read(path, px, w, h);
+    return rc < 0 ? why_unread(path, rc) : rc;
 }
 
 /* Value of "name" in the JSON object written by describe(). */
@@ -340,11 +342,9 @@ static int json_get(const char *json, const char *name, char *buf, size_t len)
     return 0;
 }
 
-int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len)
+static int read_attr(const char *path, const char *name, char *buf, size_t len)
 {
-    int rc = readable(path);
-    if (rc < 0)
-        return rc;
+    int rc;
     enum fmt f = format_of(path);
     if (f == FMT_FITS)
         return nc__fits_read_attr(path, name, buf, len);
@@ -359,4 +359,10 @@ int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len
         rc = nc_error(NC_EIMAGE, "%s: no attribute '%s' in ImageDescription", path, name);
     free(desc);
     return rc;
+}
+
+int nc_image_read_attr(const char *path, const char *name, char *buf, size_t len)
+{
+    const int rc = read_attr(path, name, buf, len);
+    return rc < 0 ? why_unread(path, rc) : rc;
 }

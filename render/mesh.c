@@ -84,17 +84,24 @@ int nc_mesh_load(const char *path, double scale_to_m, struct nc_mesh *out)
 /* ---- OBJ -------------------------------------------------------------- */
 
 /* Parse one face corner "i", "i/t", "i//n" or "i/t/n" (whole numbers; a
- * negative i counts back from the last vertex so far). */
+ * negative i counts back from the last vertex so far); a '#' may follow. */
 static int obj_index(const char **s, long *out)
 {
     char *end;
     errno = 0;
     *out = strtol(*s, &end, 10);
-    if (end == *s || errno || (*end && *end != '/' && !isspace((unsigned char)*end)))
+    if (end == *s || errno)
         return -1;
-    end += strspn(end, "/+-0123456789");
+    for (int part = 0; part < 2 && *end == '/'; part++) { /* t, n: each may be empty */
+        const char *at = ++end;
+        if (*at == '+' || *at == '-' || isdigit((unsigned char)*at)) {
+            strtol(at, &end, 10);
+            if (end == at)
+                return -1;
+        }
+    }
     *s = end;
-    return *end && !isspace((unsigned char)*end) ? -1 : 0;
+    return *end && *end != '#' && !isspace((unsigned char)*end) ? -1 : 0;
 }
 
 int nc_mesh_load_obj(const char *path, double scale, struct nc_mesh *out)

@@ -60,10 +60,22 @@ struct ply_reader {
     enum ply_format fmt;
     struct nc_lines ln; /* the header's lines, and an ASCII body's */
     char *cur;          /* ASCII: cursor in ln.line */
-    char at[4200];      /* where the element being read is, for errors: "PATH:LINE: vertex 3" */
+    const struct ply_elem *el; /* the element being read: el->name, its index i, from ASCII line `line` */
+    size_t i, line;
+    char at[4200]; /* where() writes "PATH:LINE: vertex 3" here, for an error */
 };
 
-/* The next element (ASCII: the next line that is not blank), named in errors as r->at. */
+/* Where the element being read is, for an error message (formatted only then: a mesh has millions). */
+static const char *where(struct ply_reader *r)
+{
+    if (r->fmt == PLY_ASCII)
+        snprintf(r->at, sizeof r->at, "%.4000s:%zu: %.63s %zu", r->path, r->line, r->el->name, r->i);
+    else
+        snprintf(r->at, sizeof r->at, "%.4000s: %.63s %zu (counted from 0)", r->path, r->el->name, r->i);
+    return r->at;
+}
+
+/* The next element (ASCII: the next line that is not blank), named in errors by where(). */
 static int ply_begin(struct ply_reader *r, const struct ply_elem *x, size_t i)
 {
     if (r->fmt == PLY_ASCII) {
@@ -78,10 +90,8 @@ static int ply_begin(struct ply_reader *r, const struct ply_elem *x, size_t i)
             if (*r->cur)
                 break;
         }
-        snprintf(r->at, sizeof r->at, "%.4000s:%zu: %.63s %zu", r->path, r->ln.no, x->name, i);
-    } else {
-        snprintf(r->at, sizeof r->at, "%.4000s: %.63s %zu (counted from 0)", r->path, x->name, i);
     }
+    r->el = x, r->i = i, r->line = r->ln.no;
     return 0;
 }
 
@@ -89,7 +99,7 @@ static int ply_begin(struct ply_reader *r, const struct ply_elem *x, size_t i)
 static int ply_end(struct ply_reader *r)
 {
     if (r->fmt == PLY_ASCII && r->cur[strspn(r->cur, " \t\r\n")])
-        return nc_error(NC_EMESH, "%s: more values on the line than its properties take ('%.*s')", r->at,
+        return nc_error(NC_EMESH, "%s: more values on the line than its properties take ('%.*s')", where(r),
                         (int)strcspn(r->cur + strspn(r->cur, " \t"), "\r\n"), r->cur + strspn(r->cur, " \t"));
     return 0;
 }
@@ -100,18 +110,18 @@ static int ply_read(struct ply_reader *r, enum ply_type t, double *out)
     if (r->fmt == PLY_ASCII) {
         r->cur += strspn(r->cur, " \t");
         if (!*r->cur || *r->cur == '\r' || *r->cur == '\n')
-            return nc_error(NC_EMESH, "%s: the line ends before its properties do", r->at);
+            return nc_error(NC_EMESH, "%s: the line ends before its properties do", where(r));
         char *end;
         *out = strtod(r->cur, &end);
         if (end == r->cur || (*end && !isspace((unsigned char)*end)))
-            return nc_error(NC_EMESH, "%s: '%.*s' is not a number", r->at, (int)strcspn(r->cur, " \t\r\n"), r->cur);
+            return nc_error(NC_EMESH, "%s: '%.*s' is not a number", where(r), (int)strcspn(r->cur, " \t\r\n"), r->cur);
         r->cur = end;
         return 0;
     }
     unsigned char b[8];
     size_t n = ply_size(t);
     if (fread(b, 1, n, r->f) != n)
-        return nc_error(NC_EMESH, "%s: unexpected end of binary data", r->at);
+        return nc_error(NC_EMESH, "%s: unexpected end of binary data", where(r));
     int host_le = 1;
     host_le = *(unsigned char *)&host_le;
     if ((r->fmt == PLY_LE) != host_le)
@@ -307,7 +317,7 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
                         goto out;
                     if (is_v && (p == ix || p == iy || p == iz)) {
                         if (!isfinite(val)) {
-                            rc = nc_error(NC_EMESH, "%s: a coordinate is not finite", r.at);
+                            rc = nc_error(NC_EMESH, "%s: a coordinate is not finite", where(&r));
                             goto out;
                         }
                         m.v[3 * i + (p == ix ? 0 : p == iy ? 1 : 2)] = val * scale;
@@ -319,11 +329,11 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
                     goto out;
                 if (is_f && p == ilist && cnt != 3) {
                     rc = nc_error(NC_EMESH, "%s: a face of %g vertices; NavCam needs triangles (triangulate the mesh)",
-                                  r.at, cnt);
+                                  where(&r), cnt);
                     goto out;
                 }
                 if (!(cnt >= 0 && cnt <= 1e6) || cnt != floor(cnt)) {
-                    rc = nc_error(NC_EMESH, "%s: bad list length %g", r.at, cnt);
+                    rc = nc_error(NC_EMESH, "%s: bad list length %g", where(&r), cnt);
                     goto out;
                 }
                 for (long k = 0; k < (long)cnt; k++) {
@@ -332,7 +342,7 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
                     if (is_f && p == ilist) {
                         if (!have_v || val < 0 || val >= (double)m.nv || val != floor(val)) {
                             rc = nc_error(NC_EMESH, "%s: vertex index %g out of range (%zu vertices, counted from 0)%s",
-                                          r.at, val, m.nv, r.fmt == PLY_ASCII ? "" : "; is the byte order right?");
+                                          where(&r), val, m.nv, r.fmt == PLY_ASCII ? "" : "; is the byte order right?");
                             goto out;
                         }
                         m.tri[3 * i + k] = (uint32_t)val;
@@ -356,9 +366,15 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
             }
         if (rc < 0)
             goto out;
-    } else if (fgetc(r.f) != EOF) {
-        rc = nc_error(NC_EMESH, "%s: data after the elements the header announces (does it count them all?)", path);
-        goto out;
+    } else {
+        int c; /* a line end or blanks after binary data are a writer's habit, not data */
+        while ((c = fgetc(r.f)) != EOF && (c == '\n' || c == '\r' || c == ' ' || c == '\t'))
+            ;
+        if (c != EOF) {
+            rc = nc_error(NC_EMESH, "%s: data after the elements the header announces (does it count them all?)",
+                          path);
+            goto out;
+        }
     }
     *out = m;
     m = (struct nc_mesh){0};

@@ -32,8 +32,8 @@ static int dem_from_config(struct nc_cfg_node *sh, struct nc_body *b, int dry)
         p.pixel_m[1] = p.pixel_m[0];
     if (rc < 0)
         return rc;
-    if (!(p.pixel_m[0] > 0 && p.pixel_m[1] > 0))
-        return nc_cfg_error(px, "pixel sizes must be > 0 m");
+    if (!(p.pixel_m[0] >= 1e-6 && p.pixel_m[0] <= 1e7 && p.pixel_m[1] >= 1e-6 && p.pixel_m[1] <= 1e7))
+        return nc_cfg_error(px, "expected pixel sizes in [1e-6, 1e7] m, got %g and %g", p.pixel_m[0], p.pixel_m[1]);
     if ((rc = nc_cfg_double(sh, "height_scale", -1e9, 1e9, &p.height_scale)) < 0 ||
         (rc = nc_cfg_double(sh, "height_offset_m", -1e9, 1e9, &p.height_offset_m)) < 0)
         return rc;

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/fs.h"
 #include "core/le.h"
 #include "core/lines.h"
 #include "render/rt.h"
@@ -149,24 +150,26 @@ int nc_star_cat_write(const struct nc_star_cat *c, const char *path)
         nc_le_put_f32(p + 24, s->v_mag);
         nc_le_put_f32(p + 28, s->b_v);
     }
-    /* under a temporary name, renamed into place once whole: a failed write leaves no partial index */
+    /* under a temporary name, put in place once whole: a failed write leaves no partial index */
     char tmp[4200];
     snprintf(tmp, sizeof tmp, "%.4000s.%ld.tmp", path, (long)getpid());
-    FILE *f = fopen(tmp, "wb");
-    int err = f ? 0 : errno;
+    int rc = nc_fs_replaceable(path);
+    FILE *f = rc < 0 ? NULL : fopen(tmp, "wb");
+    if (rc == 0 && !f)
+        rc = nc_error(-errno, "%s: cannot write the star index: %s", path, strerror(errno));
     if (f) {
         errno = 0;
-        if (fwrite(b, 1, size, f) != size)
-            err = errno ? errno : EIO;
-        if (fclose(f) != 0 && !err)
-            err = errno;
-        if (!err && rename(tmp, path) < 0)
-            err = errno;
-        if (err)
+        const int err = fwrite(b, 1, size, f) != size ? (errno ? errno : EIO) : 0;
+        if (fclose(f) != 0 || err)
+            rc = nc_error(-(err ? err : errno), "%s: cannot write the star index: %s", path,
+                          strerror(err ? err : errno));
+        if (rc == 0)
+            rc = nc_commit_file(tmp, path);
+        if (rc < 0)
             remove(tmp);
     }
     free(b);
-    return err ? nc_error(-err, "%s: cannot write the star index: %s", path, strerror(err)) : 0;
+    return rc;
 }
 
 int nc_star_cat_load(const char *path, struct nc_star_cat *c)

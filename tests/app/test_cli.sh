@@ -147,8 +147,9 @@ expect 2 "navcam render: unrecognized option '--bogus'" -- "$navcam" render --bo
 # an option's value that is itself an option is refused, not taken (getopt would read "--set --set k=v" as a
 # --set of "--set" and a file "k=v")
 expect 2 "navcam render: --set needs a value, got the option '--set'" -- "$navcam" render --set --set a=1 -o x.exr
-expect 2 "navcam batch: --output needs a value, got the option '--json'" -- "$navcam" batch builtin:approach -o --json
+expect 2 "navcam batch: -o needs a value, got the option '--json'" -- "$navcam" batch builtin:approach -o --json
 expect 2 "navcam pose send: --host needs a value, got the option '--port'" -- "$navcam" pose send --host --port 1
+expect 0 "wrote --x.png" -- env -C "$tmp" "$navcam" render --output=--x.png "${small[@]}" # attached: as written
 expect 0 "navcam stars info INDEX" -- "$navcam" stars info --help
 # Number options: the whole argument a number in range, else exit 2 naming it.
 expect 2 "navcam replay: --speed expects 0..1e+06, got 'abc'" -- "$navcam" replay builtin:approach --speed abc

@@ -14,6 +14,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "camera/load.h"
 #include "camera/sky.h"
@@ -127,6 +129,20 @@ int main(void)
               !memcmp(d.star, c.star, 3 * sizeof *c.star),
           "index round trip: %s", nc_errmsg());
     CHECK(nc_star_cat_count_to(&d, 0.0) == 1 && nc_star_cat_count_to(&d, 9) == 3, "prefix to a magnitude");
+    { /* a pipe (or, as root, /dev/null) at the index's path is not replaced; a symbolic link is, not its target */
+        const char *fifo = nc_test_path("pipe.ncs"), *link = nc_test_path("link.ncs");
+        struct stat st;
+        unlink(fifo);
+        CHECK(mkfifo(fifo, 0600) == 0 && nc_star_cat_write(&c, fifo) < 0 &&
+                  nc_test_contains(nc_errmsg(), "pipe.ncs: exists and is not a regular file") && stat(fifo, &st) == 0 &&
+                  S_ISFIFO(st.st_mode),
+              "a pipe at the index's path: %s", nc_errmsg());
+        unlink(fifo);
+        unlink(link);
+        CHECK(symlink(fifo, link) == 0 && nc_star_cat_write(&c, link) == 0 && lstat(link, &st) == 0 &&
+                  S_ISREG(st.st_mode),
+              "a symbolic link at the index's path: %s", nc_errmsg());
+    }
     nc_star_cat_free(&d);
     { /* an index whose header epoch is no epoch (every star vanished), with bytes past its stars, with a
        * star's Dec beyond the pole, or out of magnitude order: each named */

@@ -112,6 +112,13 @@ int main(void)
     expect_fail("verts.obj", "v 0 0 0\nv 1 0 0\n", "mesh has no triangles");
     expect_fail("garbage.obj", "f x y z\n", "garbage.obj:1: bad face index 'x'");
     expect_fail("idxjunk.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1abc 2 3\n", "idxjunk.obj:4: bad face index '1abc'");
+    expect_fail("idxparts.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/-/+ 2 3\n", "idxparts.obj:4: bad face index '1/-/+'");
+    /* corners with parts and a comment right after the last: read as before */
+    rc = nc_mesh_load(write_tmp("parts.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/1/1 2//2 3/3/#tri\nf -3/ -2/-2 -1#c\n"),
+                      1.0, &m);
+    CHECK(rc == 0 && m.nt == 2 && m.tri[2] == 2 && m.tri[3] == 0, "parts.obj: %s", rc < 0 ? nc_errmsg() : "wrong");
+    if (rc == 0)
+        nc_mesh_free(&m);
     expect_fail("idxreal.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2.5 3\n", "idxreal.obj:4: bad face index '2.5'");
     expect_fail("relative.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf -1 -2 -7\n",
                 "relative.obj:4: face index -7 out of range (3 vertices before it)");
@@ -185,6 +192,8 @@ int main(void)
             fwrite(b, 1, 4, f);
         }
         if (k == 3)
+            fputs("\r\nx", f); /* a line end after binary data is fine, more is not */
+        if (k == 1)
             fputc('\n', f);
         fclose(f);
         rc = nc_mesh_load(nc_test_path(name), 1.0, &m);
