@@ -50,6 +50,10 @@ static inline void nc_v3_basis(struct nc_vec3 a, struct nc_vec3 *e1, struct nc_v
     *e2 = nc_v3_cross(a, *e1);
 }
 
+static inline int nc_quat_isfinite(struct nc_quat q)
+{
+    return isfinite(q.w) && isfinite(q.x) && isfinite(q.y) && isfinite(q.z);
+}
 static inline double nc_quat_norm(struct nc_quat q) { return sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z); }
 
 static inline struct nc_quat nc_quat_mul(struct nc_quat a, struct nc_quat b)

@@ -114,6 +114,8 @@ def main():
         ap.error("give a trajectory file or --circle N")
     port = a.port or (5751 if a.lockstep else 5750)
     sock = socket.create_connection((a.host, port)) if a.lockstep else socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    if a.lockstep:  # small messages sent at once, not held back for an acknowledgement (docs/protocol.md)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     t0 = time.monotonic()
     for seq, (t, pos, q, sun, cap) in enumerate(rows, start=1):
         msg = encode(POSE, seq, CAPTURE if cap else 0, int(round(t * 1e9)), pos, q, sun)

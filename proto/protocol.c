@@ -126,7 +126,6 @@ static const uint8_t *get_quat(const uint8_t *p, struct nc_quat *q)
     return p + 32;
 }
 
-static int quat_finite(struct nc_quat q) { return isfinite(q.w) && isfinite(q.x) && isfinite(q.y) && isfinite(q.z); }
 
 /* Unit within tolerance, then normalised. */
 static int unit_quat(struct nc_quat *q)
@@ -206,8 +205,8 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
         p += 8;
     }
     /* Values: all finite, quaternions unit, the rest in physical range. */
-    if (!nc_v3_isfinite(m->cam_position_m) || !quat_finite(m->cam_attitude_q) || !nc_v3_isfinite(m->sun) ||
-        !nc_v3_isfinite(m->body_position_m) || !quat_finite(m->body_attitude_q) ||
+    if (!nc_v3_isfinite(m->cam_position_m) || !nc_quat_isfinite(m->cam_attitude_q) || !nc_v3_isfinite(m->sun) ||
+        !nc_v3_isfinite(m->body_position_m) || !nc_quat_isfinite(m->body_attitude_q) ||
         !nc_v3_isfinite(m->cam_velocity_m_s) || !nc_v3_isfinite(m->cam_angular_velocity_rad_s) ||
         !nc_v3_isfinite(m->body_velocity_m_s) || !nc_v3_isfinite(m->body_angular_velocity_rad_s) ||
         !isfinite(m->exposure_s) || !isfinite(m->gain_db))

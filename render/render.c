@@ -1075,6 +1075,19 @@ int nc_render_tile_list(struct nc_renderer *r, const struct nc_scene *s, struct 
     return render_rows(r, s, f, 0, n, tiles, blocks, NULL, pass);
 }
 
+/* Every pose of the scene finite: the camera's, the bodies', the Sun's
+ * (a pose propagated by rates too large for its time turns into NaN, and
+ * a frame of it would be no image of anything). */
+static int pose_finite(const struct nc_scene *s)
+{
+    int ok = nc_v3_isfinite(s->camera.position_m) && nc_quat_isfinite(s->camera.attitude_q) &&
+             nc_v3_isfinite(s->sun.has_position ? s->sun.position_m : s->sun.direction);
+    for (int b = 0; b < s->nbodies; b++)
+        ok = ok && nc_v3_isfinite(s->body[b].position_m) && nc_quat_isfinite(s->body[b].attitude_q);
+    return ok ? 0 : nc_error(NC_ERANGE, "the pose to render is not finite (the camera's, a body's or the Sun's: "
+                                        "rates too large for the time they are propagated over?)");
+}
+
 /* Tile rows [begin, end), or the tiles tiles[0 .. end - begin) where not NULL. */
 static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct nc_frame *f, int tile_row_begin,
                        int tile_row_end, const int *tiles, int blocks, const double *row_dt,
@@ -1084,8 +1097,8 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
     if (f->width_px != c->width_px || f->height_px != c->height_px)
         return nc_error(NC_ERANGE, "frame is %dx%d but the camera is %dx%d", f->width_px, f->height_px,
                         c->width_px, c->height_px);
-    int rc = nc_rt_update(r->rt, s);
-    if (rc < 0)
+    int rc = pose_finite(s);
+    if (rc < 0 || (rc = nc_rt_update(r->rt, s)) < 0)
         return rc;
     struct job j = {.r = r, .s = s, .rt = r->rt, .f = f};
     struct nc_rt_stats st;

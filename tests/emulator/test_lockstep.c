@@ -285,11 +285,20 @@ static void failures_are_drops(void)
                             .exposure_s = 0.01};
     nc_client_send(c, &m);
     uint32_t s1 = one_answer(c, &f1);
+    /* A body's rate that turns its attitude at mid-exposure into NaN: no frame of it either (it was delivered,
+     * a flat image with NaN in its record) */
+    struct nc_pose_msg mb = {.type = NC_MSG_POSE, .flags = NC_MSG_CAPTURE | NC_MSG_BODY_POSE | NC_MSG_BODY_RATES,
+                             .sim_time_ns = 2500000000, .cam_position_m = {0, -3000, 0},
+                             .cam_attitude_q = {0.70710678118654752, -0.70710678118654752, 0, 0}, .sun = {1, 0, 0},
+                             .body_attitude_q = {1, 0, 0, 0}, .body_angular_velocity_rad_s = {0, 0, 1e300}};
+    nc_client_send(c, &mb);
+    uint32_t s1b = one_answer(c, &f1);
     capture(c, 3);
     uint32_t s2 = one_answer(c, &f2);
-    CHECK(s0 == NC_FRAME_DELIVERED && s1 == NC_FRAME_DROPPED && s2 == NC_FRAME_DELIVERED && f2 == f0 + 1,
-          "render error: statuses %u %u %u, frames %llu then %llu (no gap)", s0, s1, s2, (unsigned long long)f0,
-          (unsigned long long)f2);
+    CHECK(s0 == NC_FRAME_DELIVERED && s1 == NC_FRAME_DROPPED && s1b == NC_FRAME_DROPPED && s2 == NC_FRAME_DELIVERED &&
+              f2 == f0 + 1,
+          "render error: statuses %u %u %u %u, frames %llu then %llu (no gap)", s0, s1, s1b, s2,
+          (unsigned long long)f0, (unsigned long long)f2);
     /* The output's directory gone (a file in its place): the frame is made
      * and lost on the way out. */
     snprintf(cmd, sizeof cmd, "rm -rf '%s' && touch '%s'", files, files);
@@ -300,7 +309,7 @@ static void failures_are_drops(void)
     nc_client_close(c);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
     char *text = server_log("lost");
-    CHECK(text && nc_test_contains(text, "render_error 1") && nc_test_contains(text, "output_failed 1") &&
+    CHECK(text && nc_test_contains(text, "render_error 2") && nc_test_contains(text, "output_failed 1") &&
               nc_test_contains(text, "output_busy 0") && nc_test_contains(text, "frames 2 "),
           "drop reasons in the statistics:\n%s", text ? text : "(none)");
     free(text);
