@@ -294,6 +294,10 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
             rc = nc_error(NC_EMESH, "%s: PLY face element lacks vertex_indices", path);
             goto out;
         }
+        if ((is_v && have_v) || (is_f && have_f)) {
+            rc = nc_error(NC_EMESH, "%s: the PLY header declares a second %s element", path, x->name);
+            goto out;
+        }
         if (is_v) {
             have_v = 1;
             m.nv = x->count;

@@ -238,6 +238,10 @@ int main(void)
     expect_fail("more.ply", text, "more.ply:14: data after the elements the header announces");
     snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n1 x 0\n3 0 1 2\n", ply3);
     expect_fail("word.ply", text, "word.ply:12: vertex 2: 'x' is not a number");
+    expect_fail("twice.ply", /* found by fuzz_readers: the first element's vertices were lost (leaked) */
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 1 1\n",
+                "twice.ply: the PLY header declares a second vertex element");
     snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n1 1 0\n\n", ply3);
     expect_fail("noface.ply", text, "noface.ply:13: the file ends at face 0 (counted from 0) of the 1 the header");
     expect_fail("nohdr.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", "no end_header");
