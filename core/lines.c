@@ -54,7 +54,7 @@ double nc_strtod_fortran(const char *s, char **end)
         return strtod(s, end);
     memcpy(num, s + lead, len);
     num[len] = '\0';
-    for (char *c = num + 1; *c; c++)
+    for (char *c = num + 1; *c && !strpbrk(num, "xX"); c++) /* not in a hexadecimal number's digits */
         if ((*c == 'D' || *c == 'd') && (isdigit((unsigned char)c[-1]) || c[-1] == '.'))
             *c = 'E';
     const double v = strtod(num, &e);

@@ -33,9 +33,10 @@ static int diameters_error(struct nc_cfg_node *map, double d_min_m, double d_max
     return nc_cfg_error(at ? at : map, "max_diameter_m (%g) must exceed min_diameter_m (%g)", d_max_m, d_min_m);
 }
 
-/* `shape.craters` of a mesh or asteroid (nc__scene_detail_from_config refuses it elsewhere): a mean count of the default
- * population (a number), or a map of its parameters. An asteroid without
- * the key gets 100. */
+/* `shape.craters` of a mesh or asteroid (nc__scene_detail_from_config
+ * refuses it on other shapes): a mean count of the default population (a
+ * number), or a map of its parameters. An asteroid without the key gets
+ * 100. */
 static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const double *dir, int dry)
 {
     struct nc_cfg_node *node = nc_cfg_get(sh, "craters"), *map = NULL;

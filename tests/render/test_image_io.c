@@ -207,7 +207,7 @@ static void whole_or_nothing(void)
     const char *fifo = nc_test_path("apipe.fits");
     unlink(fifo);
     CHECK(mkfifo(fifo, 0600) == 0 && nc_image_write(fifo, img, 2, 2, NULL, 0, NULL) < 0 &&
-              nc_test_contains(nc_errmsg(), "apipe.fits: exists and is not a regular file (a device, pipe or socket)") &&
+              nc_test_contains(nc_errmsg(), "apipe.fits: exists and is not a regular file (a device, pipe") &&
               stat(fifo, &st) == 0 && S_ISFIFO(st.st_mode),
           "a pipe named like the output: %s", nc_errmsg());
     unlink(fifo);
