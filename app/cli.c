@@ -149,6 +149,14 @@ void nc_cli_json_num(FILE *f, const char *key, double v, const char *sep)
         fprintf(f, "\"%s\": null%s", key, sep);
 }
 
+void nc_cli_json_vec(FILE *f, const char *key, const double *v, int n, const char *sep)
+{
+    fprintf(f, "\"%s\": [", key);
+    for (int i = 0; i < n; i++)
+        fprintf(f, "%.17g%s", v[i], i + 1 < n ? ", " : "");
+    fprintf(f, "]%s", sep);
+}
+
 void nc_cli_json_str(FILE *f, const char *key, const char *v)
 {
     fprintf(f, "\"%s\": \"", key);

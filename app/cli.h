@@ -58,6 +58,8 @@ int nc_cli_gnuplot(const char *dir, const char *script);
  * "key": "v", (the string escaped). */
 void nc_cli_json_num(FILE *f, const char *key, double v, const char *sep);
 void nc_cli_json_str(FILE *f, const char *key, const char *v);
+/* "key": [v0, v1, ...] (n numbers to 17 digits) then sep. */
+void nc_cli_json_vec(FILE *f, const char *key, const double *v, int n, const char *sep);
 
 /* The members of a texture measurement (core/texture.h): region_px,
  * scale [lo, hi], corners, corners_per_mpx, psd_beta, psd_r2, grad_mean,

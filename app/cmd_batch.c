@@ -66,14 +66,6 @@ static const char batch_help[] =
     "                        cores; 0: all cores)\n"
     "  -h, --help            this help\n";
 
-static void json_vec(FILE *f, const char *key, const double *v, int n, const char *sep)
-{
-    fprintf(f, "\"%s\": [", key);
-    for (int i = 0; i < n; i++)
-        fprintf(f, "%.17g%s", v[i], i + 1 < n ? ", " : "");
-    fprintf(f, "]%s", sep);
-}
-
 /* Row stem's lock (DIR/.STEM.lock, flock; its path into lock): held while
  * the row is rendered, so that two processes given the same rows (a shard
  * submitted again while it still runs) never write the same temporary
@@ -210,7 +202,8 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
 /* The detail a frame was rendered with, as the emulator's frame records
  * give it (docs/emulator.md). */
 struct detail {
-    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg;
+    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg, line_time_s; /* 0: global shutter */
+    int time_samples;
 };
 
 static int truth(const char *dir, const char *stem, const char *ext, int geometry, long row,
@@ -240,32 +233,38 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
     double v[4];
     fprintf(f, " \"camera\": {");
     v[0] = c->position_m.x, v[1] = c->position_m.y, v[2] = c->position_m.z;
-    json_vec(f, "position_m", v, 3, ", ");
+    nc_cli_json_vec(f, "position_m", v, 3, ", ");
     v[0] = c->attitude_q.w, v[1] = c->attitude_q.x, v[2] = c->attitude_q.y, v[3] = c->attitude_q.z;
-    json_vec(f, "attitude_q", v, 4, ", ");
+    nc_cli_json_vec(f, "attitude_q", v, 4, ", ");
     fprintf(f, "\"width_px\": %d, \"height_px\": %d, ", c->width_px, c->height_px);
     v[0] = c->fx_px, v[1] = c->fy_px, v[2] = c->cx_px, v[3] = c->cy_px;
-    json_vec(f, "fx_fy_cx_cy_px", v, 4, ", ");
+    nc_cli_json_vec(f, "fx_fy_cx_cy_px", v, 4, ", ");
     const double k[5] = {c->k1, c->k2, c->k3, c->p1, c->p2}; /* Brown-Conrady, OpenCV's order; 0 without */
-    json_vec(f, "distortion_k1_k2_k3_p1_p2", k, 5, ", ");
-    fprintf(f, "\"mirrored_rows\": %d, \"mirrored_columns\": %d},\n", c->flip_rows, c->flip_cols);
+    nc_cli_json_vec(f, "distortion_k1_k2_k3_p1_p2", k, 5, ", ");
+    fprintf(f, "\"mirrored_rows\": %d, \"mirrored_columns\": %d, ", c->flip_rows, c->flip_cols);
+    const double m[6] = {c->velocity_m_s.x, c->velocity_m_s.y, c->velocity_m_s.z, c->angular_velocity_rad_s.x,
+                         c->angular_velocity_rad_s.y, c->angular_velocity_rad_s.z}; /* the motion through the exposure */
+    nc_cli_json_vec(f, "velocity_m_s", m, 3, ", ");
+    nc_cli_json_vec(f, "angular_velocity_rad_s", m + 3, 3, ", ");
+    fprintf(f, "\"shutter\": \"%s\", \"line_time_s\": %.17g, \"time_samples\": %d},\n",
+            d->line_time_s > 0 ? "rolling" : "global", d->line_time_s, d->time_samples);
     struct nc_vec3 sd;
     double irr;
     nc_scene_sun_at(s, s->body[0].position_m, &sd, &irr);
     fprintf(f, " \"sun\": {");
     v[0] = s->sun.direction.x, v[1] = s->sun.direction.y, v[2] = s->sun.direction.z;
     if (!s->sun.has_position)
-        json_vec(f, "direction_body0", v, 3, ", ");
+        nc_cli_json_vec(f, "direction_body0", v, 3, ", ");
     v[0] = sd.x, v[1] = sd.y, v[2] = sd.z;
-    json_vec(f, "direction_scene", v, 3, ", ");
+    nc_cli_json_vec(f, "direction_scene", v, 3, ", ");
     fprintf(f, "\"distance_m\": %.17g, \"irradiance_w_m2\": %.17g},\n \"bodies\": [", s->sun.distance_m, irr);
     for (int b = 0; b < s->nbodies; b++) {
         const struct nc_body *bd = &s->body[b];
         fprintf(f, "{\"name\": \"%s\", ", bd->name);
         v[0] = bd->position_m.x, v[1] = bd->position_m.y, v[2] = bd->position_m.z;
-        json_vec(f, "position_m", v, 3, ", ");
+        nc_cli_json_vec(f, "position_m", v, 3, ", ");
         v[0] = bd->attitude_q.w, v[1] = bd->attitude_q.x, v[2] = bd->attitude_q.y, v[3] = bd->attitude_q.z;
-        json_vec(f, "attitude_q", v, 4, "}");
+        nc_cli_json_vec(f, "attitude_q", v, 4, "}");
         fprintf(f, "%s", b + 1 < s->nbodies ? ", " : "],\n");
     }
     /* the keys and types of the emulator's frame records (docs/emulator.md) */
@@ -325,7 +324,8 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
         (rc = nc_commit_file(tmp, path)) < 0)
         return rc;
     const struct detail det = {nc_rt_lod_error_m(r->rt), nc_rt_boulder_min_m(r->rt), nc_rt_boulder_mesh_px(r->rt),
-                               nc_render_fold_theta_bar_deg(r, s.nbodies)};
+                               nc_render_fold_theta_bar_deg(r, s.nbodies),
+                               cs->sensor.shutter == NC_SHUTTER_ROLLING ? cs->sensor.line_time_s : 0, info.time_samples};
     int nrocks = -1, ncraters = -1;
     if (geometry) {
         snprintf(tmp, sizeof tmp, "%s/.%s_geometry.tmp.fits", dir, stem);

@@ -119,7 +119,8 @@ static void charge_row(const float *restrict lam, const float *restrict p0, cons
                        const float *restrict zs, int W, int shot, float *restrict q)
 {
     for (int x = 0; x < W; x++) {
-        float hi = floorf(lam[x] + sqrtf(lam[x]) * zs[x] + 0.5f);
+        /* variance lambda - 1/12: rounding to whole electrons adds 1/12 back */
+        float hi = floorf(lam[x] + sqrtf(lam[x] - 0.083333333f) * zs[x] + 0.5f);
         hi = hi > 0 ? hi : 0.0f;
         float lo = u[x] <= p0[x] ? 0.0f : -1.0f;
         q[x] = !shot ? lam[x] : lam[x] >= 32.0f ? hi : lo;

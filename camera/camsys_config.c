@@ -145,7 +145,8 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
     o->vignetting = NC_VIGNETTING_COS4;
     if (!m)
         return 0;
-    if ((hn = nc_cfg_double(m, "f_number", 0.3, 1000, &o->f_number)) < 0)
+    /* N >= 0.5: the irradiance L pi / (4 N^2) is at most pi L, a lens filling the hemisphere */
+    if ((hn = nc_cfg_double(m, "f_number", 0.5, 1000, &o->f_number)) < 0)
         return hn;
     if ((hd = nc_cfg_double(m, "aperture_diameter_m", 1e-6, 100, &d)) < 0)
         return hd;
@@ -156,6 +157,9 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
             return nc_cfg_key_error(m, "aperture_diameter_m",
                                     "needs camera.focal_length_m (the camera gives fx_px); give f_number instead");
         o->f_number = focal_length_m / d;
+        if (o->f_number < 0.5)
+            return nc_cfg_key_error(m, "aperture_diameter_m", "an aperture of %g m on a %g m focal length is f/%.3g; "
+                                    "no lens is faster than f/0.5", d, focal_length_m, o->f_number);
     }
     if ((rc = nc_cfg_double(m, "transmission", 0, 1, &o->transmission)) < 0)
         return rc;
@@ -324,7 +328,7 @@ static int sensor_from_config(struct nc_cfg_node *m, const struct nc_camera *geo
     s->shutter = (enum nc_shutter)sh;
     if ((rc = nc_cfg_double(m, "line_time_s", 0, 1, &s->line_time_s)) < 0)
         return rc;
-    if (s->shutter == NC_SHUTTER_ROLLING && !(s->line_time_s > 0))
+    if (s->shutter == NC_SHUTTER_ROLLING && rc == 0) /* 0 given: every row at once, as a global shutter */
         return nc_cfg_missing(m, "line_time_s", "the delay between successive rows of a rolling shutter, seconds");
     if (s->bias_dn > ldexp(1.0, s->adc_bits) - 1)
         return nc_cfg_key_error(m, "bias_dn", "bias %g DN does not fit a %d-bit ADC", s->bias_dn, s->adc_bits);
@@ -408,11 +412,14 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
      * non-uniformity and the hot pixels alike (the pattern is the sensor's,
      * its scale the temperature's). DSNU is a log-normal factor of mean 1 and
      * relative rms dsnu_e_s / dark_current_e_s: never negative, so nothing is
-     * clipped and the mean dark current follows the law at every temperature. */
+     * clipped and the mean dark current follows the law at every temperature.
+     * PRNU the same, of relative rms prnu (a normal factor 1 + prnu z was
+     * clipped at 0: at prnu 1 the mean response was 1.087, the rms 0.87). */
     double tscale = exp2((s->temperature_k - s->dark_ref_temp_k) / s->dark_doubling_k);
     double dark = s->dark_current_e_s * tscale;
     double cv = s->dark_current_e_s > 0 ? s->dsnu_e_s / s->dark_current_e_s : 0;
-    double ln_sigma = sqrt(log1p(cv * cv)), ln_mu = -0.5 * ln_sigma * ln_sigma;
+    const double ln_sigma = sqrt(log1p(cv * cv)), ln_mu = -0.5 * ln_sigma * ln_sigma;
+    const double pr_sigma = sqrt(log1p(s->prnu * s->prnu)), pr_mu = -0.5 * pr_sigma * pr_sigma;
     const int m = cs->margin_px;
     for (int y = 0; y < cs->render_height_px; y++)
         for (int x = 0; x < cs->render_width_px; x++) {
@@ -427,7 +434,7 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
             double u[4], z1, z2;
             nc_rng4(s->seed, NC_RNG_FIXED_PATTERN, 0, (uint32_t)p, 0, u);
             nc_normal2(u[0], u[1], &z1, &z2);
-            cs->prnu_map[p] = (float)fmax(0.0, 1.0 + s->prnu * z1);
+            cs->prnu_map[p] = (float)exp(pr_mu + pr_sigma * z1);
             double dp = dark * exp(ln_mu + ln_sigma * z2);
             if (u[2] < s->hot_pixel_fraction)
                 dp += s->hot_pixel_dark_e_s * tscale;

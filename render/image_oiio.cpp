@@ -65,8 +65,9 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
         return fail(NC_EIMAGE, err, elen, "%s: %s cannot encode to memory", path, out->format_name());
     // OpenImageIO deflates a float TIFF with the floating-point predictor
     // (3), which some readers cannot undo (Python's tifffile without
-    // imagecodecs); deflate alone is read everywhere.
-    if (type == NC__PX_FLOAT && !std::strcmp(out->format_name(), "tiff"))
+    // imagecodecs), and an integer one with horizontal differencing (2);
+    // deflate alone is read everywhere, by zlib alone.
+    if (!std::strcmp(out->format_name(), "tiff"))
         spec.attribute("tiff:Predictor", 1);
     if (!out->open(path, spec))
         return fail(NC_EIMAGE, err, elen, "%s: open for writing: %s", path, out->geterror().c_str());
