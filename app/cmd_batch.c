@@ -202,8 +202,8 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
 /* The detail a frame was rendered with, as the emulator's frame records
  * give it (docs/emulator.md). */
 struct detail {
-    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg, line_time_s; /* 0: global shutter */
-    int time_samples;
+    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg, line_time_s;
+    int rolling, time_samples;
 };
 
 static int truth(const char *dir, const char *stem, const char *ext, int geometry, long row,
@@ -243,11 +243,11 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
     nc_cli_json_vec(f, "distortion_k1_k2_k3_p1_p2", k, 5, ", ");
     fprintf(f, "\"mirrored_rows\": %d, \"mirrored_columns\": %d, ", c->flip_rows, c->flip_cols);
     const double m[6] = {c->velocity_m_s.x, c->velocity_m_s.y, c->velocity_m_s.z, c->angular_velocity_rad_s.x,
-                         c->angular_velocity_rad_s.y, c->angular_velocity_rad_s.z}; /* the motion through the exposure */
+                         c->angular_velocity_rad_s.y, c->angular_velocity_rad_s.z}; /* motion in the exposure */
     nc_cli_json_vec(f, "velocity_m_s", m, 3, ", ");
     nc_cli_json_vec(f, "angular_velocity_rad_s", m + 3, 3, ", ");
     fprintf(f, "\"shutter\": \"%s\", \"line_time_s\": %.17g, \"time_samples\": %d},\n",
-            d->line_time_s > 0 ? "rolling" : "global", d->line_time_s, d->time_samples);
+            d->rolling ? "rolling" : "global", d->rolling ? d->line_time_s : 0, d->time_samples);
     struct nc_vec3 sd;
     double irr;
     nc_scene_sun_at(s, s->body[0].position_m, &sd, &irr);
@@ -324,8 +324,8 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
         (rc = nc_commit_file(tmp, path)) < 0)
         return rc;
     const struct detail det = {nc_rt_lod_error_m(r->rt), nc_rt_boulder_min_m(r->rt), nc_rt_boulder_mesh_px(r->rt),
-                               nc_render_fold_theta_bar_deg(r, s.nbodies),
-                               cs->sensor.shutter == NC_SHUTTER_ROLLING ? cs->sensor.line_time_s : 0, info.time_samples};
+                               nc_render_fold_theta_bar_deg(r, s.nbodies), cs->sensor.line_time_s,
+                               cs->sensor.shutter == NC_SHUTTER_ROLLING, info.time_samples};
     int nrocks = -1, ncraters = -1;
     if (geometry) {
         snprintf(tmp, sizeof tmp, "%s/.%s_geometry.tmp.fits", dir, stem);
@@ -456,10 +456,8 @@ int main(int argc, char **argv)
     int32_t *rock = geometry ? malloc(plane * sizeof *rock) : NULL;
     if (geometry && (!geom || !rock))
         rc = nc_error(-ENOMEM, "out of memory for the geometry planes");
-    char probe[16]; /* the image library now, not at the first frame; after the configuration */
-    snprintf(probe, sizeof probe, "f.%s", ext);
-    if (rc >= 0)
-        rc = nc_image_prepare(probe);
+    if (rc >= 0) /* the image library now, not at the first frame; after the configuration */
+        rc = nc_image_prepare(dotext);
     if (rc >= 0) /* once the configuration is known good: no empty directory left by a mistake in it */
         rc = nc_mkdirs(dir);
     long done = 0, skipped = 0, busy = 0, mine = 0, no_capture = 0;
