@@ -32,7 +32,8 @@ int nc_lines_next(struct nc_lines *l)
         l->len -= 3;
         memmove(l->line, l->line + 3, l->len + 1);
     }
-    const char *cr = strchr(l->line, '\r'); /* CRs ending the line (CR LF, or CR CR LF converted twice) are fine */
+    /* CRs ending the line (CR LF, or CR CR LF converted twice) are fine; memchr: the length is known */
+    const char *cr = memchr(l->line, '\r', l->len);
     if (cr && strcmp(cr + strspn(cr, "\r"), "\n") != 0 && cr[strspn(cr, "\r")] != '\0')
         return nc_error(l->code, "%s:%zu: a carriage return at column %zu inside the line (classic Mac line ends? "
                         "end lines with LF or CR LF)", l->path, l->no, (size_t)(cr - l->line) + 1);
