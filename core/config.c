@@ -347,8 +347,7 @@ static void node_remove(struct nc_cfg_node *parent, struct nc_cfg_node *c)
     node_free(c);
 }
 
-/* YAML's null, which --set and a file laid over another take as "leave this key out". */
-static int is_null(const struct nc_cfg_node *v)
+int nc__cfg_is_null(const struct nc_cfg_node *v)
 {
     return v->kind == NC_CFG_SCALAR && v->value &&
            (!strcmp(v->value, "null") || !strcmp(v->value, "Null") || !strcmp(v->value, "NULL") ||
@@ -365,7 +364,7 @@ static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
                 return rc;
             continue;
         }
-        if (is_null(c)) { /* key: null takes the base's key out */
+        if (nc__cfg_is_null(c)) { /* key: null takes the base's key out */
             node_remove(b, old);
             continue;
         }
@@ -468,7 +467,7 @@ int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)
             node_free(value);
             return nc_error(NC_EUSAGE, "%s: cannot descend into '%s': its parent is a single value", origin, tok);
         }
-        if (!next && is_null(value)) { /* KEY=null: the key (or list item) taken out */
+        if (!next && nc__cfg_is_null(value)) { /* KEY=null: the key (or list item) taken out */
             node_free(value);
             node_remove(cur, child);
             return 0;

@@ -50,6 +50,9 @@ int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top);
 
 /* Child of a map by key without marking it used (internal to config*.c). */
 struct nc_cfg_node *nc__cfg_find(struct nc_cfg_node *map, const char *key);
+/* Whether a scalar is YAML's null (null, Null, NULL, ~), which --set and a
+ * file laid over another take as "leave this key out" (config.c). */
+int nc__cfg_is_null(const struct nc_cfg_node *v);
 /* Edit distance of two keys, two swapped neighbours counting one (config_read.c). */
 size_t nc__cfg_edits(const char *a, const char *b);
 /* The one of names[0..n-1] nearest key within a third of its letters'

@@ -96,7 +96,8 @@ rm busy/frame_000002.json
 python3 -c "import fcntl, sys, time; f = open(sys.argv[1], 'w'); fcntl.flock(f, fcntl.LOCK_EX)
 open(sys.argv[2], 'w').close(); time.sleep(60)" busy/.frame_000002.lock busy.held &
 holder=$!
-for _ in $(seq 100); do [ -e busy.held ] && break; sleep 0.1; done
+for _ in $(seq 600); do [ -e busy.held ] && break; sleep 0.1; done # a loaded machine starts python slowly
+[ -e busy.held ] || fail "busy: the process holding the lock did not start within 60 s"
 "$navcam" batch traj.csv -o busy "${scene[@]}" > busy.log 2>&1 || fail "busy: $(cat busy.log)"
 kill $holder; wait $holder 2>/dev/null || true
 grep -q "0 rendered, 7 already done, 1 being rendered by another process" busy.log || fail "busy: $(tail -1 busy.log)"

@@ -68,6 +68,10 @@ int main(void)
     expect_error("wrong length", "  position_m: [0, 0, -5000]\n", "  position_m: [0, -5000]\n", NULL, 0,
                  "camera.position_m", "expected a list of 3 numbers");
     expect_error("missing key", "  width_px: 64\n", "", NULL, 0, "camera.width_px", "missing required key");
+    expect_error("null in a plain file", "  width_px: 64\n", "  width_px: ~\n", NULL, 0, "test.yaml:7: camera.width_px",
+                 "got \"~\" (YAML's null: give a value, or leave the key out for its default)");
+    expect_error("no value in a plain file", "  focal_length_m: 0.05\n", "  focal_length_m:\n", NULL, 0,
+                 "test.yaml:9: camera.focal_length_m", "got \"\" (no value: give a value, or leave the key out");
     expect_error("missing key, misspelt", "  width_px: 64\n", "  widht_px: 64\n", NULL, 0,
                  "camera.width_px: missing required key", "'widht_px' (line 7) is not a key here: a misspelling");
     { /* KEY=null takes the key out: the file's f_number makes way for an aperture */
