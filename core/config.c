@@ -145,6 +145,7 @@ static int convert(struct nc_cfg *cfg, yaml_document_t *doc, yaml_node_t *yn, co
         n = node_new(NC_CFG_SCALAR, origin, line);
         if (!n || !(n->value = strndup((const char *)yn->data.scalar.value, yn->data.scalar.length)))
             goto nomem;
+        n->quoted = yn->data.scalar.style != YAML_PLAIN_SCALAR_STYLE;
         break;
     case YAML_SEQUENCE_NODE:
         n = node_new(NC_CFG_SEQ, origin, line);
@@ -349,7 +350,7 @@ static void node_remove(struct nc_cfg_node *parent, struct nc_cfg_node *c)
 
 int nc__cfg_is_null(const struct nc_cfg_node *v)
 {
-    return v->kind == NC_CFG_SCALAR && v->value &&
+    return v->kind == NC_CFG_SCALAR && v->value && !v->quoted &&
            (!strcmp(v->value, "null") || !strcmp(v->value, "Null") || !strcmp(v->value, "NULL") ||
             !strcmp(v->value, "~"));
 }

@@ -20,6 +20,7 @@ struct nc_cfg_node {
     enum nc_cfg_kind kind;
     char *key;   /* key within the parent map, NULL for sequence items and root */
     char *value; /* scalar text; NULL otherwise */
+    int quoted;  /* a scalar written in quotes (or as a block): never YAML's null */
     const char *origin; /* file name or "--set ..." (owned by struct nc_cfg) */
     int line;           /* 1-based; 0 when not from a file */
     int used;
@@ -50,7 +51,7 @@ int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top);
 
 /* Child of a map by key without marking it used (internal to config*.c). */
 struct nc_cfg_node *nc__cfg_find(struct nc_cfg_node *map, const char *key);
-/* Whether a scalar is YAML's null (null, Null, NULL, ~), which --set and a
+/* Whether a scalar is YAML's null (null, Null, NULL, ~ unquoted), which --set and a
  * file laid over another take as "leave this key out" (config.c). */
 int nc__cfg_is_null(const struct nc_cfg_node *v);
 /* Edit distance of two keys, two swapped neighbours counting one (config_read.c). */

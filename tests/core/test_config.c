@@ -84,6 +84,9 @@ int main(void)
         nc_cfg_free(&cfg);
         const char *item[] = {"camera.width_px=~"};
         expect_error("a required key set to null", NULL, NULL, item, 1, "camera.width_px", "missing required key");
+        const char *quoted[] = {"camera.width_px=\"null\""}; /* a word, not a null: the key stays */
+        expect_error("a key set to \"null\" quoted", NULL, NULL, quoted, 1, "camera.width_px: expected a whole number, "
+                     "got \"null\"", NULL);
     }
     { /* an albedo map's image is read with the body's build: a mistake in a
        * later body's keys is reported first */
