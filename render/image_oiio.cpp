@@ -36,6 +36,38 @@ __attribute__((format(printf, 4, 5))) int fail(int code, char *err, size_t len, 
     return code;
 }
 
+// TIFF's DateTime (tag 306) is "YYYY:MM:DD HH:MM:SS" or absent. OpenImageIO
+// stamps the time of writing unless given a value, and writes "" as an
+// empty tag, which strict TIFF validators call malformed: the empty entry is
+// taken out of the first directory (the entries after it and the next
+// directory's offset move up 12 bytes; nothing points into a directory).
+void drop_empty_datetime(std::vector<unsigned char> &b)
+{
+    const bool le = b.size() >= 8 && b[0] == 'I' && b[1] == 'I';
+    if (b.size() < 8 || (!le && !(b[0] == 'M' && b[1] == 'M')))
+        return;
+    auto u16 = [&](size_t o) -> size_t { return le ? b[o] | b[o + 1] << 8 : b[o] << 8 | b[o + 1]; };
+    auto u32 = [&](size_t o) -> size_t { return le ? u16(o) | u16(o + 2) << 16 : u16(o) << 16 | u16(o + 2); };
+    const size_t ifd = u32(4);
+    if (u16(2) != 42 || ifd < 8 || ifd > b.size() - 6) // 43: BigTIFF, not written here
+        return;
+    const size_t n = u16(ifd);
+    if (n == 0 || (b.size() - ifd - 6) / 12 < n)
+        return;
+    for (size_t i = 0; i < n; i++) {
+        const size_t e = ifd + 2 + 12 * i;
+        if (u16(e) != 306)
+            continue;
+        if (u16(e + 2) != 2 || u32(e + 4) > 1) // ASCII, at most its NUL: empty
+            return;
+        std::memmove(&b[e], &b[e + 12], 12 * (n - 1 - i) + 4);
+        std::memset(&b[ifd + 2 + 12 * (n - 1) + 4], 0, 12);
+        b[ifd] = (unsigned char)(le ? (n - 1) & 0xff : (n - 1) >> 8);
+        b[ifd + 1] = (unsigned char)(le ? (n - 1) >> 8 : (n - 1) & 0xff);
+        return;
+    }
+}
+
 int write_image(const char *path, const void *px, int w, int h, enum nc__pixel type, const struct nc_image_attr *attrs,
                 int nattrs, const char *description, char *err, size_t elen)
 {
@@ -78,6 +110,8 @@ int write_image(const char *path, const void *px, int w, int h, enum nc__pixel t
     }
     if (!out->close())
         return fail(NC_EIMAGE, err, elen, "%s: close: %s", path, out->geterror().c_str());
+    if (!std::strcmp(out->format_name(), "tiff"))
+        drop_empty_datetime(bytes);
     FILE *f = std::fopen(path, "wb");
     if (!f)
         return fail(-errno, err, elen, "%s: %s", path, std::strerror(errno));
