@@ -14,7 +14,8 @@ cmake --build "$out/build" -j 2 >"$out/build.log" 2>&1 || { cat "$out/build.log"
 
 # Seeds: valid messages of every flag combination, the repository's scenes,
 # and a small valid file of each format the readers take (the first byte
-# picks the reader: 0 OBJ, 1 PLY, 2 ICQ, 3 SUM, 4 trajectory CSV).
+# picks the reader: 0 OBJ, 1 PLY, 2 ICQ, 3 SUM, 4 trajectory CSV, 5 KStars
+# stars.dat, 6 NavCam's star index).
 rm -rf "$out/corpus_protocol" "$out/corpus_config" "$out/corpus_readers"
 mkdir -p "$out/corpus_protocol" "$out/corpus_config" "$out/corpus_readers"
 "$out/build/make_seeds" "$out/corpus_protocol"
@@ -35,6 +36,12 @@ printf '\3EX1\n2020 JAN 15 12:00:00.000\n    96    64    10 65535   NPX, NLN, TH
   'END FILE\n' > "$r/sum"
 printf '\4t_s,cam_x_m,cam_y_m,cam_z_m,q_w,q_x,q_y,q_z,sun_x,sun_y,sun_z\n0,0,-6000,0,0.7071068,-0.7071068,0,0,1,0,0\n' \
   > "$r/csv"
+printf '\5# a comment\n%s\n%s\n' '183656.34 +384701.3 +000201.0+000287.500128.9 00.03-0.00A0 0            , alp Lyr, Vega' \
+  '064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1' > "$r/dat"
+# the index: magic, star count 1 and epoch J1991.25 (little-endian), then one
+# star's RA and Dec (rad, f64), proper motions (mas/yr), V and B-V (f32)
+{ printf '\6NCSTARS1\1\0\0\0\0\0\0\0\0\0\0\0\0\x1d\x9f\x40'
+  printf '\0\0\0\0\0\0\xf0\x3f\0\0\0\0\0\0\xe0\x3f\0\0\x80\x3f\0\0\0\x40\0\0\xa0\x40\0\0\0\0'; } > "$r/stars"
 
 for t in protocol config readers; do
   echo "fuzzing $t for $secs s"
