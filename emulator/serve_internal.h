@@ -65,7 +65,8 @@ struct nc__job {
     const char *source;
     double exposure_s, gain_db;
     int before_poses; /* triggered before any pose: not on the simulator's clock */
-    int rejected;     /* lock-step: the request was refused; answer "dropped" in its turn */
+    int refused;      /* lock-step: the request was refused; answer "dropped" (for refused_why) in its turn */
+    enum nc__drop_reason refused_why;
     int has_pose;     /* lock-step: the pose the request carries, rendered as sent */
     struct nc_pose pose;
 };

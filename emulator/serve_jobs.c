@@ -183,14 +183,24 @@ void nc__serve_lockstep(struct nc__emu *e, const struct nc_pose_msg *m, int clie
     push_job(e, &j);
 }
 
+/* A request answered "dropped" for why: a TCP client's in lock-step through
+ * the queue, so that every answer keeps its request's order (the client's
+ * next request waits while the queue is full); else at once. */
+static void refuse(struct nc__emu *e, struct nc__job *j, enum nc__drop_reason why)
+{
+    j->refused = 1;
+    j->refused_why = why;
+    if (e->mode == NC__MODE_LOCKSTEP && j->client >= 0)
+        push_job(e, j);
+    else
+        nc__serve_drop(e, j, why);
+}
+
 void nc__serve_refused_capture(struct nc__emu *e, const struct nc_pose_msg *m, int client, unsigned gen)
 {
     struct nc__job j = {.trigger_sim_ns = m->sim_time_ns, .sequence = m->sequence, .client = client,
-                        .client_gen = gen, .rejected = 1};
-    if (e->mode == NC__MODE_LOCKSTEP)
-        push_job(e, &j);
-    else
-        nc__serve_drop(e, &j, NC__DROP_REJECTED);
+                        .client_gen = gen};
+    refuse(e, &j, NC__DROP_REJECTED);
 }
 
 /* A software command (m: the TRIGGER or POSE message that asked, or NULL
@@ -209,7 +219,7 @@ void nc__serve_software(struct nc__emu *e, const struct nc_pose_msg *m, int clie
     if (!active) {
         struct nc__job j = {.trigger_sim_ns = m ? m->sim_time_ns : 0, .sequence = m ? m->sequence : 0,
                             .client = client, .client_gen = gen};
-        nc__serve_drop(e, &j, NC__DROP_IGNORED);
+        refuse(e, &j, NC__DROP_IGNORED);
         return;
     }
     int before = 0;

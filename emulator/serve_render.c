@@ -309,8 +309,8 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
     int buf = 0;
     while (!e->have_held && next_job(e, &j)) {
         struct staged x = {.j = j};
-        if (j.rejected) {
-            drop_job(e, &j, NC__DROP_REJECTED);
+        if (j.refused) {
+            drop_job(e, &j, j.refused_why);
             continue;
         }
         if (!pose_for(e, &j, &x.pose, &x.q, &x.gap)) {

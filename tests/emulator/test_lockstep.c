@@ -155,6 +155,21 @@ static void twenty_back_to_back(void)
     }
     CHECK(rc == 0 && seq == 21 && status == NC_FRAME_DELIVERED && slow == 0,
           "timeout 0: rc %d after %d polls, sequence %u, status %u, %d polls waited", rc, polls, seq, status, slow);
+    /* A TRIGGER (ignored in lock-step) behind two captures and before a
+     * third: its "dropped" comes in its turn (it came first, ahead of the
+     * captures still rendering). */
+    capture(c, 3.0);
+    capture(c, 3.1);
+    struct nc_pose_msg trig = {.type = NC_MSG_TRIGGER, .flags = NC_MSG_CAPTURE, .sim_time_ns = 3200000000};
+    nc_client_send(c, &trig);
+    capture(c, 3.3);
+    uint32_t st[4] = {0};
+    int order = 1;
+    for (int k = 0; k < 4 && nc_client_next_frame(c, 60000, &seq, &frame, &status) == 0; k++)
+        order &= seq == 22u + (uint32_t)k, st[k] = status;
+    CHECK(order && st[0] == NC_FRAME_DELIVERED && st[1] == NC_FRAME_DELIVERED && st[2] == NC_FRAME_DROPPED &&
+              st[3] == NC_FRAME_DELIVERED,
+          "a TRIGGER among captures: in order %d, statuses %u %u %u %u", order, st[0], st[1], st[2], st[3]);
     nc_client_close(c);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
 }
