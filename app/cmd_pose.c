@@ -18,10 +18,10 @@ static const char pose_help[] =
     "Usage: navcam pose send --position X,Y,Z [--attitude W,X,Y,Z] [--sun X,Y,Z] [options]\n"
     "\n"
     "Send one POSE (or, with --trigger, one software TRIGGER) to `navcam serve`.\n"
-    "  -P, --position X,Y,Z   camera position, m, scene frame\n"
+    "  -P, --position X,Y,Z   camera position, m, scene frame, within 1e15 m of the origin\n"
     "  -A, --attitude W,X,Y,Z camera -> scene quaternion, of unit length within 1e-6 (default 1,0,0,0)\n"
     "  -S, --sun X,Y,Z        Sun direction, body frame, not zero (default 1,0,0)\n"
-    "  -t, --time S           simulation time, s (default 0)\n"
+    "  -t, --time S           simulation time, s, -4.6e9 to 4.6e9 (default 0)\n"
     "  -c, --capture          ask for a frame (lock-step or trigger mode)\n"
     "      --trigger          send a TRIGGER instead of a POSE\n"
     "  -e, --exposure S       exposure for the requested frame, s, 0 to 3600\n"
@@ -78,7 +78,12 @@ int main(int argc, char **argv)
     const char *why = NULL; /* what is wrong with the option's value */
     while ((c = nc_cli_getopt(argc - 1, argv + 1, "P:A:S:t:ce:g:H:p:h", opts)) != -1) {
         switch (c) {
-        case 'P': have_pos = parse_vec(optarg, pos, 3, &why) == 0; if (!have_pos) goto bad; break;
+        case 'P':
+            have_pos = parse_vec(optarg, pos, 3, &why) == 0;
+            if (!have_pos || (why = "farther than 1e15 m from the origin",
+                              !(nc_v3_norm(nc_v3(pos[0], pos[1], pos[2])) <= NC_PROTO_POSITION_MAX_M)))
+                goto bad;
+            break;
         case 'A':
             if (parse_vec(optarg, att, 4, &why) < 0)
                 goto bad;
@@ -91,7 +96,11 @@ int main(int argc, char **argv)
             if (parse_vec(optarg, sun, 3, &why) < 0 || (why = "a zero vector", !(sun[0] || sun[1] || sun[2])))
                 goto bad;
             break;
-        case 't': if (parse_vec(optarg, &t, 1, &why) < 0 || (why = "beyond +-9.2e9 s", !(fabs(t) < 9.2e9))) goto bad; break;
+        case 't':
+            if (parse_vec(optarg, &t, 1, &why) < 0 ||
+                (why = "beyond +-4.6e9 s", !(fabs(t) <= NC_PROTO_TIME_MAX_NS * 1e-9)))
+                goto bad;
+            break;
         case 'c': m.flags |= NC_MSG_CAPTURE; break;
         case 'R': m.type = NC_MSG_TRIGGER; m.flags |= NC_MSG_CAPTURE; break;
         case 'e':

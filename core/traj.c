@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/lines.h"
+#include "navcam/protocol.h"
 #include "core/pose.h"
 #include "core/sumfile.h"
 
@@ -245,6 +246,11 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
                 break;
             }
             rows = r2;
+        }
+        if (!(fabs(v[0]) <= NC_PROTO_TIME_MAX_NS * 1e-9)) {
+            rc = nc_error(NC_ECONFIG, "%s:%zu: t_s %g s is beyond +-%g s (about 146 years: a simulation time in "
+                          "ns fits 64 bits)", path, lineno, v[0], NC_PROTO_TIME_MAX_NS * 1e-9);
+            break;
         }
         struct nc_traj_row *r = &rows[n];
         r->t_s = v[0];

@@ -26,6 +26,12 @@ extern "C" { /* C linkage, for simulators written in C++ */
 #define NC_PROTO_QUAT_TOL 1e-6  /* | |q| - 1 | allowed, then normalised */
 #define NC_PROTO_EXPOSURE_MAX_S 3600.0 /* EXPOSURE: 0 to this */
 #define NC_PROTO_GAIN_MAX_DB 60.0      /* GAIN: -this to this */
+/* sim_time_ns: -this to this (about 146 years either side of the
+ * simulation's epoch; a Unix time in ns fits until 2115), so that a time
+ * plus an exposure, and the difference of two times, fit in 64 bits. */
+#define NC_PROTO_TIME_MAX_NS 4600000000000000000LL
+#define NC_PROTO_POSITION_MAX_M 1e15 /* camera and body positions: |p| up to this (6700 au) */
+#define NC_PROTO_SPEED_MAX_M_S 299792458.0 /* camera and body velocities: |v| up to the speed of light */
 
 /* POSE and TRIGGER: simulator -> NavCam. FRAME: NavCam -> simulator over
  * TCP, one per captured request, once the frame is with every output. */

@@ -161,6 +161,11 @@ printf '0,0,-5000,0,1,0,0,0,1,0,0\n4,0,-4000,0,1,0,0,0,1,0,0\n3,0,-3000,0,1,0,0,
 expect 1 "back.csv:3: t_s 3 s is before the row before's 4 s (line 2): free-run poses go forward" -- \
   "$navcam" replay "$tmp/back.csv" -p 9
 expect 2 "navcam serve: --max-frames expects 1.." -- "$navcam" serve -n 2x
+# Times beyond what 64-bit ns hold with room for an exposure: refused where they are read.
+printf '0,0,-5000,0,1,0,0,0,1,0,0\n9.3e9,0,-4000,0,1,0,0,0,1,0,0\n' > "$tmp/far.csv"
+expect 1 "far.csv:2: t_s 9.3e+09 s is beyond +-4.6e+09 s" -- "$navcam" replay "$tmp/far.csv" -p 9
+expect 2 "navcam pose send: --time -5e9: beyond +-4.6e9 s" -- "$navcam" pose send -P 0,0,0 -t -5e9
+expect 2 "navcam pose send: --position 0,2e15,0: farther than 1e15 m" -- "$navcam" pose send -P 0,2e15,0
 # replay --lockstep started before the server: it waits (--wait) until the
 # server listens, then streams; the README's tour runs its two lines so.
 port=$((20000 + RANDOM % 20000))

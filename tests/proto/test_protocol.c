@@ -6,6 +6,7 @@
 #include <string.h>
 #include <zlib.h>
 
+#include "core/le.h"
 #include "navcam/protocol.h"
 #include "testutil.h"
 
@@ -116,6 +117,21 @@ int main(void)
     EXPECT(BAD_QUATERNION, n, put_f64(t + 56, 0.9), reseal(t, n));
     EXPECT(BAD_VALUE, n, memset(t + 88, 0, 24), reseal(t, n)); /* a zero Sun vector */
     EXPECT(BAD_VALUE, n, put_f64(t + n - 12, -1.0), reseal(t, n)); /* negative exposure */
+    /* Times within +-4.6e18 ns (a time plus an exposure, and two times'
+     * difference, fit 64 bits), positions within 1e15 m, speeds below c. */
+    EXPECT(BAD_VALUE, n, nc_le_put_u64(t + 24, (uint64_t)INT64_MAX - 1000000), reseal(t, n));
+    EXPECT(BAD_VALUE, n, nc_le_put_u64(t + 24, (uint64_t)(-NC_PROTO_TIME_MAX_NS - 1)), reseal(t, n));
+    EXPECT(NONE, n, nc_le_put_u64(t + 24, (uint64_t)-NC_PROTO_TIME_MAX_NS), reseal(t, n));
+    EXPECT(NONE, n, nc_le_put_u64(t + 24, (uint64_t)NC_PROTO_TIME_MAX_NS), reseal(t, n));
+    EXPECT(BAD_VALUE, n, put_f64(t + 32, 2e15), reseal(t, n));   /* the camera 2e15 m out */
+    EXPECT(BAD_VALUE, n, put_f64(t + 120, 1e300), reseal(t, n)); /* the body 1e300 m out */
+    for (int who = 0; who < 2; who++) {
+        struct nc_pose_msg v = sample(NC_MSG_CAMERA_RATES | NC_MSG_BODY_RATES);
+        *(who ? &v.body_velocity_m_s : &v.cam_velocity_m_s) = nc_v3(0, 3e8, 0);
+        size_t vn = nc_msg_encode(&v, t, sizeof t);
+        CHECK(vn && nc_msg_decode(t, vn, &out) == NC_REJECT_BAD_VALUE, "a %s faster than light accepted",
+              who ? "body" : "camera");
+    }
     /* Nearly unit quaternions are accepted and normalised. */
     memcpy(t, buf, n);
     put_f64(t + 56, 0.5 * (1 + 5e-7));
