@@ -12,6 +12,7 @@
 #ifndef NC_SERVE_INTERNAL_H
 #define NC_SERVE_INTERNAL_H
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -71,6 +72,15 @@ struct nc__job {
     struct nc_pose pose;
 };
 
+/* A job's exposure: its start on the simulator's clock and on
+ * CLOCK_MONOTONIC, and its length (ns), as its frame record gives them. */
+static inline void nc__job_exposure(const struct nc__job *j, int64_t *start_sim, int64_t *start_mono, int64_t *len)
+{
+    *len = (int64_t)llround(j->exposure_s * 1e9);
+    *start_sim = j->mid_sim_ns - (int64_t)llround(0.5 * j->exposure_s * 1e9);
+    *start_mono = j->trigger_mono_ns + (*start_sim - j->trigger_sim_ns);
+}
+
 /* A finished job on its way to the outputs: a frame, or (lock-step) a drop
  * that must be answered in request order. */
 struct nc__slot {
@@ -102,6 +112,7 @@ struct nc__emu {
     atomic_llong readout_end_ns; /* CLOCK_MONOTONIC the frame being rendered should be done (0: none) */
     int inside_warned;           /* the render thread's: the last frame's samples mostly met a back side */
     int64_t last_trigger_mono_ns; /* of the trigger or tick before (under jlock) */
+    int64_t last_exposure_end_mono_ns; /* free-run and trigger: of the last exposure taken (under jlock) */
     int job_cap; /* jobs that may wait for the render: queue_frames (lock-step) or 1 (the sensor holds one frame) */
     char bind[64];
     int udp_port, tcp_port, max_clients;

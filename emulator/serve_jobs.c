@@ -105,7 +105,10 @@ static int too_late(struct nc__emu *e, struct nc__job *j)
 static int push_job(struct nc__emu *e, struct nc__job *j)
 {
     pthread_mutex_lock(&e->jlock);
-    if (e->mode != NC__MODE_LOCKSTEP && too_late(e, j)) {
+    int64_t start_sim, start, len;
+    nc__job_exposure(j, &start_sim, &start, &len);
+    /* One sensor: an exposure cannot begin before the one before it ends. */
+    if (e->mode != NC__MODE_LOCKSTEP && (too_late(e, j) || start < e->last_exposure_end_mono_ns)) {
         pthread_mutex_unlock(&e->jlock);
         nc__serve_drop(e, j, NC__DROP_OVERRUN); /* counted, and answered if a TCP client asked */
         return 0;
@@ -126,6 +129,8 @@ static int push_job(struct nc__emu *e, struct nc__job *j)
     }
     e->jobs[(e->jhead + e->jcount) % e->queue_frames] = *j;
     e->jcount++;
+    if (e->mode != NC__MODE_LOCKSTEP)
+        e->last_exposure_end_mono_ns = start + len;
     pthread_cond_signal(&e->jcond);
     pthread_mutex_unlock(&e->jlock);
     if (replaced)

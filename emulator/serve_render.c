@@ -231,9 +231,8 @@ static void finish_frame(struct stage *st, const struct staged *x)
         return;
     }
     e->next_frame++;
-    int64_t exp_ns = (int64_t)llround(j->exposure_s * 1e9);
-    int64_t start_sim = j->mid_sim_ns - (int64_t)llround(0.5 * j->exposure_s * 1e9);
-    int64_t start_mono = j->trigger_mono_ns + (start_sim - j->trigger_sim_ns);
+    int64_t exp_ns, start_sim, start_mono;
+    nc__job_exposure(j, &start_sim, &start_mono, &exp_ns);
     sl->job = *j;
     sl->dropped = 0;
     sl->render_start_mono_ns = x->t0;

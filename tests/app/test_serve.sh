@@ -313,6 +313,35 @@ print("three software triggers at once:", got, "(sequence, status: 0 delivered, 
 assert [q for q, _ in got] == [1, 2, 3] and any(st == 0 for _, st in got) and any(st == 1 for _, st in got), got
 PY
 stop
+# Software triggers every 10 ms asking for 50 ms exposures: one sensor takes
+# one exposure at a time, so a trigger during an exposure is an overrun, and
+# no two frames' exposures overlap (they did, in pairs).
+start overlap 14 --set serve.mode=trigger --set serve.max_extrapolation_s=10
+"$navcam" pose send --port "$udp" --time 1 --position 0,-6000,0 > /dev/null 2>&1
+python3 - "$src/examples" "$tcp" <<'PY' && ok || bad "software triggers during an exposure are not overruns"
+import socket, struct, sys, time
+sys.path.insert(0, sys.argv[1])
+import python_client as pc
+s = socket.create_connection(("127.0.0.1", int(sys.argv[2])))
+s.settimeout(30)
+for k in range(1, 21):
+    m = pc.encode(pc.TRIGGER, k, pc.CAPTURE, 10**9 + k * 10**7, exposure_s=0.05)
+    s.sendall(struct.pack("<I", len(m)) + m)
+    time.sleep(0.01)
+got = [pc.read_frame_answer(s)[2] for _ in range(20)]
+print("20 triggers 10 ms apart, 50 ms exposures:", got.count(0), "delivered,", got.count(1), "dropped")
+assert 2 <= got.count(0) <= 8, got
+PY
+stop
+python3 - "$tmp/overlap" <<'PY' && ok || bad "overlapping exposures"
+import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1] + "/frames/frames.jsonl")]
+s = json.load(open(sys.argv[1] + "/stats.json"))
+spans = sorted((r["exposure_start_mono_ns"], r["exposure_end_mono_ns"]) for r in rows)
+assert all(b[0] >= a[1] for a, b in zip(spans, spans[1:])), spans
+assert len(rows) + s["dropped"]["overrun"] == 20, (len(rows), s["dropped"])
+print("exposures taken:", len(rows), "none overlapping; overruns", s["dropped"]["overrun"])
+PY
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
