@@ -100,8 +100,8 @@ static int craters_from_config(struct nc_cfg_node *sh, struct nc_body *b, const 
     /* Against geometric saturation, 1.54e6 D^-2 per km^2 (D in m), at the
      * end of the diameters where the population comes closest to it: beyond
      * ten times it every crater only erases others, and carving them takes
-     * minutes (2 million craters of 142 to 285 m on a 0.7 km^2 body, 36 000
-     * times saturation: 6.5 min). */
+     * minutes (2 million craters of 142 to 285 m on the default asteroid at
+     * subdivisions 3, 5e4 times saturation: 6.5 min). */
     const double d_worst = p.slope > 2 ? p.d_min_m : p.d_max_m;
     const double sat_x = p.c_per_km2 * pow(d_worst, 2 - p.slope) / 1.54e6;
     if (node && sat_x > 10)
