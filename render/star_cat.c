@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -185,6 +186,10 @@ int nc_star_cat_load(const char *path, struct nc_star_cat *c)
     uint64_t n = rc ? 0 : nc_le_get_u64(h + 8);
     if (rc == 0 && (n == 0 || n > 100000000))
         rc = nc_error(NC_ECONFIG, "%s: %llu stars", path, (unsigned long long)n);
+    struct stat st; /* the size before the memory: a damaged count must not allocate gigabytes */
+    if (rc == 0 && fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && (uint64_t)st.st_size < HEADER + n * RECORD)
+        rc = nc_error(NC_ECONFIG, "%s: truncated (%llu stars announced, %llu bytes of them)", path,
+                      (unsigned long long)n, (unsigned long long)(st.st_size - HEADER));
     uint8_t *b = rc ? NULL : malloc(n * RECORD);
     if (rc == 0 && (!b || !(c->star = malloc(n * sizeof *c->star))))
         rc = nc_error(-ENOMEM, "out of memory");

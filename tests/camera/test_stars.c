@@ -151,8 +151,9 @@ int main(void)
         const char *bad = nc_test_path("bad.ncs"),
                    *want[] = {"epoch Jnan is not a catalogue epoch", "bytes after the 3 stars",
                               "star 1 (from 0; byte 56): declination (rad) is not within +-pi/2",
-                              "star 2 (from 0; byte 88): V magnitude is brighter than the star before"};
-        for (int k = 0; bytes && k < 4; k++) {
+                              "star 2 (from 0; byte 88): V magnitude is brighter than the star before",
+                              "truncated (50000000 stars announced, 96 bytes of them)"};
+        for (int k = 0; bytes && k < 5; k++) {
             char *b = malloc(len);
             FILE *f = b ? fopen(bad, "wb") : NULL;
             if (!f) {
@@ -166,6 +167,8 @@ int main(void)
                 memcpy(b + 24 + 32 + 8, &(double){2.0}, 8); /* star 1's Dec, rad */
             if (k == 3)
                 memcpy(b + 24 + 2 * 32 + 24, &(float){-2.0f}, 4); /* star 2's V */
+            if (k == 4) /* the header's count (u64 at byte 8), damaged: checked against the size first */
+                memcpy(b + 8, (const unsigned char[8]){0x80, 0xf0, 0xfa, 0x02, 0, 0, 0, 0}, 8);
             fwrite(b, 1, len, f);
             if (k == 1)
                 fputc(0, f);
