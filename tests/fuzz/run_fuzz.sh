@@ -45,8 +45,9 @@ printf '\5# a comment\n%s\n%s\n' '183656.34 +384701.3 +000201.0+000287.500128.9 
 
 for t in protocol config readers; do
   echo "fuzzing $t for $secs s"
-  "$out/build/fuzz_$t" -max_total_time="$secs" -rss_limit_mb=2048 -print_final_stats=1 "$out/corpus_$t" \
-    > "$out/fuzz_$t.log" 2>&1 || { tail -40 "$out/fuzz_$t.log"; echo "FAIL: fuzz_$t"; exit 1; }
+  # a finding's input is kept beside the logs (crash-*, oom-*, leak-*, timeout-*)
+  "$out/build/fuzz_$t" -max_total_time="$secs" -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$out/" \
+    "$out/corpus_$t" > "$out/fuzz_$t.log" 2>&1 || { tail -40 "$out/fuzz_$t.log"; echo "FAIL: fuzz_$t"; exit 1; }
   grep -E "stat::number_of_executed_units|Done" "$out/fuzz_$t.log" | tail -2
 done
 echo "3 passed, 0 failed"
