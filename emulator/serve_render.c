@@ -57,7 +57,9 @@ static int pose_for(struct nc__emu *e, const struct nc__job *j, struct nc_pose *
     pthread_mutex_lock(&e->tl_lock);
     for (;;) {
         int64_t now = nc_mono_ns(), until = j->ready_mono_ns;
-        if (now >= until && e->mode != NC__MODE_LOCKSTEP && !j->before_poses && e->sim_anchor_ns < j->mid_sim_ns)
+        /* no pose yet at all: no stream to wait for (the scene's pose or no_pose) */
+        if (now >= until && e->mode != NC__MODE_LOCKSTEP && !j->before_poses && e->have_anchor &&
+            e->sim_anchor_ns < j->mid_sim_ns)
             until += e->pose_wait_ns;
         if (now >= until || atomic_load(&e->stop) >= 2)
             break;

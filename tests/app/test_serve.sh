@@ -332,6 +332,18 @@ print("three software triggers at once:", got, "(sequence, status: 0 delivered, 
 assert [q for q, _ in got] == [1, 2, 3] and any(st == 0 for _, st in got) and any(st == 1 for _, st in got), got
 PY
 stop
+# With pose_wait_s but no pose ever sent, a triggered frame has no stream to
+# wait for: it is made at once with the scene's pose (it waited 0.5 s).
+start nopose 18 --set serve.mode=trigger --set serve.pose_wait_s=0.5
+"$navcam" pose send --tcp --port "$tcp" --trigger --time 1 > "$tmp/nopose/a.out" 2>&1
+stop
+python3 - "$tmp/nopose" <<'PY' && ok || bad "a triggered frame before any pose waited for one: $(cat "$tmp/nopose/a.out")"
+import json, sys
+s = json.load(open(sys.argv[1] + "/stats.json"))
+rows = [json.loads(l) for l in open(sys.argv[1] + "/frames/frames.jsonl")]
+print(f"no pose, pose_wait_s 0.5: {len(rows)} frame, quality {rows[0]['pose']['quality']}, wait_p99 {s['wait_p99_ms']} ms")
+assert len(rows) == 1 and rows[0]["pose"]["quality"] == "scene" and s["wait_p99_ms"] < 250, s
+PY
 # Software triggers every 10 ms asking for 50 ms exposures: one sensor takes
 # one exposure at a time, so a trigger during an exposure is an overrun, and
 # no two frames' exposures overlap (they did, in pairs).
