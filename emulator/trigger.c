@@ -83,8 +83,8 @@ int nc_trigger_open(struct nc_trigger *t, const struct nc_trigger_driver *drv, s
     if (!t->priv)
         return nc_error(-ENOMEM, "out of memory");
     pthread_mutex_init(&t->lock, NULL);
-    struct nc_trigger_ctx ctx = {.fire = on_edge, .sink = t};
-    if ((rc = drv->open(t->priv, opts, &ctx)) < 0) {
+    t->ctx = (struct nc_trigger_ctx){.fire = on_edge, .sink = t};
+    if ((rc = drv->open(t->priv, opts, &t->ctx)) < 0) {
         free(t->priv);
         pthread_mutex_destroy(&t->lock);
         memset(t, 0, sizeof *t);

@@ -104,6 +104,7 @@ struct nc_trigger {
     void *sink_arg;
     int started;
     int enabled; /* 0: edges are ignored before the gate (and not counted) */
+    struct nc_trigger_ctx ctx; /* given to the driver's open: valid until close */
 };
 
 /* opts (`serve.trigger`) against the common keys and the driver's table:
