@@ -68,10 +68,13 @@ double nc__serve_resulting_rate_hz(struct nc__emu *e)
     struct nc_acquisition a;
     nc__serve_acq_get(e, &a);
     double want = a.triggered || e->mode == NC__MODE_LOCKSTEP ? INFINITY : a.frame_rate_hz;
-    /* Free-run: an exposure longer than the period spans ticks the sensor
-     * cannot take (overrun rule 4): every k-th tick is taken. */
+    /* One exposure at a time (overrun rule 4): in free-run an exposure
+     * spanning k periods takes every k-th tick; triggers come at most one an
+     * exposure. */
     if (isfinite(want))
         want /= fmax(1.0, ceil(a.exposure_s * a.frame_rate_hz - 1e-9));
+    else if (e->mode != NC__MODE_LOCKSTEP && a.exposure_s > 0)
+        want = 1.0 / a.exposure_s;
     double r = nc__serve_busy_ms(e, 1), can = r > 0 ? 1000.0 / r : INFINITY;
     double got = fmin(want, can);
     return isfinite(got) ? got : 0.0;

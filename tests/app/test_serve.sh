@@ -347,7 +347,7 @@ PY
 # Software triggers every 10 ms asking for 50 ms exposures: one sensor takes
 # one exposure at a time, so a trigger during an exposure is an overrun, and
 # no two frames' exposures overlap (they did, in pairs).
-start overlap 14 --set serve.mode=trigger --set serve.max_extrapolation_s=10
+start overlap 14 --set serve.mode=trigger --set serve.max_extrapolation_s=10 --set exposure.time_s=0.05
 "$navcam" pose send --port "$udp" --time 1 --position 0,-6000,0 > /dev/null 2>&1
 python3 - "$src/examples" "$tcp" <<'PY' && ok || bad "software triggers during an exposure are not overruns"
 import socket, struct, sys, time
@@ -371,7 +371,9 @@ s = json.load(open(sys.argv[1] + "/stats.json"))
 spans = sorted((r["exposure_start_mono_ns"], r["exposure_end_mono_ns"]) for r in rows)
 assert all(b[0] >= a[1] for a, b in zip(spans, spans[1:])), spans
 assert len(rows) + s["dropped"]["overrun"] == 20, (len(rows), s["dropped"])
-print("exposures taken:", len(rows), "none overlapping; overruns", s["dropped"]["overrun"])
+assert 0 < s["resulting_frame_rate_hz"] <= 20.0, s["resulting_frame_rate_hz"]  # one 50 ms exposure at a time
+print("exposures taken:", len(rows), "none overlapping; overruns", s["dropped"]["overrun"], "; resulting rate",
+      s["resulting_frame_rate_hz"], "Hz")
 PY
 
 echo "$pass passed, $fail failed"
