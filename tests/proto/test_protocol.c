@@ -118,7 +118,7 @@ int main(void)
     EXPECT(BAD_VALUE, n, memset(t + 88, 0, 24), reseal(t, n)); /* a zero Sun vector */
     EXPECT(BAD_VALUE, n, put_f64(t + n - 12, -1.0), reseal(t, n)); /* negative exposure */
     /* Times within +-4.6e18 ns (a time plus an exposure, and two times'
-     * difference, fit 64 bits), positions within 1e15 m, speeds below c. */
+     * difference, fit 64 bits), positions within 1e15 m, speeds up to c. */
     EXPECT(BAD_VALUE, n, nc_le_put_u64(t + 24, (uint64_t)INT64_MAX - 1000000), reseal(t, n));
     EXPECT(BAD_VALUE, n, nc_le_put_u64(t + 24, (uint64_t)(-NC_PROTO_TIME_MAX_NS - 1)), reseal(t, n));
     EXPECT(NONE, n, nc_le_put_u64(t + 24, (uint64_t)-NC_PROTO_TIME_MAX_NS), reseal(t, n));
