@@ -358,6 +358,13 @@ static double vignette(const struct nc_optics *o, double theta)
     return f[i - 1] + t * (f[i] - f[i - 1]);
 }
 
+/* exp(mu + sigma z), z standard normal, has mean 1 and relative rms cv. */
+static void lognormal(double cv, double *mu, double *sigma)
+{
+    *sigma = sqrt(log1p(cv * cv));
+    *mu = -0.5 * *sigma * *sigma;
+}
+
 int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom, double focal_length_m,
                           struct nc_camsys *cs)
 {
@@ -418,8 +425,9 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
     double tscale = exp2((s->temperature_k - s->dark_ref_temp_k) / s->dark_doubling_k);
     double dark = s->dark_current_e_s * tscale;
     double cv = s->dark_current_e_s > 0 ? s->dsnu_e_s / s->dark_current_e_s : 0;
-    const double ln_sigma = sqrt(log1p(cv * cv)), ln_mu = -0.5 * ln_sigma * ln_sigma;
-    const double pr_sigma = sqrt(log1p(s->prnu * s->prnu)), pr_mu = -0.5 * pr_sigma * pr_sigma;
+    double ln_mu, ln_sigma, pr_mu, pr_sigma;
+    lognormal(cv, &ln_mu, &ln_sigma);
+    lognormal(s->prnu, &pr_mu, &pr_sigma);
     const int m = cs->margin_px;
     for (int y = 0; y < cs->render_height_px; y++)
         for (int x = 0; x < cs->render_width_px; x++) {

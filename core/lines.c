@@ -55,9 +55,10 @@ double nc_strtod_fortran(const char *s, char **end)
         return strtod(s, end);
     memcpy(num, s + lead, len);
     num[len] = '\0';
-    for (char *c = num + 1; *c && !strpbrk(num, "xX"); c++) /* not in a hexadecimal number's digits */
-        if ((*c == 'D' || *c == 'd') && (isdigit((unsigned char)c[-1]) || c[-1] == '.'))
-            *c = 'E';
+    if (!strpbrk(num, "xX")) /* not in a hexadecimal number's digits */
+        for (char *c = num + 1; *c; c++)
+            if ((*c == 'D' || *c == 'd') && (isdigit((unsigned char)c[-1]) || c[-1] == '.'))
+                *c = 'E';
     const double v = strtod(num, &e);
     if (end)
         *end = (char *)s + (e == num ? 0 : lead + (size_t)(e - num));

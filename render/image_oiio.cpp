@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/error.h" // the codes only
+#include "core/le.h"
 #include "render/image_io_impl.h"
 
 using namespace OIIO;
@@ -41,29 +42,28 @@ __attribute__((format(printf, 4, 5))) int fail(int code, char *err, size_t len, 
 // empty tag, which strict TIFF validators call malformed: the empty entry is
 // taken out of the first directory (the entries after it and the next
 // directory's offset move up 12 bytes; nothing points into a directory).
-void drop_empty_datetime(std::vector<unsigned char> &b)
+// libtiff writes the host's byte order: a little-endian file is mended, a
+// big-endian host's keeps the empty tag.
+void drop_empty_datetime(std::vector<unsigned char> &v)
 {
-    const bool le = b.size() >= 8 && b[0] == 'I' && b[1] == 'I';
-    if (b.size() < 8 || (!le && !(b[0] == 'M' && b[1] == 'M')))
+    uint8_t *b = v.data();
+    if (v.size() < 8 || b[0] != 'I' || b[1] != 'I' || nc_le_get_u16(b + 2) != 42) // 43: BigTIFF, not written here
         return;
-    auto u16 = [&](size_t o) -> size_t { return le ? b[o] | b[o + 1] << 8 : b[o] << 8 | b[o + 1]; };
-    auto u32 = [&](size_t o) -> size_t { return le ? u16(o) | u16(o + 2) << 16 : u16(o) << 16 | u16(o + 2); };
-    const size_t ifd = u32(4);
-    if (u16(2) != 42 || ifd < 8 || ifd > b.size() - 6) // 43: BigTIFF, not written here
+    const size_t ifd = nc_le_get_u32(b + 4);
+    if (ifd < 8 || ifd > v.size() - 6)
         return;
-    const size_t n = u16(ifd);
-    if (n == 0 || (b.size() - ifd - 6) / 12 < n)
+    const size_t n = nc_le_get_u16(b + ifd);
+    if (n == 0 || (v.size() - ifd - 6) / 12 < n)
         return;
     for (size_t i = 0; i < n; i++) {
-        const size_t e = ifd + 2 + 12 * i;
-        if (u16(e) != 306)
+        uint8_t *e = b + ifd + 2 + 12 * i;
+        if (nc_le_get_u16(e) != 306)
             continue;
-        if (u16(e + 2) != 2 || u32(e + 4) > 1) // ASCII, at most its NUL: empty
+        if (nc_le_get_u16(e + 2) != 2 || nc_le_get_u32(e + 4) > 1) // ASCII, at most its NUL: empty
             return;
-        std::memmove(&b[e], &b[e + 12], 12 * (n - 1 - i) + 4);
-        std::memset(&b[ifd + 2 + 12 * (n - 1) + 4], 0, 12);
-        b[ifd] = (unsigned char)(le ? (n - 1) & 0xff : (n - 1) >> 8);
-        b[ifd + 1] = (unsigned char)(le ? (n - 1) >> 8 : (n - 1) & 0xff);
+        std::memmove(e, e + 12, 12 * (n - 1 - i) + 4);
+        std::memset(b + ifd + 2 + 12 * (n - 1) + 4, 0, 12);
+        nc_le_put_u16(b + ifd, (uint16_t)(n - 1));
         return;
     }
 }

@@ -16,6 +16,7 @@
 #include <float.h>
 
 #include "core/error.h"
+#include "core/le.h"
 #include "render/frame_io.h"
 #include "render/image_io.h"
 #include "testutil.h"
@@ -229,24 +230,19 @@ static void whole_or_nothing(void)
     free(bytes);
 }
 
-/* Whether a classic TIFF's first directory has an entry of this tag: 1, 0,
- * or -1 when the file is not one. */
+/* Whether a little-endian classic TIFF's first directory has an entry of
+ * this tag: 1, 0, or -1 when the file is not one. */
 static int tiff_tag(const char *path, unsigned tag)
 {
     size_t len = 0;
-    unsigned char *b = (unsigned char *)nc_test_read(path, &len);
+    uint8_t *b = (uint8_t *)nc_test_read(path, &len);
     int found = -1;
-    const int le = b && len >= 8 && b[0] == 'I';
-#define U16(o) (le ? (unsigned)b[o] | (unsigned)b[(o) + 1] << 8 : (unsigned)b[o] << 8 | (unsigned)b[(o) + 1])
-#define U32(o) (le ? U16(o) | (size_t)U16((o) + 2) << 16 : (size_t)U16(o) << 16 | U16((o) + 2))
-    if (b && len >= 8 && U16(2) == 42 && U32(4) + 2 <= len) {
-        const size_t ifd = U32(4), n = U16(ifd);
+    if (b && len >= 8 && !memcmp(b, "II", 2) && nc_le_get_u16(b + 2) == 42 && nc_le_get_u32(b + 4) + 2 <= len) {
+        const size_t ifd = nc_le_get_u32(b + 4), n = nc_le_get_u16(b + ifd);
         found = ifd + 2 + 12 * n + 4 <= len ? 0 : -1;
         for (size_t i = 0; i < n && found == 0; i++)
-            found = U16(ifd + 2 + 12 * i) == tag;
+            found = nc_le_get_u16(b + ifd + 2 + 12 * i) == tag;
     }
-#undef U16
-#undef U32
     free(b);
     return found;
 }
