@@ -113,9 +113,12 @@ static int file_submit(void *priv, const struct nc_frame_record *r)
     int rc = nc_image_write_dn(path, r->dn, r->width_px, r->height_px, r->adc_bits, attrs, f->bottom_up ? 6 : 5);
     if (rc < 0)
         return rc;
-    if (f->sidecar && jl > 0) {
-        fprintf(f->sidecar, "%s\n", json);
-        fflush(f->sidecar); /* every line whole on disk when the frame is reported delivered */
+    /* every line whole on disk when the frame is reported delivered: else the frame is not (a full disk) */
+    if (f->sidecar && (jl < 0 || fprintf(f->sidecar, "%s\n", json) < 0 || fflush(f->sidecar) != 0)) {
+        const int e = jl < 0 ? ENOSPC : errno;
+        clearerr(f->sidecar);
+        return nc_error(-e, "file output: %s: the frame's line not written: %s", f->sidecar_path,
+                        jl < 0 ? "the record does not fit its buffer" : strerror(e));
     }
     return 0;
 }

@@ -135,7 +135,7 @@ static void *poll_thread(void *arg)
     const long period_ns = (long)(1e9 / g->poll_hz);
     int64_t next_rate_ns = 0, next_probe_ns = 0;
     while (!atomic_load(&g->stop)) {
-        nanosleep(&(struct timespec){0, period_ns}, NULL);
+        nanosleep(&(struct timespec){period_ns / 1000000000, period_ns % 1000000000}, NULL); /* poll_hz 1: 1 s */
         /* What a client wrote within one period is taken in a GenICam client's order: settings, AcquisitionStart,
          * TriggerSoftware. So the settings apply before the stream opens to exposures from now on, and a trigger
          * right after the start or a setting makes a frame that is sent, with that setting. */
@@ -175,24 +175,20 @@ static void *poll_thread(void *arg)
 
 /* The layout of frame r in buf[fill] as the registers ask for it now (ROI,
  * pixel format, the metadata row on top); pack() fills it. Returns 0, or -1
- * for settings NavCam does not serve (a format it lacks, a size beyond the
- * sensor plus a row): nothing is sent then. */
+ * while a client's write the device will undo stands (a region beyond the
+ * sensor, a format it lacks, nc__gige_check_registers): nothing is sent
+ * then (docs/gige.md). */
 static int layout(struct gige *g, const struct nc_frame_record *r)
 {
-    /* Clients may write anything into these registers (GenICam range checks
-     * are the client's): offsets are clamped to the sensor. */
-    const uint32_t w = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_WIDTH), h = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_HEIGHT);
-    const uint32_t rox = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_X_OFFSET);
-    const uint32_t roy = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_Y_OFFSET);
-    const uint32_t pf = nc__gige_reg(g->fc, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT);
-    const int ox = rox < (uint32_t)g->W ? (int)rox : g->W, oy = roy < (uint32_t)g->H ? (int)roy : g->H;
-    if ((pf != PF_MONO8 && pf != PF_MONO12 && pf != PF_MONO16) || w == 0 || h == 0 ||
-        (size_t)w * h > (size_t)g->W * (g->H + 1))
+    uint32_t v[NC_GIGE_HELD]; /* Width, Height, OffsetX, OffsetY, PixelFormat, ... */
+    nc__gige_hold(g->fc, v);
+    if (!nc__gige_holds(v, g->W, g->H, g->meta_rows))
         return -1;
+    const uint32_t w = v[0], h = v[1], ox = v[2], oy = v[3], pf = v[4];
     const int bpp = pf == PF_MONO8 ? 1 : 2, k = g->fill;
     atomic_store(&g->packed[k], 0);
-    g->im[k] = (struct nc__gvsp_image){.pixel_format = pf, .width = w, .height = h, .offset_x = (uint32_t)ox,
-                                       .offset_y = (uint32_t)oy, .data = g->buf[k], .size = (size_t)w * h * bpp,
+    g->im[k] = (struct nc__gvsp_image){.pixel_format = pf, .width = w, .height = h, .offset_x = ox,
+                                       .offset_y = oy, .data = g->buf[k], .size = (size_t)w * h * bpp,
                                        /* the GVSP timestamp: the exposure's start on the device's counter */
                                        .timestamp_ns = nc__gige_clock_at(&g->clock, r->exposure_start_mono_ns),
                                        .ready = &g->packed[k]};

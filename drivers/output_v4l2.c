@@ -356,8 +356,10 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     v->size = v->bytesperline * (size_t)v->height;
     if (!(v->buf = malloc(v->size)))
         return nc_error(-ENOMEM, "v4l2 output: out of memory");
-    if ((rc = connect_device(v)) < 0)
+    if ((rc = connect_device(v)) < 0) { /* close is not called when open fails */
+        free(v->buf);
         return rc;
+    }
     char fc[5];
     nc_log_info("output/v4l2", "%s (card '%s', driver '%s'): %dx%d %s at %g Hz through %s%s", v->path,
             v->card, v->driver, v->width, v->height, fourcc_text(v->fourcc, fc), v->fps,

@@ -51,7 +51,7 @@ struct gpio_trig {
     atomic_int stop;
     pthread_mutex_t lock; /* the exposure windows */
     struct nc_windows win;
-    unsigned long read_errors;
+    unsigned long read_errors, strobe_errors;
     int warned_clock;
 };
 
@@ -203,7 +203,8 @@ static void set_strobe(struct gpio_trig *g, int on)
     if (on == g->strobe_on)
         return;
     if (gpiod_line_set_value(g->strobe.line, on ^ g->strobe_active_low) < 0) {
-        nc_log_error("trigger/gpio", "strobe %s: %s", g->strobe.desc, strerror(errno));
+        if (g->strobe_errors++ == 0) /* once: a chip that is gone fails every window (counted, closing says) */
+            nc_log_error("trigger/gpio", "strobe %s: %s", g->strobe.desc, strerror(errno));
         return;
     }
     g->strobe_on = on;
@@ -260,6 +261,13 @@ static void *gpio_thread(void *arg)
         }
         if (p[0].revents & POLLIN)
             read_edges(g, efd);
+        else if (p[0].revents & (POLLERR | POLLHUP | POLLNVAL)) {
+            /* the chip is gone (a USB GPIO expander unplugged, a gpio-sim chip removed): the kernel says so on
+             * every poll from now on; no edge can come, so the line is no longer polled */
+            nc_log_error("trigger/gpio", "%s: the GPIO chip is gone (unplugged or removed): no more edges from it "
+                         "until navcam serve is restarted", g->in.desc);
+            efd = -1;
+        }
     }
     if (g->have_strobe)
         set_strobe(g, 0);
@@ -312,9 +320,10 @@ static void gpio_close(void *priv)
 {
     struct gpio_trig *g = priv;
     gpio_stop(g);
-    if (g->have_strobe && (g->win.missed || g->read_errors))
+    if (g->have_strobe && (g->win.missed || g->read_errors || g->strobe_errors))
         nc_log_info("trigger/gpio", "%lu strobes, %lu exposure windows passed before the strobe could be "
-                    "driven, %lu event read errors", g->win.started, g->win.missed, g->read_errors);
+                    "driven, %lu event read errors, %lu strobe line writes failed", g->win.started, g->win.missed,
+                    g->read_errors, g->strobe_errors);
     struct gpiod_chip *shared = g->in.line ? gpiod_line_get_chip(g->in.line) : NULL;
     release_line(&g->strobe, shared);
     release_line(&g->in, NULL);

@@ -51,9 +51,13 @@ static int LIBUSB_CALL on_hotplug(libusb_context *ctx, libusb_device *dev, libus
 {
     struct nc__usb_trig *u = arg;
     pthread_mutex_lock(&u->lock);
-    if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT && dev == u->dev)
+    if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT && dev == u->dev) {
         u->gone = 1;
-    else if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED) { /* looked at by the event loop: no I/O in a hot-plug callback */
+        u->session_error = 0; /* unplugged, whatever a transfer said */
+    } else if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT && dev == u->retry) {
+        libusb_unref_device(u->retry); /* the transfer error was its unplugging: it comes back as an arrival */
+        u->retry = NULL;
+    } else if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED) { /* looked at by the event loop: no I/O in a hot-plug callback */
         if (u->narrived == NC__USB_N_ARRIVED) {
             libusb_unref_device(u->arrived[0]);
             memmove(u->arrived, u->arrived + 1, sizeof u->arrived[0] * --u->narrived);
@@ -64,21 +68,78 @@ static int LIBUSB_CALL on_hotplug(libusb_context *ctx, libusb_device *dev, libus
     return 0;
 }
 
+/* A session that ended: closed, and counted and reported as an unplug, or
+ * (error: the transfer status that ended it) left for the verdict: the
+ * adapter is opened again after a wait, unless its hot-plug departure comes
+ * first (an unplug often ends the transfers with an I/O error before udev
+ * tells). While its sessions keep ending within 10 s of their start, the
+ * wait doubles, up to 10 s. Event thread. */
+static void session_ended(struct nc__usb_trig *u, int error)
+{
+    pthread_mutex_lock(&u->lock);
+    libusb_device *again = error ? libusb_ref_device(u->dev) : NULL;
+    pthread_mutex_unlock(&u->lock);
+    nc__usb_close_session(u);
+    pthread_mutex_lock(&u->lock);
+    u->unplugged_at_ns = nc_mono_ns();
+    u->session_error = 0;
+    u->verdict = error;
+    if (again) {
+        if (u->retry)
+            libusb_unref_device(u->retry);
+        u->retry = again;
+        const int64_t w = u->retry_wait_ns;
+        u->retry_wait_ns = !w || u->unplugged_at_ns - u->session_start_ns > 10000000000 ? 200000000
+                           : w < 5000000000 ? 2 * w : 10000000000;
+        u->retry_at_ns = u->unplugged_at_ns + u->retry_wait_ns;
+    }
+    pthread_mutex_unlock(&u->lock);
+}
+
+/* The verdict on a session a transfer error ended, once known: the adapter
+ * left (an unplug), or it is still there at the time to open it again (a
+ * session error). Lock held; returns the line to log ("" if none). */
+static const char *verdict(struct nc__usb_trig *u, int64_t now, char *line, size_t len)
+{
+    line[0] = 0;
+    if (!u->verdict || (u->retry && now < u->retry_at_ns))
+        return line;
+    if (!u->retry)
+        snprintf(line, len, "adapter %s unplugged (%lu so far); waiting for it to come back", u->desc, ++u->unplugged);
+    else
+        snprintf(line, len, "adapter %s: the session ended on a transfer error (%s; %lu so far); opening it again",
+                 u->desc, u->verdict == LIBUSB_TRANSFER_STALL      ? "a stall"
+                          : u->verdict == LIBUSB_TRANSFER_OVERFLOW ? "an overflow"
+                                                                   : "an I/O error",
+                 ++u->session_errors);
+    u->verdict = 0;
+    return line;
+}
+
 static void *usb_thread(void *arg)
 {
     struct nc__usb_trig *u = arg;
     while (!atomic_load(&u->stop)) {
         int64_t now = nc_mono_ns();
+        char said[256];
         pthread_mutex_lock(&u->lock);
         int gone = u->state != NC__USB_ABSENT && u->gone;
+        const int error = gone ? u->session_error : 0;
+        verdict(u, now, said, sizeof said);
         /* Devices plugged in during a session are other devices; once the
-         * session is gone, each is a candidate, oldest first. */
+         * session is gone, each is a candidate, oldest first; then the
+         * adapter a session error left, when its time comes. */
         libusb_device *arrived = NULL;
+        int from_retry = 0;
         while (u->narrived && u->state != NC__USB_ABSENT && !u->gone)
             libusb_unref_device(u->arrived[--u->narrived]);
         if (u->narrived && u->state == NC__USB_ABSENT) {
             arrived = u->arrived[0];
             memmove(u->arrived, u->arrived + 1, sizeof u->arrived[0] * --u->narrived);
+        } else if (u->retry && u->state == NC__USB_ABSENT && now >= u->retry_at_ns) {
+            arrived = u->retry;
+            u->retry = NULL;
+            from_retry = 1;
         }
         if (u->state == NC__USB_READY && !u->gone && now >= u->next_sync_ns) {
             nc__usb_send_time_req(u);
@@ -95,27 +156,40 @@ static void *usb_thread(void *arg)
             nc__usb_send_msg(u, &hello);
             u->next_sync_ns = now + 1000000000;
         }
-        int64_t wait = u->state != NC__USB_ABSENT ? u->next_sync_ns - now : 1000000000;
+        int64_t wait = u->state != NC__USB_ABSENT                            ? u->next_sync_ns - now
+                       : u->retry && u->retry_at_ns - now < 1000000000 ? u->retry_at_ns - now
+                                                                          : 1000000000;
         pthread_mutex_unlock(&u->lock);
+        if (said[0])
+            nc_log_warn(LOG, "%s", said);
         if (gone) {
-            nc__usb_close_session(u);
-            pthread_mutex_lock(&u->lock);
-            u->unplugged++;
-            u->unplugged_at_ns = nc_mono_ns();
-            pthread_mutex_unlock(&u->lock);
-            nc_log_warn(LOG, "adapter %s unplugged (%lu so far); waiting for it to come back", u->desc, u->unplugged);
+            session_ended(u, error);
+            if (!error) {
+                pthread_mutex_lock(&u->lock);
+                unsigned long n = ++u->unplugged;
+                pthread_mutex_unlock(&u->lock);
+                nc_log_warn(LOG, "adapter %s unplugged (%lu so far); waiting for it to come back", u->desc, n);
+            }
             continue;
         }
         if (arrived) {
             int rc = nc__usb_try_open(u, arrived);
-            if (rc < 0)
-                nc_log_error(LOG, "%s", nc_errmsg());
-            else if (rc > 0 && u->unplugged) {
-                pthread_mutex_lock(&u->lock);
-                u->reopened++;
-                pthread_mutex_unlock(&u->lock);
-                nc_log_info(LOG, "adapter %s reopened after %.1f s", u->desc, (nc_mono_ns() - u->unplugged_at_ns) * 1e-9);
+            pthread_mutex_lock(&u->lock);
+            const int was_away = u->unplugged + u->session_errors > u->reopened;
+            u->reopened += rc > 0 && was_away;
+            const int first_failure = rc <= 0 && from_retry && u->retry_failures++ == 0;
+            if (rc > 0)
+                u->retry_failures = 0;
+            if (rc <= 0 && from_retry && !u->retry) { /* again later, less often (up to every 10 s) */
+                u->retry = libusb_ref_device(arrived);
+                u->retry_wait_ns = u->retry_wait_ns < 5000000000 ? 2 * u->retry_wait_ns : 10000000000;
+                u->retry_at_ns = nc_mono_ns() + u->retry_wait_ns;
             }
+            pthread_mutex_unlock(&u->lock);
+            if (rc < 0 && (!from_retry || first_failure))
+                nc_log_error(LOG, "%s%s", nc_errmsg(), from_retry ? " (trying again, less often, up to every 10 s)" : "");
+            else if (rc > 0 && was_away)
+                nc_log_info(LOG, "adapter %s reopened after %.1f s", u->desc, (nc_mono_ns() - u->unplugged_at_ns) * 1e-9);
             libusb_unref_device(arrived);
             continue;
         }
@@ -247,11 +321,13 @@ static void write_stats(struct nc__usb_trig *u, FILE *f)
     pthread_mutex_lock(&u->lock);
     fprintf(f, "{\"connected\": %s, \"messages\": %lu, \"edges\": %lu, \"lost\": %lu, \"missed_by_adapter\": %lu, "
                "\"level_repeats\": %lu, "
-               "\"other_lines\": %lu, \"unknown\": %lu, \"unplugged\": %lu, \"reopened\": %lu, \"strobes\": %lu, "
+               "\"other_lines\": %lu, \"unknown\": %lu, \"unplugged\": %lu, \"session_errors\": %lu, "
+               "\"reopened\": %lu, \"strobes\": %lu, "
                "\"strobes_skipped\": %lu, \"clock_exchanges\": %lu, \"clock_exchanges_used\": %d, \"clock_offset_s\": %.9f, \"clock_drift_ppm\": %.3f, "
                "\"clock_bound_us\": %.3f, \"edge_bound_max_us\": %.3f}",
             u->state == NC__USB_READY ? "true" : "false", u->messages, u->edges, u->lost, u->missed, u->level_repeats, u->other_line, u->unknown,
-            u->unplugged, u->reopened, u->strobes, u->strobes_skipped, u->map.added, u->map.used, u->map.offset_ns * 1e-9,
+            u->unplugged, u->session_errors, u->reopened, u->strobes, u->strobes_skipped, u->map.added, u->map.used,
+            u->map.offset_ns * 1e-9,
             u->map.drift * 1e6, u->map.valid ? u->map.bound_ns * 1e-3 : -1.0, u->edge_bound_max_ns * 1e-3);
     pthread_mutex_unlock(&u->lock);
 }
@@ -291,16 +367,19 @@ static void usb_close(void *priv)
         nc__usb_close_session(u);
     while (u->narrived)
         libusb_unref_device(u->arrived[--u->narrived]);
+    if (u->retry)
+        libusb_unref_device(u->retry);
+    u->retry = NULL;
     for (int i = 0; i < NC__USB_N_IN; i++)
         if (u->in[i]) {
             free(u->in[i]->buffer);
             u->in[i]->buffer = NULL;
             libusb_free_transfer(u->in[i]);
         }
-    if (u->edges || u->lost || u->unplugged)
-        nc_log_info(LOG, "%lu edges, %lu messages lost, %lu missed by the adapter, unplugged %lu times, reopened %lu; "
-                    "clock bound %.1f us at the end", u->edges, u->lost, u->missed, u->unplugged, u->reopened,
-                    u->map.bound_ns * 1e-3);
+    if (u->edges || u->lost || u->unplugged || u->session_errors)
+        nc_log_info(LOG, "%lu edges, %lu messages lost, %lu missed by the adapter, unplugged %lu times, %lu session "
+                    "errors, reopened %lu; clock bound %.1f us at the end", u->edges, u->lost, u->missed, u->unplugged,
+                    u->session_errors, u->reopened, u->map.bound_ns * 1e-3);
     libusb_exit(u->usb);
     pthread_mutex_destroy(&u->lock);
     u->usb = NULL;

@@ -180,9 +180,6 @@ static void shutdown_threads(struct nc__emu *e, pthread_t *threads, int nthreads
     pthread_mutex_lock(&e->jlock);
     pthread_cond_broadcast(&e->jcond);
     pthread_mutex_unlock(&e->jlock);
-    pthread_mutex_lock(&e->slock);
-    pthread_cond_broadcast(&e->sfree); /* a lock-step render waiting for a slot */
-    pthread_mutex_unlock(&e->slock);
     if (nthreads > 1)
         pthread_join(threads[1], NULL); /* render */
     atomic_store(&e->stop, 3);
@@ -253,6 +250,8 @@ int nc_serve(const struct nc_serve_options *opt)
     }
     while (rc >= 0 && !atomic_load(&e->warm) && atomic_load(&e->stop) < 2)
         usleep(1000); /* the render thread's warm-up frame (serve_render.c) */
+    if (rc >= 0 && atomic_load(&e->failed) < 0) /* not started: no triggers, no banner */
+        rc = nc_error(atomic_load(&e->failed), "serve: the emulator could not start (the error above says why)");
     if (rc >= 0 && e->have_freerun)
         rc = nc_trigger_start(&e->freerun);
     if (rc >= 0 && e->have_line)
@@ -266,6 +265,8 @@ int nc_serve(const struct nc_serve_options *opt)
         supervise(e, opt);
     }
     shutdown_threads(e, threads, nthreads);
+    if (rc >= 0 && atomic_load(&e->failed) < 0)
+        rc = nc_error(atomic_load(&e->failed), "serve: the emulator could not go on (the error above says why)");
     if (rc >= 0) {
         double el = (nc_mono_ns() - e->start_mono_ns) * 1e-9;
         nc__serve_stats_line(e, el);

@@ -159,12 +159,14 @@ struct nc__emu {
     /* network */
     int udp_fd, tcp_fd;
     struct nc__client *clients; /* max_clients of them */
+    int next_client;            /* the network thread's: whose request is taken first (take_requests) */
     pthread_mutex_t client_lock;
     unsigned long refused_clients, slow_clients; /* over max_clients; disconnected for reading no answers */
     int64_t last_refuse_log_ns;
     /* state */
     atomic_int stop; /* 1: stop taking input; 2: render exits; 3: output exits */
     atomic_int warm; /* 1: the render thread has made its warm-up frame */
+    atomic_int failed; /* < 0: a thread gave up with this error (logged): navcam serve fails */
     uint64_t next_frame;
     int64_t start_mono_ns;
     /* statistics */

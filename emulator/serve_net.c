@@ -28,20 +28,33 @@ static void log_reject(struct nc__emu *e, enum nc_reject r, const char *from)
     }
 }
 
-static void handle_message(struct nc__emu *e, const uint8_t *buf, size_t len, int client, unsigned gen, const char *from)
+/* A message counted and decoded, a rejection counted and logged: its
+ * reason, or NC_REJECT_NONE. *answer is set when it carries a CAPTURE that
+ * must be answered: accepted, or refused for a value (its header and CRC
+ * sound), so that no client waits for it. */
+static enum nc_reject take_message(struct nc__emu *e, const uint8_t *buf, size_t len, const char *from,
+                                   struct nc_pose_msg *m, int *answer)
+{
+    atomic_fetch_add(&e->received, 1);
+    enum nc_reject r = nc_msg_decode(buf, len, m);
+    if (r == NC_REJECT_NONE && m->type == NC_MSG_FRAME)
+        r = NC_REJECT_BAD_TYPE; /* FRAME goes the other way */
+    if (r != NC_REJECT_NONE)
+        log_reject(e, r, from);
+    *answer = (r == NC_REJECT_NONE || r == NC_REJECT_NOT_FINITE || r == NC_REJECT_BAD_QUATERNION ||
+               r == NC_REJECT_BAD_VALUE) && (m->flags & NC_MSG_CAPTURE);
+    return r;
+}
+
+static void handle_message(struct nc__emu *e, const uint8_t *buf, size_t len, int client, unsigned gen,
+                           const char *from)
 {
     struct nc_pose_msg m;
-    int64_t now = nc_mono_ns();
-    atomic_fetch_add(&e->received, 1);
-    enum nc_reject r = nc_msg_decode(buf, len, &m);
-    if (r == NC_REJECT_NONE && m.type == NC_MSG_FRAME)
-        r = NC_REJECT_BAD_TYPE; /* FRAME goes the other way */
+    const int64_t now = nc_mono_ns();
+    int answer;
+    enum nc_reject r = take_message(e, buf, len, from, &m, &answer);
     if (r != NC_REJECT_NONE) {
-        log_reject(e, r, from);
-        /* A value refused (its header and CRC sound): a CAPTURE it carried
-         * is still answered, exactly once, so that no client waits for it. */
-        if ((r == NC_REJECT_NOT_FINITE || r == NC_REJECT_BAD_QUATERNION || r == NC_REJECT_BAD_VALUE) &&
-            (m.flags & NC_MSG_CAPTURE))
+        if (answer)
             nc__serve_refused_capture(e, &m, client, gen);
         return;
     }
@@ -176,14 +189,20 @@ static int client_take(struct nc__emu *e, int i)
 }
 
 /* Requests waiting in the clients' buffers, one per client in turn, so that
- * no client's backlog goes before another's. */
+ * no client's backlog goes before another's: the turn goes on from the
+ * client after the one whose request was taken last, also across calls (a
+ * lock-step queue that frees one place at a time goes to each in turn). */
 static void take_requests(struct nc__emu *e)
 {
     for (int progress = 1; progress;) {
         progress = 0;
-        for (int i = 0; i < e->max_clients; i++)
-            if (e->clients[i].fd >= 0 && client_take(e, i) > 0)
+        for (int k = 0, first = e->next_client; k < e->max_clients; k++) {
+            const int i = (first + k) % e->max_clients;
+            if (e->clients[i].fd >= 0 && client_take(e, i) > 0) {
                 progress = 1;
+                e->next_client = (i + 1) % e->max_clients;
+            }
+        }
     }
 }
 
@@ -269,12 +288,15 @@ void *nc__serve_net_thread(void *arg)
         nc_log_error("emulator/net", "out of memory");
         free(pf);
         free(map);
+        atomic_store(&e->failed, -ENOMEM);
         atomic_store(&e->stop, 1);
         return NULL;
     }
     while (atomic_load(&e->stop) == 0) {
-        /* Lock-step with a full job queue: requests stay in the sockets
-         * (the simulator's sends block) until the render takes a job. */
+        /* Lock-step with a full job queue: requests wait in the clients'
+         * buffers, and when those are full in the sockets (the simulator's
+         * sends block), until the render takes a job; every client's next
+         * request is read meanwhile, so that each is there for its turn. */
         int held = e->mode == NC__MODE_LOCKSTEP && nc__serve_queue_full(e);
         int n = 0;
         if (e->udp_fd >= 0)
@@ -284,7 +306,9 @@ void *nc__serve_net_thread(void *arg)
         pthread_mutex_lock(&e->client_lock);
         for (int i = 0; i < e->max_clients; i++)
             if (e->clients[i].fd >= 0)
-                pf[n] = (struct pollfd){e->clients[i].fd, (short)((held ? 0 : POLLIN) | (e->clients[i].out_len ? POLLOUT : 0)), 0},
+                pf[n] = (struct pollfd){e->clients[i].fd,
+                                        (short)((e->clients[i].have < sizeof e->clients[i].buf ? POLLIN : 0) |
+                                                (e->clients[i].out_len ? POLLOUT : 0)), 0},
                 map[n++] = i;
         pthread_mutex_unlock(&e->client_lock);
         if (poll(pf, (nfds_t)n, held ? 2 : 50) > 0) {
@@ -322,18 +346,23 @@ void nc__serve_answer_unread(struct nc__emu *e)
                 uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
                                (uint32_t)c->buf[3] << 24;
                 if ((len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) && len <= SKIP_MAX_BYTES) {
-                    c->skip = 4 + len; /* refused, passed over (client_take) */
+                    atomic_fetch_add(&e->received, 1); /* refused, passed over (client_take) */
+                    log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
+                    c->skip = 4 + len;
                     continue;
                 }
                 if (len > NC_PROTO_MAX_BYTES || c->have < 4 + len)
                     break;
+                /* counted as handle_message counts it; a capture is answered in its turn: dropped at
+                 * shutdown, or refused for its value (the render, which would answer that in
+                 * lock-step, has stopped) */
                 struct nc_pose_msg m;
-                if (nc_msg_decode(c->buf + 4, len, &m) == NC_REJECT_NONE && (m.flags & NC_MSG_CAPTURE) &&
-                    m.type != NC_MSG_FRAME) {
+                int answer;
+                const enum nc_reject r = take_message(e, c->buf + 4, len, "a TCP client", &m, &answer);
+                if (answer) {
                     struct nc__job j = {.trigger_sim_ns = m.sim_time_ns, .sequence = m.sequence, .client = i,
                                         .client_gen = c->gen};
-                    atomic_fetch_add(&e->received, 1);
-                    nc__serve_drop(e, &j, NC__DROP_SHUTDOWN);
+                    nc__serve_drop(e, &j, r != NC_REJECT_NONE ? NC__DROP_REJECTED : NC__DROP_SHUTDOWN);
                 }
                 memmove(c->buf, c->buf + 4 + len, c->have - 4 - len);
                 c->have -= 4 + len;

@@ -95,25 +95,24 @@ static void hold_job(struct nc__emu *e, const struct nc__job *j)
  * every output until the job is due (its exposure's end, plus one frame
  * period, plus render_ns, the render it took: the latency bound of
  * docs/emulator.md, the camera model's time aside) and else drop it
- * (output_busy: an output slower than the render). NULL: none (dropped, or
- * shutting down: the job is held for the shutdown's answers). */
+ * (output_busy: an output slower than the render). NULL: none (dropped).
+ * The same at shutdown: the frame in flight is finished and delivered (the
+ * output thread runs until the render thread has ended). */
 static struct nc__slot *free_slot(struct nc__emu *e, const struct nc__job *j, int64_t render_ns)
 {
     pthread_mutex_lock(&e->slock);
-    while (e->mode == NC__MODE_LOCKSTEP && e->scount == e->nslots && atomic_load(&e->stop) < 2)
+    while (e->mode == NC__MODE_LOCKSTEP && e->scount == e->nslots)
         pthread_cond_wait(&e->sfree, &e->slock);
     const int64_t due = j->ready_mono_ns + j->period_ns + render_ns;
-    while (e->mode != NC__MODE_LOCKSTEP && e->scount > 0 && atomic_load(&e->stop) < 2 && nc_mono_ns() < due) {
+    while (e->mode != NC__MODE_LOCKSTEP && e->scount > 0 && nc_mono_ns() < due) {
         struct timespec ts = {(time_t)(due / 1000000000), (long)(due % 1000000000)};
         pthread_cond_timedwait(&e->sfree, &e->slock, &ts);
     }
     const int room = e->mode == NC__MODE_LOCKSTEP ? e->scount < e->nslots : e->scount == 0;
     struct nc__slot *sl = room ? &e->slots[(e->shead + e->scount) % e->nslots] : NULL;
     pthread_mutex_unlock(&e->slock);
-    if (!sl && e->mode == NC__MODE_LOCKSTEP)
-        hold_job(e, j);
-    else if (!sl) /* the wait for the outputs ended by shutdown, or past the due time */
-        nc__serve_drop(e, j, atomic_load(&e->stop) >= 2 ? NC__DROP_SHUTDOWN : NC__DROP_OUTPUT_BUSY);
+    if (!sl) /* past the due time (lock-step always has room here) */
+        nc__serve_drop(e, j, NC__DROP_OUTPUT_BUSY);
     return sl;
 }
 
@@ -407,6 +406,7 @@ void *nc__serve_render_thread(void *arg)
         ok = 0;
     }
     if (!ok) {
+        atomic_store(&e->failed, err ? -err : -ENOMEM);
         atomic_store(&e->stop, 2);
     } else {
         atomic_store(&e->warm, 1);

@@ -96,6 +96,22 @@ static struct nc_vec3 lerp(struct nc_vec3 a, struct nc_vec3 b, double s)
     return nc_v3(a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.z + s * (b.z - a.z));
 }
 
+/* Directions a and b (of any lengths) interpolated along the great circle
+ * between them: the angle from a grows in proportion to s, whatever the
+ * lengths the simulator gave (a straight line between vectors of unequal
+ * lengths is not). Opposite directions have no one circle: the nearer one. */
+static struct nc_vec3 dir_slerp(struct nc_vec3 a, struct nc_vec3 b, double s)
+{
+    const struct nc_vec3 ua = nc_v3_unit(a), ub = nc_v3_unit(b);
+    const double sn = nc_v3_norm(nc_v3_cross(ua, ub)), th = atan2(sn, nc_v3_dot(ua, ub));
+    if (th < 1e-4) /* linear, then normalised: within 1e-13 rad of the arc */
+        return nc_v3_unit(lerp(ua, ub, s));
+    if (sn < 1e-12)
+        return s < 0.5 ? ua : ub;
+    const double wa = sin((1 - s) * th) / sn, wb = sin(s * th) / sn;
+    return nc_v3_unit(nc_v3_add(nc_v3_scale(ua, wa), nc_v3_scale(ub, wb)));
+}
+
 /* Pose p moved by dt seconds with its own rates. */
 static void propagate(const struct nc_pose *p, double dt, struct nc_pose *out)
 {
@@ -148,11 +164,8 @@ enum nc_pose_quality nc_timeline_at(const struct nc_timeline *tl, int64_t t, str
     out->cam_angular_velocity_rad_s = lerp(a->cam_angular_velocity_rad_s, b->cam_angular_velocity_rad_s, s);
     out->body_velocity_m_s = lerp(a->body_velocity_m_s, b->body_velocity_m_s, s);
     out->body_angular_velocity_rad_s = lerp(a->body_angular_velocity_rad_s, b->body_angular_velocity_rad_s, s);
-    if (a->sun_is_position == b->sun_is_position) {
-        out->sun = lerp(a->sun, b->sun, s);
-        if (!out->sun_is_position)
-            out->sun = nc_v3_unit(out->sun);
-    }
+    if (a->sun_is_position == b->sun_is_position)
+        out->sun = a->sun_is_position ? lerp(a->sun, b->sun, s) : dir_slerp(a->sun, b->sun, s);
     out->has_body = a->has_body && b->has_body;
     return NC_POSE_INTERPOLATED;
 }

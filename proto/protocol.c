@@ -68,7 +68,8 @@ static uint8_t *put_quat(uint8_t *p, struct nc_quat q)
 size_t nc_msg_encode(const struct nc_pose_msg *m, uint8_t *buf, size_t cap)
 {
     size_t n = nc_msg_size(m->type, m->flags);
-    if (n > cap || (m->flags & ~NC_MSG_KNOWN_FLAGS) || (m->type != NC_MSG_POSE && (m->flags & NC_MSG_POSE_ONLY_FLAGS)))
+    if ((m->type != NC_MSG_POSE && m->type != NC_MSG_TRIGGER && m->type != NC_MSG_FRAME) || n > cap ||
+        (m->flags & ~NC_MSG_KNOWN_FLAGS) || (m->type != NC_MSG_POSE && (m->flags & NC_MSG_POSE_ONLY_FLAGS)))
         return 0;
     nc_le_put_u32(buf, NC_PROTO_MAGIC);
     nc_le_put_u16(buf + 4, NC_PROTO_VERSION);

@@ -158,13 +158,19 @@ static const char *const held_name[NC_GIGE_HELD] = {"Width",       "Height",    
                                                      "OffsetY",     "PixelFormat",       "GevSCPSPacketSize",
                                                      "GevHeartbeatTimeout"};
 
-/* Whether image and transport registers v hold for a sensor of W x H rows. */
+/* Whether image and transport registers v hold for a sensor of W x H rows
+ * (the metadata rows included). */
 static int holds(const uint32_t v[NC_GIGE_HELD], uint32_t W, uint32_t H)
 {
     const uint32_t min_w = W < 16 ? W : 16, packet = v[5] & 0xffff;
     return v[0] >= min_w && v[0] <= W && v[2] <= W - v[0] && v[1] >= 1 && v[1] <= H && v[3] <= H - v[1] &&
            (v[4] == PF_MONO8 || v[4] == PF_MONO12 || v[4] == PF_MONO16) && packet >= 576 && packet <= 65000 &&
            packet % 4 == 0 && v[6] >= 500 && v[6] <= 60000;
+}
+
+int nc__gige_holds(const uint32_t v[NC_GIGE_HELD], int w, int h, int meta_rows)
+{
+    return holds(v, (uint32_t)w, (uint32_t)(h + meta_rows));
 }
 
 int nc__gige_check_registers(ArvFakeCamera *fc, int w, int h, int meta_rows, uint32_t held[NC_GIGE_HELD],

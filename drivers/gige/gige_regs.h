@@ -89,6 +89,9 @@ void nc__gige_apply(ArvFakeCamera *fc, const struct nc_camera_control *ctl, stru
  * GevHeartbeatTimeout. */
 #define NC_GIGE_HELD 7
 void nc__gige_hold(ArvFakeCamera *fc, uint32_t held[NC_GIGE_HELD]);
+/* Whether their values v hold for a sensor of w x h pixels with meta_rows
+ * metadata rows (nc__gige_check_registers's rules). */
+int nc__gige_holds(const uint32_t v[NC_GIGE_HELD], int w, int h, int meta_rows);
 /* Aravis's device stores whatever a client writes (GenICam's ranges are
  * the client's to check, and Aravis leaves them unchecked by default): the
  * checks a camera's firmware makes, for a sensor of w x h pixels with

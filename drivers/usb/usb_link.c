@@ -54,7 +54,7 @@ int nc__usb_send_msg(struct nc__usb_trig *u, const struct nc_ut_msg *m)
 void nc__usb_send_time_req(struct nc__usb_trig *u)
 {
     struct nc_ut_msg m = {.type = NC_UT_TIME_REQ, .tag = ++u->tag};
-    int k = u->nreq++ % NC__USB_N_REQ;
+    const unsigned k = u->nreq++ % NC__USB_N_REQ;
     u->req[k].tag = m.tag;
     u->req[k].t1 = nc_mono_ns();
     if (nc__usb_send_msg(u, &m) < 0)
@@ -153,7 +153,11 @@ static void LIBUSB_CALL in_done(struct libusb_transfer *t)
     if (t->status == LIBUSB_TRANSFER_COMPLETED) {
         nc__usb_receive(u, t->buffer, t->actual_length, now);
     } else if (t->status != LIBUSB_TRANSFER_CANCELLED && t->status != LIBUSB_TRANSFER_TIMED_OUT) {
-        u->gone = 1; /* NO_DEVICE, or an error the session does not survive */
+        /* NO_DEVICE (unplugged), or an error the session does not survive (a STALL, an OVERFLOW): the adapter
+         * is still there, and is opened again (trigger_usb.c) */
+        if (t->status != LIBUSB_TRANSFER_NO_DEVICE && !u->gone)
+            u->session_error = (int)t->status;
+        u->gone = 1;
     }
     if (t->status == LIBUSB_TRANSFER_CANCELLED || u->gone || libusb_submit_transfer(t) < 0) {
         u->gone = u->gone || t->status != LIBUSB_TRANSFER_CANCELLED;
@@ -228,8 +232,11 @@ int nc__usb_try_open(struct nc__usb_trig *u, libusb_device *dev)
         return nc_error(NC_EUNSUPPORTED, "usb trigger: adapter %s: cannot claim interface %d: %s", u->desc, u->iface,
                         libusb_strerror(rc));
     }
+    /* an endpoint a session before left halted (a STALL ended it) works again; on a fresh one, a no-op */
+    libusb_clear_halt(h, u->ep_in);
+    libusb_clear_halt(h, u->ep_out);
     pthread_mutex_lock(&u->lock);
-    u->h = h, u->dev = libusb_ref_device(dev), u->gone = 0;
+    u->h = h, u->dev = libusb_ref_device(dev), u->gone = 0, u->session_start_ns = nc_mono_ns();
     nc_clock_map_reset(&u->map);
     u->nunsynced = 0;
     for (int i = 0; i < NC__USB_N_IN; i++) {

@@ -42,13 +42,19 @@ struct nc__usb_trig {
     libusb_device *dev; /* the open adapter */
     libusb_device *arrived[NC__USB_N_ARRIVED]; /* plugged in since the loop last looked (oldest first) */
     int narrived;
+    int session_error;    /* the status of a transfer that ended the session (0: none, or NO_DEVICE) */
+    int verdict;          /* a closed session's session_error, until known to be an unplug or not */
+    libusb_device *retry; /* that adapter, opened again at retry_at_ns (unless it leaves first) */
+    int64_t retry_at_ns, retry_wait_ns, session_start_ns;
+    unsigned long retry_failures; /* attempts since the last session that did not open it */
     int iface, gone, inflight, maxpkt;
     uint8_t ep_in, ep_out;
     struct libusb_transfer *in[NC__USB_N_IN];
     char desc[96];
     uint32_t tag, hello_tag, next_seq;
     struct { uint32_t tag; int64_t t1; } req[NC__USB_N_REQ];
-    int nreq, burst;
+    unsigned nreq; /* exchanges sent; wraps (16 divides 2^32: the slots go on in turn) */
+    int burst;
     int64_t next_sync_ns, unplugged_at_ns;
     uint64_t dither;
     struct nc_clock_map map;
@@ -57,7 +63,8 @@ struct nc__usb_trig {
     int nunsynced;
     struct nc_trigger_edge fire[NC__USB_N_UNSYNCED + NC__USB_MAX_PACKET / NC_UT_MSG_BYTES]; /* event thread only */
     int nfire;
-    unsigned long messages, edges, lost, missed, level_repeats, other_line, unknown, unplugged, reopened, strobes, strobes_skipped;
+    unsigned long messages, edges, lost, missed, level_repeats, other_line, unknown, unplugged, session_errors,
+        reopened, strobes, strobes_skipped;
     double edge_bound_max_ns;
 };
 

@@ -65,6 +65,18 @@ cmp -s <(strip "$tmp/lock1/frames/frames.jsonl") <(strip "$tmp/lock2/frames/fram
 [ "$(wc -l < "$tmp/lock1/frames/frames.jsonl")" -eq 8 ] && ok || bad "sidecar lines"
 [ "$(json "$tmp/lock1/stats.json" "d['frames_delivered']")" = 8 ] && ok || bad "stats: frames_delivered"
 
+# A sidecar that cannot be written (a full disk: /dev/full) fails the file
+# output's submit, frame by frame, with the reason; the frames go on to the
+# other output and are delivered.
+mkdir -p "$tmp/full/frames" && ln -s /dev/full "$tmp/full/frames/frames.jsonl"
+start full 0 --set serve.mode=lockstep
+"$navcam" replay builtin:approach --lockstep --port "$tcp" > "$tmp/full/replay.out" 2>&1 \
+  && ok || bad "replay to a full sidecar: $(cat "$tmp/full/replay.out")"
+stop
+[ "$(json "$tmp/full/stats.json" "[(o['submitted'], o['failed']) for o in d['outputs']]")" = "[(0, 8), (8, 0)]" ] \
+  && [ "$(grep -c "frames.jsonl: the frame's line not written: No space left on device" "$tmp/full/serve.log")" -ge 1 ] \
+  && ok || bad "full sidecar: $(json "$tmp/full/stats.json" "d['outputs']"); $(grep jsonl "$tmp/full/serve.log" | head -2)"
+
 # A camera inside the body (two poses) and then outside it: those frames'
 # records say so, and the log warns once when it begins and once when it ends.
 printf '0,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n1,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n' > "$tmp/inside.csv"
@@ -375,6 +387,23 @@ assert 0 < s["resulting_frame_rate_hz"] <= 20.0, s["resulting_frame_rate_hz"]  #
 print("exposures taken:", len(rows), "none overlapping; overruns", s["dropped"]["overrun"], "; resulting rate",
       s["resulting_frame_rate_hz"], "Hz")
 PY
+
+# The render thread cannot get its frames (an address-space limit of 3 GB;
+# 8000x8000 frames need more, while the small scene itself fits in 2.5 GB):
+# serve fails with exit status 1 at start, before its banner, saying why.
+if [ -z "${NAVCAM_TEST_SANITIZED:-}" ]; then
+  mkdir -p "$tmp/nomem"
+  (ulimit -v 3000000 && cd "$tmp/nomem" && exec "$navcam" serve -j 1 --set bodies.0.shape.subdivisions=4 \
+     --set camera.width_px=8000 --set camera.height_px=8000 --set serve.udp_port=$((base + 20)) \
+     --set serve.tcp_port=$((base + 21)) --max-seconds 2 > stats.json 2> serve.log)
+  rc=$?
+  [ "$rc" = 1 ] && grep -q "out of memory for frames" "$tmp/nomem/serve.log" \
+    && grep -q "the emulator could not start" "$tmp/nomem/serve.log" \
+    && ! grep -q "SIGINT or SIGTERM stops" "$tmp/nomem/serve.log" && ok \
+    || bad "a render thread out of memory at start: exit $rc; $(cat "$tmp/nomem/serve.log")"
+else
+  echo "note: the address-space limit check runs in the optimised tree (ASan reserves terabytes of it)"
+fi
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -4,7 +4,9 @@
  * device stops the acquisition and closes the stream channel), then a new
  * client streams and reads GevHeartbeatTimeout; in lock-step, refused
  * settings written with one that is not are undone alone; the timestamp
- * counter's latch and reset; clear errors for a missing
+ * counter's latch and reset; at poll_hz 1 the device idles between its
+ * checks, and frames of a region beyond the sensor are not sent; clear
+ * errors for a missing
  * interface, a taken port 3956, an invalid XML (also one named relative to
  * a configuration file in another directory), a model name too long, a
  * packet size off its step.
@@ -267,6 +269,80 @@ static void test_errors(void)
     CHECK(stop(first) == 0, "first serve did not exit cleanly");
 }
 
+/* CPU seconds process pid has used (user and system). */
+static double cpu_s(pid_t pid)
+{
+    char path[64], buf[1024];
+    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+    FILE *f = fopen(path, "r");
+    size_t n = f ? fread(buf, 1, sizeof buf - 1, f) : 0;
+    if (f)
+        fclose(f);
+    buf[n] = 0;
+    const char *p = strrchr(buf, ')'); /* fields 14 and 15 after the command's name */
+    unsigned long ut = 0, st = 0;
+    if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &ut, &st) != 2)
+        return -1;
+    return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
+}
+
+/* Until register reg reads v (up to s seconds); 1 when it did. */
+static int reads(ArvDevice *d, guint32 reg, guint32 v, double s)
+{
+    guint32 x = ~v;
+    for (double t0 = now_s(); now_s() - t0 < s; usleep(5000))
+        if (arv_device_read_register(d, reg, &x, NULL) && x == v)
+            return 1;
+    return 0;
+}
+
+/* poll_hz 1, its minimum: the device checks what clients write once a
+ * second, its poll thread asleep between (it spun: a second of nanoseconds
+ * is no timespec). A region beyond the sensor (OffsetX 100 beside the full
+ * Width) stands until the next check; the frames made meanwhile are not
+ * sent (the output's stop line counts them failed), none with a region the
+ * sensor lacks. */
+static void test_slow_poll(void)
+{
+    char dir[4096];
+    pid_t pid;
+    ArvCamera *c = begin("slowpoll", "outputs=[{driver: gige, poll_hz: 1}]", "serve.frame_rate_hz=20", &pid, dir,
+                         sizeof dir);
+    if (!c)
+        return;
+    ArvDevice *d = arv_camera_get_device(c);
+    struct stream st;
+    const int streaming = start(c, &st) == 0;
+    arv_device_write_register(d, 0x130, 100, NULL);
+    const int undone = reads(d, 0x130, 0, 2.5); /* a check has just run */
+    const double cpu0 = cpu_s(pid), t0 = now_s();
+    arv_device_write_register(d, 0x130, 100, NULL);
+    usleep(500000);
+    guint32 ox = 0;
+    arv_device_read_register(d, 0x130, &ox, NULL);
+    const int again = reads(d, 0x130, 0, 1.5);
+    const double cpu = cpu_s(pid) - cpu0, wall = now_s() - t0;
+    printf("poll_hz 1: OffsetX 100 undone %d, stood %.2f s (%u after 0.5 s); serve used %.2f s of CPU in it\n",
+           undone && again, wall, ox, cpu);
+    CHECK(undone && again && ox == 100 && wall > 0.5,
+          "poll_hz 1: the write stood %.2f s (%u after 0.5 s), undone %d %d", wall, ox, undone, again);
+    CHECK(cpu >= 0 && cpu < 0.5 * wall, "poll_hz 1: serve used %.2f s of CPU in %.2f s", cpu, wall);
+    if (streaming)
+        finish(c, &st);
+    g_object_unref(c);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+    char path[4200];
+    size_t len = 0;
+    snprintf(path, sizeof path, "%s/serve.log", dir);
+    char *log = nc_test_read(path, &len);
+    const char *at = log ? strstr(log, "exposed before AcquisitionStart, ") : NULL;
+    long failed = at ? strtol(at + 33, NULL, 10) : -1;
+    printf("frames made while the region stood beyond the sensor, not sent: %ld\n", failed);
+    CHECK(failed >= 5, "frames with OffsetX 100 beside Width %d: %ld not sent, want those of the second it stood", W,
+          failed);
+    free(log);
+}
+
 int main(int argc, char **argv)
 {
     if (rig_args(argc, argv, "test_gige_control") < 0)
@@ -274,6 +350,7 @@ int main(int argc, char **argv)
     test_client_killed();
     test_lockstep_units();
     test_timestamps();
+    test_slow_poll();
     test_errors();
     return nc_test_end();
 }

@@ -4,8 +4,9 @@
  * exactly once and in request order (back-pressure, not drops); 50
  * concurrent clients within serve.max_clients are all served; a client
  * beyond the limit is told why; a client that reads none of its answers
- * does not hold up another; at shutdown every capture still queued is
- * answered "dropped", after the frames before it; a failed render and a
+ * does not hold up another; clients take turns; at shutdown every capture
+ * still queued or unread is answered "dropped", after the frames before
+ * it, and counted; a failed render and a
  * frame no output took are drops with their reasons, and a failed render
  * leaves no gap in the frame numbers.
  * Usage: test_lockstep NAVCAM TMPDIR */
@@ -241,8 +242,19 @@ static void shutdown_answers_everything(void)
     struct nc_client *c = serve_one("shutdown", NULL, &pid);
     if (!c)
         return;
-    for (int i = 0; i < 20; i++)
-        capture(c, i * 0.1);
+    for (int i = 0; i < 20; i++) {
+        if (i != 17) {
+            capture(c, i * 0.1);
+            continue;
+        }
+        /* the 18th refused for its value (still unread in the socket at SIGTERM: 4 queued, the
+         * buffer holds about 9): answered in its turn too */
+        struct nc_pose_msg m = {.type = NC_MSG_POSE, .flags = NC_MSG_CAPTURE | NC_MSG_EXPOSURE,
+                                .sim_time_ns = 1700000000, .cam_position_m = {0, -3000, 0},
+                                .cam_attitude_q = {0.70710678118654752, -0.70710678118654752, 0, 0},
+                                .sun = {1, 0, 0}, .exposure_s = -1};
+        nc_client_send(c, &m);
+    }
     uint32_t seq, status;
     uint64_t frame;
     CHECK(nc_client_next_frame(c, 60000, &seq, &frame, &status) == 0 && seq == 1, "first answer");
@@ -266,6 +278,48 @@ static void shutdown_answers_everything(void)
     waitpid(pid, &st, 0);
     CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0, "serve exit status %d", st);
     nc_client_close(c);
+    char path[4200];
+    size_t n;
+    snprintf(path, sizeof path, "%s/shutdown/stats.json", tmp);
+    char *text = nc_test_read(path, &n);
+    CHECK(text && nc_test_contains(text, "\"messages\": 20,") && nc_test_contains(text, "\"out_of_range\": 1") &&
+              nc_test_contains(text, "\"rejected_request\": 1"),
+          "shutdown: every message counted, the refused one as such: %s", text ? text : "(none)");
+    free(text);
+}
+
+/* Requests are taken one per client in turn: a client that sends one
+ * capture while another has 30 queued and buffered is served within a few
+ * frames (the queue of 4 and the frame being made), not after the other's
+ * backlog. */
+static void clients_take_turns(void)
+{
+    pid_t pid = serve("turns", NULL);
+    struct nc_client *a = connect_to(), *b = connect_to();
+    if (!a || !b) {
+        CHECK(0, "turns: connections: %s", nc_client_errmsg());
+        nc_client_close(a);
+        nc_client_close(b);
+        finish(pid);
+        return;
+    }
+    for (int i = 0; i < 30; i++)
+        capture(a, i * 0.01);
+    uint32_t seq, status;
+    uint64_t fa[30] = {0}, fb = 0;
+    int ok = nc_client_next_frame(a, 60000, &seq, &fa[0], &status) == 0; /* the render has begun */
+    ok &= capture(b, 1) > 0;
+    ok &= nc_client_next_frame(b, 60000, &seq, &fb, &status) == 0 && status == NC_FRAME_DELIVERED;
+    int before = 0;
+    for (int i = 1; ok && i < 30; i++)
+        ok &= nc_client_next_frame(a, 60000, &seq, &fa[i], &status) == 0;
+    for (int i = 0; i < 30; i++)
+        before += fa[i] < fb;
+    printf("turns: one capture beside 30 of another client's: served after %d of them\n", before);
+    CHECK(ok && before <= 7, "turns: the second client's capture came after %d of the first's (ok %d)", before, ok);
+    nc_client_close(a);
+    nc_client_close(b);
+    CHECK(finish(pid) == 0, "serve did not exit cleanly");
 }
 
 /* One answer: its status, and its frame number in *frame. */
@@ -360,6 +414,7 @@ int main(int argc, char **argv)
     fifty_clients_and_a_slow_one();
     refused_beyond_the_limit();
     shutdown_answers_everything();
+    clients_take_turns();
     failures_are_drops();
     return nc_test_end();
 }

@@ -2,7 +2,8 @@
  * a straight line at constant speed, turning at a constant rate about a fixed
  * axis, sampled every 100 ms; interpolated at arbitrary instants, positions
  * are exact (linear) and attitudes exact (slerp of a constant rotation).
- * Extrapolation with the rates, staleness, time going backwards, overflow. */
+ * Extrapolation with the rates, staleness, time going backwards, overflow;
+ * Sun directions of unequal lengths along their great circle. */
 #include <math.h>
 #include <stdio.h>
 
@@ -87,6 +88,24 @@ int main(void)
     struct nc_quat a = {1, 0, 0, 0}, b = {-cos(0.1), 0, 0, -sin(0.1)};
     struct nc_quat mid = nc_quat_slerp(a, b, 0.5);
     CHECK(fabs(qdiff(mid, (struct nc_quat){cos(0.05), 0, 0, sin(0.05)})) < 1e-12, "shorter arc");
+    nc_timeline_free(&tl);
+    /* Sun directions of unequal lengths: along the great circle, the angle
+     * in proportion to the time (a straight line between (1000, 0, 0) and
+     * (0, 1, 0) was 0.06 deg from the first at mid-time, not 45) */
+    nc_timeline_init(&tl, 4, 0);
+    struct nc_pose s0 = truth(0), s1 = truth(1);
+    s0.sun = nc_v3(1000, 0, 0);
+    s1.sun = nc_v3(0, 1, 0);
+    nc_timeline_push(&tl, &s0);
+    nc_timeline_push(&tl, &s1);
+    double worst_s = 0;
+    for (int k = 0; k <= 8; k++) {
+        nc_timeline_at(&tl, 125000000LL * k, &out, NULL);
+        const struct nc_vec3 u = nc_v3_unit(out.sun); /* at a pose: its own vector, as sent */
+        const double want_rad = k * M_PI / 16, got = atan2(u.y, u.x);
+        worst_s = fmax(worst_s, fabs(got - want_rad) + fabs(u.z));
+    }
+    CHECK(worst_s < 1e-12, "Sun directions of unequal lengths: worst error %.3g rad", worst_s);
     nc_timeline_free(&tl);
     return nc_test_end();
 }

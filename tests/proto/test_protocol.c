@@ -74,6 +74,11 @@ int main(void)
     struct nc_pose_msg sun_trig = trig;
     sun_trig.flags |= NC_MSG_SUN_POSITION;
     CHECK(nc_msg_encode(&sun_trig, buf, sizeof buf) == 0, "a trigger flagged SUN_POSITION was encoded");
+    struct nc_pose_msg odd = trig;
+    for (int t = 0; t <= 8; t += t == 0 ? 4 : 1) { /* 0 and 4..8: no such type (the decoder: bad_type) */
+        odd.type = (enum nc_msg_type)t;
+        CHECK(nc_msg_encode(&odd, buf, sizeof buf) == 0, "a message of type %d was encoded", t);
+    }
 
     /* The minimal pose message of docs/protocol.md, byte for byte. */
     struct nc_pose_msg ex = {.type = NC_MSG_POSE, .sequence = 1, .flags = NC_MSG_CAPTURE, .sim_time_ns = 1000000000};

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """check.py OUTDIR EDGES - the checks of guest_v4l2_gpio.sh, on what its
-three phases left in OUTDIR (stdlib only: it runs inside the guest).
+five phases left in OUTDIR (stdlib only: it runs inside the guest).
 
 A: every frame the V4L2 reader captured equals, byte for byte, the frame the
    file output wrote (FITS, parsed here); EDGES edges gave exactly EDGES
@@ -17,6 +17,9 @@ D: v4l2-ctl, a reader that is not NavCam's, streams 5 free-run frames by
    holds the record's core (magic, frame number, exposure, its CRC-32), the
    rows below are Y16, little-endian, DN << 4 (y16_align msb), of the frame
    of that number the file output wrote, in the order delivered.
+E: the trigger's GPIO chip removed mid-run: reported once, serve idle after
+   it (no thread spinning on the hung-up line), the strobe's failed writes
+   logged once and counted, a clean stop.
 """
 import os
 import struct
@@ -214,6 +217,16 @@ for g in got:
 check(len(matched) == len(got) == 5 and matched == sorted(set(matched)),
       f"D: each frame v4l2-ctl read names its frame in row 0 (frames {matched}) and is that file-output frame, "
       f"in order")
+
+# ---- E ----------------------------------------------------------------------
+elog = open(os.path.join(out, "e/serve.log")).read()
+ticks, hz = (int(v) for v in open(os.path.join(out, "e/cpu_ticks.txt")).read().split())
+check(elog.count("the GPIO chip is gone (unplugged or removed): no more edges from it") == 1,
+      "E: the chip's removal is reported, once")
+check(ticks < 0.5 * 2 * hz, f"E: serve used {ticks / hz:.2f} s of CPU in the 2 s after the chip went (free-run 2 Hz)")
+serrs = elog.count("trigger/gpio: error: strobe")
+check(serrs <= 1 and (serrs == 0 or "strobe line writes failed" in elog),
+      f"E: the strobe's failed writes logged once ({serrs} lines), counted at the stop")
 
 print(f"{len(failures)} checks failed" if failures else "all checks passed")
 if lat:

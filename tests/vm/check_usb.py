@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""check_usb.py OUTDIR EDGES - the checks of guest_usb.sh, on what its three
+"""check_usb.py OUTDIR EDGES - the checks of guest_usb.sh, on what its four
 phases left in OUTDIR (stdlib only: it runs inside the guest).
 
 A: EDGES edges on the adapter's input gave EDGES frames (file output and a
@@ -16,6 +16,9 @@ B: a storm of 20000 pulses: every edge the adapter read reached NavCam or
    the adapter's kernel merged is reported next to what was driven.
 C: unplugged and plugged again: reported, counted, reopened; the edges
    before and after gave frames, the ones while unplugged none.
+D: the adapter's IN endpoint stalled (still plugged in): the session's end
+   is reported and counted as a session error, not an unplug; the adapter is
+   opened again by itself; the edges before and after gave frames.
 """
 import json
 import os
@@ -136,6 +139,18 @@ e2 = csv_rows(os.path.join(out, "c/edges2.csv"))
 check(len(crecs) >= n2 and all(e[1] - 5000000 <= r["trigger_mono_ns"] <= e[2] + 5000000
                                for r, e in zip(crecs[n1:], e2)),
       "C: after the re-plug, trigger times again match their edges (new clock map)")
+
+# ---- D ----------------------------------------------------------------------
+sd = stats(out, "d")
+ud = sd["trigger"]["usb"]
+m1, m2 = len(csv_rows(os.path.join(out, "d/edges1.csv"))), len(csv_rows(os.path.join(out, "d/edges2.csv")))
+drecs = records(os.path.join(out, "d/files/frames.jsonl"))
+dlog = open(os.path.join(out, "d/serve.log")).read()
+check(ud["session_errors"] == 1 and ud["unplugged"] == 0 and ud["reopened"] == 1,
+      f"D: session_errors {ud['session_errors']}, unplugged {ud['unplugged']}, reopened {ud['reopened']}")
+check("the session ended on a transfer error (a stall; 1 so far); opening it again" in dlog
+      and "reopened after" in dlog, "D: the stall and the reopening are reported")
+check(len(drecs) == m1 + m2, f"D: {m1} edges before and {m2} after the stall -> {len(drecs)} frames")
 
 print(f"{len(failures)} checks failed" if failures else "all checks passed")
 if lat:

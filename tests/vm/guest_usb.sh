@@ -14,7 +14,7 @@ out=$1 navcam=$2 helpers=$3 src=$4 adapter=$5
 edges=${6:-12}
 mods=/run/vm/root
 cd "$out"
-rm -rf a b c && mkdir -p a b c
+rm -rf a b c d && mkdir -p a b c d
 
 . "$(dirname "$0")/guest_lib.sh"
 trap 'echo "guest_usb.sh: line $LINENO: $BASH_COMMAND failed"' ERR
@@ -169,6 +169,23 @@ sleep 1
 taskset -c 0 "$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" 6 300 c/edges2.csv
 sleep 0.5
 stop_serve c
+
+# ---- D: a transfer error with the adapter still there ---------------------------
+# A read of FunctionFS's IN endpoint file halts the endpoint: NavCam's queued
+# IN transfers end with a stall, as a device's firmware fault would make them.
+step "D: the adapter's IN endpoint stalled mid-run: the session ends and starts again"
+start_serve d --set "serve.trigger=$trig" --set serve.udp_port=5780 --set serve.tcp_port=5781 \
+    --set "outputs=[{driver: file, directory: files, pattern: frame_%06llu.fits}]"
+sleep 1
+taskset -c 0 "$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" 4 300 d/edges1.csv
+sleep 0.3
+dd if=$ffs/ep1 of=/dev/null bs=64 count=1 >d/halt.log 2>&1 || true
+wait_log d "the session ended on a transfer error (a stall"
+wait_log d "reopened after"
+sleep 1
+taskset -c 0 "$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" 4 300 d/edges2.csv
+sleep 0.5
+stop_serve d
 
 kill -INT "$adapter_pid"
 wait "$adapter_pid" || true

@@ -11,7 +11,7 @@ out=$1 navcam=$2 helpers=$3 src=$4
 mods=/run/vm/root
 edges=${5:-12}
 cd "$out"
-rm -rf a b c d && mkdir -p a b c d
+rm -rf a b c d e && mkdir -p a b c d e
 
 . "$(dirname "$0")/guest_lib.sh"
 trap 'echo "guest_v4l2_gpio.sh: line $LINENO: $BASH_COMMAND failed"' ERR
@@ -143,6 +143,27 @@ for _ in $(seq 50); do
     sleep 0.1
 done
 stop_serve d
+
+# ---- E: the GPIO chip goes away mid-run ------------------------------------------
+# A chip of its own, removed while serve holds its lines (a USB GPIO expander
+# unplugged): the kernel then reports the line's event file hung up on every
+# poll. Serve says so once, stops polling it (it spun at 100 % CPU), and
+# still stops cleanly; the strobe's failed writes are logged once.
+step "E: the trigger's GPIO chip removed mid-run"
+v4l2_chip=$chip
+sim_chip gone 2
+start_serve e --set serve.mode=freerun --set serve.frame_rate_hz=2 --set serve.udp_port=5790 --set serve.tcp_port=5791 \
+    --set "serve.trigger={driver: gpio, chip: $chip, line: TRIG, strobe: {line: STROBE, active: high}}" \
+    --set "outputs=[{driver: null}]"
+sleep 1
+echo 0 >/sys/kernel/config/gpio-sim/gone/live
+sleep 0.5
+t0=$(awk '{print $14 + $15}' /proc/$serve_pid/stat)
+sleep 2
+t1=$(awk '{print $14 + $15}' /proc/$serve_pid/stat)
+echo "$((t1 - t0)) $(getconf CLK_TCK)" >e/cpu_ticks.txt
+stop_serve e
+chip=$v4l2_chip
 
 step "checks"
 python3 "$src/tests/vm/check.py" "$out" "$edges"
