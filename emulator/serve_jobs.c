@@ -24,6 +24,10 @@ void nc__serve_flush_client(struct nc__emu *e, struct nc__client *c)
         ssize_t w = send(c->fd, c->out + sent, c->out_len - sent, MSG_NOSIGNAL | MSG_DONTWAIT);
         if (w < 0 && errno == EINTR)
             continue;
+        if (w < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+            sent = c->out_len; /* the connection is broken (EPIPE, ECONNRESET): no one reads them */
+            break;
+        }
         if (w <= 0)
             break; /* EAGAIN: the net thread sends the rest when the socket takes it */
         sent += (size_t)w;

@@ -304,12 +304,14 @@ void *nc__serve_net_thread(void *arg)
         if (e->tcp_fd >= 0)
             pf[n] = (struct pollfd){e->tcp_fd, POLLIN, 0}, map[n++] = -2;
         pthread_mutex_lock(&e->client_lock);
-        for (int i = 0; i < e->max_clients; i++)
-            if (e->clients[i].fd >= 0)
-                pf[n] = (struct pollfd){e->clients[i].fd,
-                                        (short)((e->clients[i].have < sizeof e->clients[i].buf ? POLLIN : 0) |
-                                                (e->clients[i].out_len ? POLLOUT : 0)), 0},
-                map[n++] = i;
+        for (int i = 0; i < e->max_clients; i++) {
+            /* a client with a full buffer and no answers waiting is not polled: poll would report its hang-up
+             * at once, again and again, until the queue takes one of its requests */
+            const struct nc__client *c = &e->clients[i];
+            const short ev = (short)((c->have < sizeof c->buf ? POLLIN : 0) | (c->out_len ? POLLOUT : 0));
+            if (c->fd >= 0 && ev)
+                pf[n] = (struct pollfd){c->fd, ev, 0}, map[n++] = i;
+        }
         pthread_mutex_unlock(&e->client_lock);
         if (poll(pf, (nfds_t)n, held ? 2 : 50) > 0) {
             for (int k = 0; k < n; k++) {
