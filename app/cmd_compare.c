@@ -51,7 +51,8 @@ static const char compare_help[] =
     "  -F, --flip-real AXES mirror REAL before anything else: y top to bottom (an\n"
     "                       image stored bottom row first), x left to right, xy\n"
     "                       both (turned by 180 degrees); default none\n"
-    "  -j, --json FILE      the results as JSON in FILE (default: standard output)\n"
+    "      --json FILE      the results as JSON in FILE (default: standard output; no -j:\n"
+    "                       that is --threads in the commands that render)\n"
     "  -h, --help           this help\n"
     "\n"
     "The JSON: real, render, width, height, flip_real, fit, scale, shift_px [dx, dy]\n"
@@ -132,7 +133,7 @@ int main(int argc, char **argv)
     const char *dir = NULL, *json = NULL;
     int fit = NC_FIT_SCALE, radius = 0, flip = 0, c;
     optind = 1;
-    while ((c = nc_cli_getopt(argc, argv, "o:f:r:j:F:h", opts)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "o:f:r:F:h", opts)) != -1) {
         switch (c) {
         case 'o': dir = optarg; break;
         case 'j': json = optarg; break;

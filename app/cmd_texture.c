@@ -51,7 +51,8 @@ static const char texture_help[] =
     "                      row Y (0-based; row 0 is the top row: FITS files are\n"
     "                      read top-down whatever their ROWORDER)\n"
     "  -g, --gsd M         ground sample distance, m per pixel: also corners per m^2\n"
-    "  -j, --json FILE     the results in FILE (default: standard output)\n"
+    "      --json FILE     the results in FILE (default: standard output; no -j: that is\n"
+    "                      --threads in the commands that render)\n"
     "  -h, --help          this help\n"
     "\n"
     "The JSON: an array, one object per image: image, width, height (the crop's\n"
@@ -128,7 +129,7 @@ int main(int argc, char **argv)
     double gsd = 0;
     int c, crop[4] = {0, 0, 0, 0};
     optind = 1;
-    while ((c = nc_cli_getopt(argc, argv, "t:r:R:b:g:j:c:h", opts)) != -1) {
+    while ((c = nc_cli_getopt(argc, argv, "t:r:R:b:g:c:h", opts)) != -1) {
         char *end;
         switch (c) {
         case 't': {

@@ -401,6 +401,10 @@ expect 1 "no.SUM: No such file or directory" -- "$navcam" render -o "$tmp/s.fits
 # navcam texture: two renders at once (JSON fields, the region, --gsd), and
 # its argument and file errors.
 expect 0 "FastFeatureDetector" -- "$navcam" texture --help
+# -j is --threads where a command renders: here there is none, and -j 2 is
+# refused (it wrote the JSON into a file named 2)
+expect 2 "invalid option" -- "$navcam" texture -j 2 "$tmp/real.fits"
+expect 2 "invalid option" -- "$navcam" compare -j 2 "$tmp/real.fits" "$tmp/real.fits"
 "$navcam" texture "$tmp/real.fits" "$tmp/other.fits" --region otsu --gsd 2 > "$tmp/tex.json" 2> "$tmp/tex.err" &&
   python3 -c "
 import json, sys; d = json.load(open(sys.argv[1]))
