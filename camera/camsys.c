@@ -139,22 +139,16 @@ static void digitise_row(const float *restrict q, const float *restrict zr, int 
     }
 }
 
-/* The ADC: round to nearest, clip to 0 .. top. */
-static inline uint16_t adc(double v, double top)
-{
-    v += 0.5;
-    if (!(v > 0))
-        return 0;
-    return v >= top ? (uint16_t)top : (uint16_t)(uint32_t)v;
-}
-
 /* The random numbers of one image row: for each pair of pixels one Philox
  * call keyed by (seed, frame, pair) gives four 24-bit uniforms in (0, 1):
  * Box-Muller pair A (u0, u1) gives both pixels' read-noise normals, pair B
- * (u2, u3) their shot-noise normals at high counts; at low counts u2 and u3
- * are instead the uniforms of exact Poisson sampling (pair B then unused). No
- * draw serves twice in one pixel. Single precision and vector batches:
- * plenty for noise, and the whole frame takes a few milliseconds. */
+ * (u2, u3) their shot-noise normals at high counts; a call of block 1 for
+ * each four pixels gives each its own uniform for exact Poisson sampling at
+ * low counts (poisson_uniforms; only in rows that have such a pixel).
+ * No draw serves two pixels' charges (a dim pixel's uniform was its bright
+ * neighbour's Box-Muller radius or angle: where the dim one read 0, the
+ * bright one's variance was six times its mean). Single precision and vector
+ * batches: plenty for noise, and the whole frame takes a few milliseconds. */
 struct row_rng {
     uint32_t *w;                 /* 4 words per pair */
     float *u, *lr, *ang, *s, *c; /* 2 per pixel each */
@@ -166,14 +160,12 @@ static void row_normals(const struct nc_camsys *cs, uint64_t frame, int y, int W
 {
     const int pairs = (W + 1) / 2;
     uint32_t *const w[4] = {b->w, b->w + pairs, b->w + 2 * pairs, b->w + 3 * pairs};
+    const float scale = 0x1.0p-24f;
     nc_rng_words(cs->sensor.seed, NC_RNG_PIXEL_NOISE, frame, (uint32_t)((size_t)y * (size_t)pairs), 0,
                  (size_t)pairs, w);
-    const float scale = 0x1.0p-24f;
     for (int k = 0; k < pairs; k++) {
         float u0 = ((float)(w[0][k] >> 8) + 0.5f) * scale, u1 = ((float)(w[1][k] >> 8) + 0.5f) * scale;
         float u2 = ((float)(w[2][k] >> 8) + 0.5f) * scale, u3 = ((float)(w[3][k] >> 8) + 0.5f) * scale;
-        b->u[2 * k] = u2;
-        b->u[2 * k + 1] = u3;
         b->lr[2 * k] = u0;
         b->lr[2 * k + 1] = u2;
         b->ang[2 * k] = 2.0f * u1;
@@ -190,6 +182,18 @@ static void row_normals(const struct nc_camsys *cs, uint64_t frame, int y, int W
         b->zs[2 * k] = b->lr[2 * k + 1] * b->c[2 * k + 1];
         b->zs[2 * k + 1] = b->lr[2 * k + 1] * b->s[2 * k + 1];
     }
+}
+
+/* Row y's uniforms of exact Poisson sampling into b->u, one per pixel:
+ * Philox block 1, four pixels a call (b->w holds the words). */
+static void poisson_uniforms(const struct nc_camsys *cs, uint64_t frame, int y, int W, struct row_rng *b)
+{
+    const int quads = (W + 3) / 4;
+    uint32_t *const w[4] = {b->w, b->w + quads, b->w + 2 * quads, b->w + 3 * quads};
+    nc_rng_words(cs->sensor.seed, NC_RNG_PIXEL_NOISE, frame, (uint32_t)((size_t)y * (size_t)quads), 1, (size_t)quads,
+                 w);
+    for (int x = 0; x < W; x++)
+        b->u[x] = ((float)(w[x & 3][x >> 2] >> 8) + 0.5f) * 0x1.0p-24f;
 }
 
 int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, double exposure_s, uint64_t frame,
@@ -224,11 +228,15 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
         /* Charge: response pattern and dark current; exp(-lambda) for the
          * low-count pixels in one batch. */
         const float t = (float)exposure_s;
+        int low = 0;
         for (int x = 0; x < W; x++) {
             const float c = electrons[o + x] * cs->prnu_map[o + x] + cs->dark_map[o + x] * t;
             lam[x] = c < CHARGE_MAX_E ? c : CHARGE_MAX_E; /* a charge beyond any well, kept finite */
             p0[x] = lam[x] < 40.0f ? -lam[x] : -40.0f;
+            low |= lam[x] < 32.0f;
         }
+        if (s->shot_noise && low)
+            poisson_uniforms(cs, frame, y, W, &b);
         if (s->shot_noise)
             nc_vexpf(p0, (size_t)W);
         /* Charge after shot noise, branch-free for the common cases: the
@@ -249,9 +257,10 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
     }
     free(buf);
     free(words);
-    free(lam);
-    if (!whole)
+    if (!whole) {
+        free(lam);
         return 0;
+    }
     if (s->cosmic_rate_cm2_s > 0)
         cosmic_rays(cs, exposure_s, frame, e);
     /* Full well: the excess is lost, or with blooming spills half up and half
@@ -261,6 +270,7 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
         if (!up) {
             free(e);
             free(rn);
+            free(lam);
             return nc_error(-ENOMEM, "out of memory");
         }
         for (int x = 0; x < W; x++) {
@@ -290,8 +300,15 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
         }
         free(up);
     }
-    for (size_t p = 0; p < n; p++)
-        dn[p] = adc(s->bias_dn + ((e[p] < fw ? e[p] : fw) + s->read_noise_e * rn[p]) * g, top);
+    /* the row path's ADC (single precision): a pixel no charge reached or
+     * left is the same DN with and without blooming and cosmic rays */
+    for (int y = 0; y < H; y++) {
+        const size_t o = (size_t)y * (size_t)W;
+        for (int x = 0; x < W; x++)
+            q[x] = (float)e[o + x];
+        digitise_row(q, rn + o, W, (float)fw, (float)s->read_noise_e, (float)s->bias_dn, (float)g, (float)top, dn + o);
+    }
+    free(lam);
     free(e);
     free(rn);
     return 0;

@@ -412,9 +412,11 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
     const struct nc_optics *o = &cs->optics;
     const struct nc_sensor *s = &cs->sensor;
     /* Camera equation for an object at infinity: focal-plane irradiance
-     * E = L tau pi / (4 N^2) V(theta); electrons/s = QE E A_pix lambda/(h c). */
+     * E = L tau pi / (4 N^2) V(theta); electrons/s = QE E A_pix lambda/(h c).
+     * The pitch is along x (f / fx); a pixel is f / fy tall: A_pix = pitch^2 fx / fy. */
     double k = s->qe * o->band_fraction * o->transmission * M_PI / (4.0 * o->f_number * o->f_number) *
-               s->pixel_pitch_m * s->pixel_pitch_m * o->wavelength_m / (NC_PLANCK_J_S * NC_LIGHT_M_S);
+               s->pixel_pitch_m * s->pixel_pitch_m * (geom->fx_px / geom->fy_px) * o->wavelength_m /
+               (NC_PLANCK_J_S * NC_LIGHT_M_S);
     /* Dark current doubles every dark_doubling_k: the mean, the per-pixel
      * non-uniformity and the hot pixels alike (the pattern is the sensor's,
      * its scale the temperature's). DSNU is a log-normal factor of mean 1 and

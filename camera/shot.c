@@ -94,7 +94,11 @@ static int wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image
 }
 
 /* Electrons (float) or a digitised frame of a rendered radiance image (the
- * camera model's render size: the sensor plus the PSF's margin). */
+ * camera model's render size: the sensor plus the PSF's margin), in the
+ * rendered orientation: the optics (vignetting, PSF) act there, and the
+ * electrons are then mirrored as s's camera stores its image, so that the
+ * sensor's fixed patterns (PRNU, DSNU, hot pixels) and its noise are keyed
+ * to stored pixels. */
 static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc_quantity q, const struct nc_scene *s,
                               const struct nc_camsys *cs, double exposure, unsigned long long frame_no,
                               const struct nc_image_attr *extra, int nextra, double *scale)
@@ -106,6 +110,8 @@ static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc
     struct nc_image_attr attrs[64];
     char text[32][200];
     int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
+    if (rc >= 0 && (s->camera.flip_rows || s->camera.flip_cols))
+        nc_image_flip(e, sizeof *e, W, H, s->camera.flip_rows, s->camera.flip_cols);
     int na = nc_frame_meta(s, q, attrs, text, 32);
     na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 31 - na);
     for (int i = 0; i < nextra && na < 64; i++)
@@ -186,7 +192,8 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     double t2 = now_ms();
     info->render_ms = ts0 - t1;
     info->stars_ms = t2 - ts0;
-    nc_frame_flip(&f, scene->camera.flip_rows, scene->camera.flip_cols);
+    if (q <= NC_Q_ROCK_ID) /* the sensor's quantities are mirrored after the optics (write_sensor_frame) */
+        nc_frame_flip(&f, scene->camera.flip_rows, scene->camera.flip_cols);
     /* Levels of detail and the smallest boulder traced (0: every rock). */
     char lod[40], rocks[40], mesh[40];
     snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r->rt));

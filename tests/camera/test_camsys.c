@@ -2,8 +2,10 @@
  * photon transfer in the style of EMVA 1288 (system gain, read noise, dark
  * current, saturation capacity, linearity) from flat and dark frames of the
  * same code path `navcam expose` uses; the radiometric chain against its
- * equation; vignetting against its formula; determinism; and no NaN/Inf for
- * zero, tiny and saturating exposures. */
+ * equation; vignetting against its formula; non-square pixels' area;
+ * neighbours' shot noise independent; determinism; blooming without
+ * saturation leaving the frame as it was; and no NaN/Inf for zero, tiny and
+ * saturating exposures. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,6 +13,7 @@
 
 #include "camera/camsys.h"
 #include "camera/load.h"
+#include "core/config.h"
 #include "core/error.h"
 #include "testutil.h"
 
@@ -271,6 +274,25 @@ static void robustness(void)
     nc_camsys_digitise(&cs, e, 0.01, 12, b);
     CHECK(memcmp(a, b, sizeof a) != 0, "frames 11 and 12 are identical");
     nc_camsys_free(&cs);
+    /* Blooming moves charge only from saturated pixels: with none, the frame
+     * is the one without blooming, DN for DN (its ADC was another path's: 68
+     * pixels of a 1024x1024 frame 1 DN apart). */
+    const char *gain[] = {"sensor.gain_e_per_dn=5", "sensor.analog_gain_db=3.7", "sensor.read_noise_e=8"};
+    const char *bloom[] = {"sensor.gain_e_per_dn=5", "sensor.analog_gain_db=3.7", "sensor.read_noise_e=8",
+                           "sensor.blooming=true"};
+    struct nc_camsys c0, c1;
+    load(gain, 3, &g, &c0);
+    load(bloom, 4, &g, &c1);
+    for (int i = 0; i < W * H; i++)
+        e[i] = (float)(50 + 97 * (i % 101)); /* up to 9750 e-, under the 20000 e- well */
+    nc_camsys_digitise(&c0, e, 0.01, 21, a);
+    nc_camsys_digitise(&c1, e, 0.01, 21, b);
+    int differ = 0;
+    for (int i = 0; i < W * H; i++)
+        differ += a[i] != b[i];
+    CHECK(differ == 0, "blooming on, nothing saturated: %d pixels differ from the frame without it", differ);
+    nc_camsys_free(&c0);
+    nc_camsys_free(&c1);
 }
 
 static void shot_noise_statistics(void)
@@ -307,6 +329,65 @@ static void shot_noise_statistics(void)
     nc_camsys_free(&cs);
 }
 
+/* Neighbours' shot noise is independent: columns alternating 5 and 1000 e-
+ * (a dim pixel beside a bright one at a limb or a star): the bright
+ * pixels' variance is their mean whether the dim neighbour read 0 or not,
+ * and their mean does not move with it (a dim pixel's uniform was its
+ * neighbour's Box-Muller radius or angle: variance 6049 e-^2 beside a 0,
+ * or a bias of +40 e-). Both orders of the pair. */
+static void shot_noise_of_neighbours(void)
+{
+    const char *sets[] = {"sensor={qe: 1, read_noise_e: 0, gain_e_per_dn: 1, full_well_e: 60000, adc_bits: 16, seed: 3}"};
+    struct nc_camera g;
+    struct nc_camsys cs;
+    load(sets, 1, &g, &cs);
+    static float e[W * H];
+    static uint16_t a[W * H];
+    for (int odd = 0; odd < 2; odd++) {
+        for (int i = 0; i < W * H; i++)
+            e[i] = i % 2 == odd ? 1000.0f : 5.0f;
+        double n[2] = {0, 0}, s[2] = {0, 0}, s2[2] = {0, 0}; /* bright pixels beside a dim 0, beside the rest */
+        for (int f = 0; f < 8; f++) {
+            nc_camsys_digitise(&cs, e, 0.0, 200 + (uint64_t)f, a);
+            for (int i = 0; i < W * H; i += 2) {
+                const int bright = i + odd, dim = i + 1 - odd, k = a[dim] != 0;
+                const double d = a[bright] - 1000.0;
+                n[k]++, s[k] += d, s2[k] += d * d;
+            }
+        }
+        const double var0 = s2[0] / n[0] - (s[0] / n[0]) * (s[0] / n[0]), var1 = s2[1] / n[1];
+        printf("shot noise, bright %s beside dim: beside a 0 (%.0f pairs) mean %+.2f e-, variance %.0f; beside the "
+               "rest variance %.0f (Poisson 1000)\n", odd ? "odd" : "even", n[0], s[0] / n[0], var0, var1);
+        CHECK(fabs(var0 / 1000 - 1) < 0.15 && fabs(var1 / 1000 - 1) < 0.02 && fabs(s[0] / n[0]) < 4 * sqrt(1000 / n[0]),
+              "bright pixels beside dim ones: variance %.0f beside a 0, %.0f else, mean %+.2f e- beside a 0", var0,
+              var1, s[0] / n[0]);
+    }
+    nc_camsys_free(&cs);
+}
+
+/* Non-square pixels (a SUM file's camera with |K11| != |K22|): a pixel is
+ * f / fx wide and f / fy tall, its signal in proportion to its area. */
+static void pixel_area(void)
+{
+    struct nc_camera g;
+    struct nc_camsys sq, tall = {0};
+    load(NULL, 0, &g, &sq);
+    struct nc_cfg cfg;
+    nc_cfg_init(&cfg);
+    struct nc_camera g2 = g; /* as a SUM file's camera with K22 = K11 / 2 makes it */
+    g2.fy_px = g.fx_px / 2;
+    CHECK(nc_cfg_load_string(&cfg, camera_yaml, "camera_yaml") == 0 &&
+              nc_camsys_from_config(cfg.root, &g2, g.focal_length_m, &tall) == 0,
+          "non-square pixels: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
+    const double ratio = tall.response ? tall.response[W * H / 2] / sq.response[W * H / 2] : 0;
+    printf("pixels twice as tall as wide: %.6f times the signal of square ones\n", ratio);
+    CHECK(fabs(ratio - 2) < 1e-9, "a pixel f/fx wide and f/fy tall (fy = fx / 2): %.9f times the signal, want 2",
+          ratio);
+    nc_camsys_free(&sq);
+    nc_camsys_free(&tall);
+}
+
 /* Cosmic rays: the number of tracks follows rate x area x exposure. */
 static void cosmic_ray_rate(void)
 {
@@ -339,6 +420,8 @@ int main(void)
     photon_transfer();
     radiometry();
     shot_noise_statistics();
+    shot_noise_of_neighbours();
+    pixel_area();
     robustness();
     return nc_test_end();
 }

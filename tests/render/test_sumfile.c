@@ -4,7 +4,8 @@
  * MMFL, K-MATRIX and CTR; the rendered geometry at that pixel must be that
  * point. For a normal and a mirrored (K22 < 0) pixel grid, with bodies[0]
  * turned in the scene frame; plus the parser's and the scene's errors.
- * And SPC's ICQ shape format: a sphere written face by face with the
+ * The camera model's vignetting peaks at the stored principal point with
+ * either grid. And SPC's ICQ shape format: a sphere written face by face with the
  * documented axes loads closed, outward and of the right size. */
 #include <math.h>
 #include <stdio.h>
@@ -13,6 +14,7 @@
 
 #include "camera/shot.h"
 #include "core/error.h"
+#include "render/image_io.h"
 #include "core/sumfile.h"
 #include "testutil.h"
 
@@ -274,9 +276,73 @@ static void check_icq(void)
           "bad ICQ: %s", nc_errmsg());
 }
 
+/* The optics act where the light falls: with a mirrored pixel grid (K22 < 0)
+ * the cos^4 vignetting still peaks at the principal point of the stored
+ * image (it peaked at the rows mirrored: 0.465 of the peak at the principal
+ * point); electrons over radiance down the principal point's column, a 3 km
+ * sphere filling a 256x256 frame of fx 200 px, principal point line 60.5. */
+static void vignetting_where_stored(double k22_sign)
+{
+    const double cam_km[3] = {4, -2, 1};
+    struct nc_sumfile sum;
+    make_sum(&sum, cam_km, k22_sign);
+    sum.nln = 256;
+    sum.ctr[0] = 128.5;
+    sum.ctr[1] = 60.5;
+    sum.k[0] = 10;
+    sum.k[4] = k22_sign * 10;
+    char sumpath[4096], cfg[4096], set[4200], out[2][4096];
+    snprintf(sumpath, sizeof sumpath, "%s", nc_test_path("vignette.SUM"));
+    snprintf(cfg, sizeof cfg, "%s", nc_test_path("vignette.yaml"));
+    CHECK(nc_sumfile_write(sumpath, &sum) == 0, "write %s", sumpath);
+    nc_test_write(cfg, "bodies:\n  - shape: {type: sphere, radius_m: 3000}\n    material: {model: lambert, A: 0.2}\n"
+                       "sun: {distance_au: 1.0}\nrender: {samples_per_pixel: 1}\nsensor: {qe: 1}\n"
+                       "optics: {vignetting: cos4}\n");
+    snprintf(set, sizeof set, "camera={sumfile: '%s'}", sumpath);
+    const char *sets[] = {set};
+    struct nc_scene s;
+    struct nc_camsys cs;
+    struct nc_sky sky;
+    struct nc_renderer r;
+    struct nc_shot_info info;
+    float *px[2] = {NULL, NULL};
+    int w = 0, h = 0;
+    if (nc_shot_setup(cfg, sets, 1, &s, &cs, &sky) < 0 || nc_renderer_init(&r, &s, 2) < 0) {
+        CHECK(0, "vignetting scene: %s", nc_errmsg());
+        return;
+    }
+    for (int k = 0; k < 2; k++) {
+        snprintf(out[k], sizeof out[k], "%s", nc_test_path(k ? "vignette_e.fits" : "vignette_r.fits"));
+        CHECK(nc_shot(&r, &s, &cs, &sky, k ? NC_Q_ELECTRONS : NC_Q_RADIANCE, 0.01, 0, 0, out[k], NULL, 0, &info) == 0 &&
+                  nc_image_read(out[k], &px[k], &w, &h) == 0 && w == 256 && h == 256,
+              "vignetting: %s: %s", out[k], nc_errmsg());
+    }
+    int peak = -1;
+    double best = 0, at_pp = 0;
+    for (int y = 0; px[0] && px[1] && y < h; y++) {
+        const double q = px[1][(size_t)y * (size_t)w + 128] / (double)px[0][(size_t)y * (size_t)w + 128];
+        if (q > best)
+            best = q, peak = y;
+        if (y == 59 || y == 60)
+            at_pp = fmax(at_pp, q);
+    }
+    printf("K22 %+g: electrons / radiance down column 128 peak at stored row %d (principal point 59.5); there %.4f "
+           "of the peak\n", k22_sign, peak, at_pp / best);
+    CHECK(abs(peak - 59) <= 1 && at_pp / best > 0.999, "K22 %+g: vignetting peaks at row %d, not the principal point",
+          k22_sign, peak);
+    free(px[0]);
+    free(px[1]);
+    nc_renderer_free(&r);
+    nc_sky_free(&sky);
+    nc_camsys_free(&cs);
+    nc_scene_free(&s);
+}
+
 int main(void)
 {
     check_icq();
+    vignetting_where_stored(1);
+    vignetting_where_stored(-1);
     check_view(1, "[1, 0, 0, 0]");
     check_view(-1, "[0.9238795, 0.2209424, 0.1104712, 0.2946]");
     check_view(1, "[0.5, 0.5, 0.5, 0.5]");
