@@ -263,6 +263,20 @@ static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const ch
     else
         rc = convert(cfg, &doc, root, origin, with_line, 0, &left, out);
     yaml_document_delete(&doc);
+    /* One document: a second one ('---', after a '...' or not) would be
+     * dropped unseen, its keys neither read nor refused. */
+    yaml_document_t more;
+    if (rc >= 0 && root && yaml_parser_load(&parser, &more)) {
+        yaml_node_t *r2 = yaml_document_get_root_node(&more);
+        if (r2) {
+            char at[16];
+            rc = nc_error(NC_ECONFIG, "%s%s: a second YAML document ('---'): one document a file (merge its keys "
+                          "into the first)", origin, at_line(at, with_line ? (int)r2->start_mark.line + 1 : 0));
+            node_free(*out);
+            *out = NULL;
+        }
+        yaml_document_delete(&more);
+    }
     yaml_parser_delete(&parser);
     return rc;
 }
@@ -304,8 +318,17 @@ int nc_cfg_load_file(struct nc_cfg *cfg, const char *path)
             rc = nc_error(-ENOMEM, "%s: out of memory", path);
             break;
         }
-        memcpy(buf + len, ln.line, ln.len + 1);
-        len += ln.len;
+        /* the line's end as LF alone: libyaml counts each CR of a CR CR LF as a line break of its own */
+        size_t n = ln.len;
+        const int lf = n > 0 && ln.line[n - 1] == '\n';
+        n -= (size_t)lf;
+        while (n > 0 && ln.line[n - 1] == '\r')
+            n--;
+        memcpy(buf + len, ln.line, n);
+        len += n;
+        if (lf)
+            buf[len++] = '\n';
+        buf[len] = '\0';
     }
     nc_lines_free(&ln);
     fclose(f);
@@ -493,6 +516,10 @@ int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)
                 node_free(value);
                 return nc_error(-ENOMEM, "out of memory");
             }
+            return 0;
+        }
+        if (!child && nc__cfg_is_null(value)) { /* nothing to take out: no parents made for it */
+            node_free(value);
             return 0;
         }
         if (!child) {

@@ -82,10 +82,13 @@ static int scalar_double(struct nc_cfg_node *n, double *out)
     if (!strcasecmp(t, ".nan") || !strcasecmp(t, ".inf"))
         return nc_cfg_error(n, "expected a finite number, got \"%s\"", n->value);
     double v = strtod(n->value, &end);
+    const char *digits = n->value + strspn(n->value, " ");
+    const int decimal = strspn(digits, "0123456789+-.eE") == (size_t)(end - digits); /* not 0x1p1, inf, nan */
     while (*end == ' ')
         end++;
-    if (end == n->value || *end)
-        return nc_cfg_error(n, "expected a number, got \"%s\"", n->value);
+    if (end == n->value || *end || !decimal)
+        return nc_cfg_error(n, "expected a number, got \"%s\"%s", n->value,
+                            strpbrk(n->value, "xX") ? " (decimal digits: no hexadecimal)" : "");
     if (errno == ERANGE)
         return nc_cfg_error(n, "expected a number, got \"%s\", beyond a double's range (%s)", n->value,
                             fabs(v) > 1 ? "at most 1.8e308" : "at least 2.2e-308 in magnitude, or 0");

@@ -293,6 +293,8 @@ for c in "t_s,qx,$named|bad.csv:1: header column 2, 'qx', is not a column" \
 done
 # a number run into letters, an empty field, semicolons, no rows: each named for what it is
 for c in "0,1,2,3x,1,0,0,0,0,1,0|bad.csv:1: column 4 (cam_z_m): '3x' is not a number" \
+         "0x10,1,2,3,1,0,0,0,0,1,0|bad.csv:1: column 1 (t_s): '0x10' is not a number" \
+         "0,nan,2,3,1,0,0,0,0,1,0|bad.csv:1: column 2 (cam_x_m): 'nan' is not a number" \
          "0,1,,3,1,0,0,0,0,1,0|bad.csv:1: column 3 (cam_y_m) is empty" \
          "0;1;2;3;1;0;0;0;0;1;0|(columns are separated by commas)" "t_s,cam_x_m|bad.csv: no poses"; do
   printf '%s\n' "${c%%|*}" > bad.csv

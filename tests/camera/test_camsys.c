@@ -337,7 +337,8 @@ static void shot_noise_statistics(void)
  * or a bias of +40 e-). Both orders of the pair. */
 static void shot_noise_of_neighbours(void)
 {
-    const char *sets[] = {"sensor={qe: 1, read_noise_e: 0, gain_e_per_dn: 1, full_well_e: 60000, adc_bits: 16, seed: 3}"};
+    const char *sets[] = {
+        "sensor={qe: 1, read_noise_e: 0, gain_e_per_dn: 1, full_well_e: 60000, adc_bits: 16, seed: 3}"};
     struct nc_camera g;
     struct nc_camsys cs;
     load(sets, 1, &g, &cs);

@@ -88,6 +88,40 @@ int main(void)
         expect_error("a key set to \"null\" quoted", NULL, NULL, quoted, 1, "camera.width_px: expected a whole number, "
                      "got \"null\"", NULL);
     }
+    expect_error("hexadecimal", "  pixel_pitch_m: 1e-5\n", "  pixel_pitch_m: 0x1p-17\n", NULL, 0,
+                 "test.yaml:10: camera.pixel_pitch_m", "got \"0x1p-17\" (decimal digits: no hexadecimal)");
+    /* One YAML document a file: a second one was dropped unseen, its keys neither read nor refused. */
+    expect_error("a second YAML document", NULL, "---\ncamera:\n  width_px: 16\n", NULL, 0, "test.yaml:14",
+                 "a second YAML document ('---'): one document a file");
+    expect_error("a second document after '...'", NULL, "...\n---\nrender: {samples_per_pixel: 3}\n", NULL, 0,
+                 "test.yaml:15", "a second YAML document");
+    { /* KEY=null where nothing is: nothing to take out, and no parents made for it (an empty `stars:` was made,
+       * and a second body: "bodies[1].shape: missing required key") */
+        const char *sets[] = {"stars.magnitude_limit=null", "bodies.1.name=null", "optics.psf.sigma_px=null"};
+        struct nc_scene t;
+        const int rc = nc_test_scene_rc(base, sets, 3, &t);
+        CHECK(rc == 0 && t.nbodies == 1, "null where nothing is: %s", rc < 0 ? nc_errmsg() : "a body more");
+        if (rc == 0)
+            nc_scene_free(&t);
+    }
+    { /* CR CR LF line ends (CR LF converted twice): errors name the line, not twice its number */
+        char crcr[4096];
+        size_t n = 0;
+        for (const char *c = base; *c && n + 4 < sizeof crcr; c++)
+            n += (size_t)snprintf(crcr + n, sizeof crcr - n, "%s", *c == '\n' ? "\r\r\n" : (char[2]){*c, 0});
+        char *w = strstr(crcr, "width_px: 64");
+        if (w)
+            memcpy(w + 10, "6x", 2);
+        const char *path = nc_test_path("crcr.yaml");
+        nc_test_write(path, crcr);
+        struct nc_cfg cfg;
+        struct nc_scene t;
+        nc_cfg_init(&cfg);
+        CHECK(w && nc_cfg_load_file(&cfg, path) == 0 && nc_scene_read(&cfg, &t) < 0 &&
+                  nc_test_contains(nc_errmsg(), "crcr.yaml:7: camera.width_px"),
+              "CR CR LF: '%s'", nc_errmsg());
+        nc_cfg_free(&cfg);
+    }
     { /* an albedo map's image is read with the body's build: a mistake in a
        * later body's keys is reported first */
         const char *sets[] = {"bodies.0.material.albedo_map={file: missing.fits}",
