@@ -57,7 +57,7 @@ static int LIBUSB_CALL on_hotplug(libusb_context *ctx, libusb_device *dev, libus
     } else if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT && dev == u->retry) {
         libusb_unref_device(u->retry); /* the transfer error was its unplugging: it comes back as an arrival */
         u->retry = NULL;
-    } else if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED) { /* looked at by the event loop: no I/O in a hot-plug callback */
+    } else if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED) { /* the event loop looks at it: no I/O in a callback */
         if (u->narrived == NC__USB_N_ARRIVED) {
             libusb_unref_device(u->arrived[0]);
             memmove(u->arrived, u->arrived + 1, sizeof u->arrived[0] * --u->narrived);
@@ -187,9 +187,11 @@ static void *usb_thread(void *arg)
             }
             pthread_mutex_unlock(&u->lock);
             if (rc < 0 && (!from_retry || first_failure))
-                nc_log_error(LOG, "%s%s", nc_errmsg(), from_retry ? " (trying again, less often, up to every 10 s)" : "");
+                nc_log_error(LOG, "%s%s", nc_errmsg(),
+                             from_retry ? " (trying again, less often, up to every 10 s)" : "");
             else if (rc > 0 && was_away)
-                nc_log_info(LOG, "adapter %s reopened after %.1f s", u->desc, (nc_mono_ns() - u->unplugged_at_ns) * 1e-9);
+                nc_log_info(LOG, "adapter %s reopened after %.1f s", u->desc,
+                            (nc_mono_ns() - u->unplugged_at_ns) * 1e-9);
             libusb_unref_device(arrived);
             continue;
         }

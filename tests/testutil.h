@@ -37,6 +37,8 @@ void nc_test_write_bytes(const char *path, const void *data, size_t len);
 /* The bytes of a file (NUL-terminated, malloc'd; its length in *len), or
  * NULL if it cannot be read. */
 char *nc_test_read(const char *path, size_t *len);
+/* CPU seconds process pid has used so far (user and system, /proc); -1 if unknown. */
+double nc_test_cpu_s(int pid);
 /* Scene from YAML text plus overrides; aborts the test on error. */
 void nc_test_scene(const char *yaml, const char *const *sets, int nsets, struct nc_scene *s);
 /* Load YAML text + sets; returns the error code and leaves nc_errmsg(). */

@@ -269,23 +269,6 @@ static void test_errors(void)
     CHECK(stop(first) == 0, "first serve did not exit cleanly");
 }
 
-/* CPU seconds process pid has used (user and system). */
-static double cpu_s(pid_t pid)
-{
-    char path[64], buf[1024];
-    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
-    FILE *f = fopen(path, "r");
-    size_t n = f ? fread(buf, 1, sizeof buf - 1, f) : 0;
-    if (f)
-        fclose(f);
-    buf[n] = 0;
-    const char *p = strrchr(buf, ')'); /* fields 14 and 15 after the command's name */
-    unsigned long ut = 0, st = 0;
-    if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &ut, &st) != 2)
-        return -1;
-    return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
-}
-
 /* Until register reg reads v (up to s seconds); 1 when it did. */
 static int reads(ArvDevice *d, guint32 reg, guint32 v, double s)
 {
@@ -315,13 +298,13 @@ static void test_slow_poll(void)
     const int streaming = start(c, &st) == 0;
     arv_device_write_register(d, 0x130, 100, NULL);
     const int undone = reads(d, 0x130, 0, 2.5); /* a check has just run */
-    const double cpu0 = cpu_s(pid), t0 = now_s();
+    const double cpu0 = nc_test_cpu_s(pid), t0 = now_s();
     arv_device_write_register(d, 0x130, 100, NULL);
     usleep(500000);
     guint32 ox = 0;
     arv_device_read_register(d, 0x130, &ox, NULL);
     const int again = reads(d, 0x130, 0, 1.5);
-    const double cpu = cpu_s(pid) - cpu0, wall = now_s() - t0;
+    const double cpu = nc_test_cpu_s(pid) - cpu0, wall = now_s() - t0;
     printf("poll_hz 1: OffsetX 100 undone %d, stood %.2f s (%u after 0.5 s); serve used %.2f s of CPU in it\n",
            undone && again, wall, ox, cpu);
     CHECK(undone && again && ox == 100 && wall > 0.5,

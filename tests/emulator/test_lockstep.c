@@ -323,23 +323,6 @@ static void clients_take_turns(void)
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
 }
 
-/* CPU seconds process pid has used (user and system). */
-static double cpu_s(pid_t pid)
-{
-    char path[64], buf[1024];
-    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
-    FILE *f = fopen(path, "r");
-    size_t n = f ? fread(buf, 1, sizeof buf - 1, f) : 0;
-    if (f)
-        fclose(f);
-    buf[n] = 0;
-    const char *p = strrchr(buf, ')'); /* fields 14 and 15 after the command's name */
-    unsigned long ut = 0, st = 0;
-    if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %lu %lu", &ut, &st) != 2)
-        return -1;
-    return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
-}
-
 /* A client that hangs up with the queue full and its buffer full of
  * requests: the network thread waits as before (poll reported the hang-up
  * at once, again and again, and it spun a core until the queue took one:
@@ -355,9 +338,9 @@ static void hang_up_with_a_full_queue(void)
     usleep(300000);
     nc_client_close(c);
     usleep(100000);
-    const double c0 = cpu_s(pid), t0 = now_s();
+    const double c0 = nc_test_cpu_s(pid), t0 = now_s();
     usleep(1000000);
-    const double cpu = cpu_s(pid) - c0, wall = now_s() - t0;
+    const double cpu = nc_test_cpu_s(pid) - c0, wall = now_s() - t0;
     printf("a client hung up with the queue full: serve used %.2f s of CPU in %.2f s (one render thread)\n", cpu,
            wall);
     CHECK(c0 >= 0 && cpu < 1.5 * wall, "hang-up: serve used %.2f s of CPU in %.2f s with one render thread", cpu,
