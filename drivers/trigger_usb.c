@@ -96,24 +96,25 @@ static void session_ended(struct nc__usb_trig *u, int error)
     pthread_mutex_unlock(&u->lock);
 }
 
-/* The verdict on a session a transfer error ended, once known: the adapter
- * left (an unplug), or it is still there at the time to open it again (a
- * session error). Lock held; returns the line to log ("" if none). */
-static const char *verdict(struct nc__usb_trig *u, int64_t now, char *line, size_t len)
+/* The verdict on a session a transfer error ended, counted, into line (""
+ * while it is still open): an unplug when the adapter left (its hot-plug
+ * departure, or gone = 1: no such device when it was opened again), else a
+ * session error once it was opened again (opened = 1) or could not be for
+ * another reason (opened = -1). Lock held. */
+static void verdict(struct nc__usb_trig *u, int gone, int opened, char *line, size_t len)
 {
     line[0] = 0;
-    if (!u->verdict || (u->retry && now < u->retry_at_ns))
-        return line;
-    if (!u->retry)
+    if (!u->verdict || (u->retry && !gone && !opened))
+        return;
+    if (gone || (!u->retry && !opened))
         snprintf(line, len, "adapter %s unplugged (%lu so far); waiting for it to come back", u->desc, ++u->unplugged);
     else
-        snprintf(line, len, "adapter %s: the session ended on a transfer error (%s; %lu so far); opening it again",
-                 u->desc, u->verdict == LIBUSB_TRANSFER_STALL      ? "a stall"
-                          : u->verdict == LIBUSB_TRANSFER_OVERFLOW ? "an overflow"
-                                                                   : "an I/O error",
-                 ++u->session_errors);
+        snprintf(line, len, "adapter %s: the session ended on a transfer error (%s; %lu so far)%s", u->desc,
+                 u->verdict == LIBUSB_TRANSFER_STALL      ? "a stall"
+                 : u->verdict == LIBUSB_TRANSFER_OVERFLOW ? "an overflow"
+                                                          : "an I/O error",
+                 ++u->session_errors, opened > 0 ? "; opened again" : "; opening it again, less often");
     u->verdict = 0;
-    return line;
 }
 
 static void *usb_thread(void *arg)
@@ -125,7 +126,7 @@ static void *usb_thread(void *arg)
         pthread_mutex_lock(&u->lock);
         int gone = u->state != NC__USB_ABSENT && u->gone;
         const int error = gone ? u->session_error : 0;
-        verdict(u, now, said, sizeof said);
+        verdict(u, 0, 0, said, sizeof said); /* it left meanwhile */
         /* Devices plugged in during a session are other devices; once the
          * session is gone, each is a candidate, oldest first; then the
          * adapter a session error left, when its time comes. */
@@ -175,18 +176,23 @@ static void *usb_thread(void *arg)
         if (arrived) {
             int rc = nc__usb_try_open(u, arrived);
             pthread_mutex_lock(&u->lock);
+            const int left = from_retry && rc == -ENODEV; /* unplugged, though udev has not said so yet */
+            if (from_retry)
+                verdict(u, left, rc > 0 ? 1 : -1, said, sizeof said);
             const int was_away = u->unplugged + u->session_errors > u->reopened;
             u->reopened += rc > 0 && was_away;
-            const int first_failure = rc <= 0 && from_retry && u->retry_failures++ == 0;
+            const int first_failure = rc <= 0 && from_retry && !left && u->retry_failures++ == 0;
             if (rc > 0)
                 u->retry_failures = 0;
-            if (rc <= 0 && from_retry && !u->retry) { /* again later, less often (up to every 10 s) */
+            if (rc <= 0 && from_retry && !left && !u->retry) { /* again later, less often (up to every 10 s) */
                 u->retry = libusb_ref_device(arrived);
                 u->retry_wait_ns = u->retry_wait_ns < 5000000000 ? 2 * u->retry_wait_ns : 10000000000;
                 u->retry_at_ns = nc_mono_ns() + u->retry_wait_ns;
             }
             pthread_mutex_unlock(&u->lock);
-            if (rc < 0 && (!from_retry || first_failure))
+            if (said[0])
+                nc_log_warn(LOG, "%s", said);
+            if (rc < 0 && !left && (!from_retry || first_failure))
                 nc_log_error(LOG, "%s%s", nc_errmsg(),
                              from_retry ? " (trying again, less often, up to every 10 s)" : "");
             else if (rc > 0 && was_away)

@@ -212,6 +212,8 @@ int nc__usb_try_open(struct nc__usb_trig *u, libusb_device *dev)
         return 0;
     libusb_device_handle *h;
     int rc = libusb_open(dev, &h);
+    if (rc == LIBUSB_ERROR_NO_DEVICE)
+        return nc_error(-ENODEV, "usb trigger: adapter %s is gone", u->desc);
     if (rc < 0)
         return nc_error(NC_EUNSUPPORTED, "usb trigger: cannot open adapter %s: %s%s", u->desc, libusb_strerror(rc),
                         rc == LIBUSB_ERROR_ACCESS ? " (install udev/70-navcam-usb-trigger.rules and join group plugdev: "

@@ -79,7 +79,8 @@ int nc__usb_send_msg(struct nc__usb_trig *u, const struct nc_ut_msg *m);
 /* Send a clock exchange's request. Lock held. */
 void nc__usb_send_time_req(struct nc__usb_trig *u);
 /* Open dev if it is the adapter asked for and start a session (HELLO
- * sent): 1 opened, 0 not it, < 0 error (nc_errmsg). Event thread. */
+ * sent): 1 opened, 0 not it, -ENODEV gone (unplugged), < 0 another error
+ * (nc_errmsg). Event thread. */
 int nc__usb_try_open(struct nc__usb_trig *u, libusb_device *dev);
 /* End the session: wait for every transfer, release the adapter. Event thread. */
 void nc__usb_close_session(struct nc__usb_trig *u);

@@ -148,7 +148,7 @@ drecs = records(os.path.join(out, "d/files/frames.jsonl"))
 dlog = open(os.path.join(out, "d/serve.log")).read()
 check(ud["session_errors"] == 1 and ud["unplugged"] == 0 and ud["reopened"] == 1,
       f"D: session_errors {ud['session_errors']}, unplugged {ud['unplugged']}, reopened {ud['reopened']}")
-check("the session ended on a transfer error (a stall; 1 so far); opening it again" in dlog
+check("the session ended on a transfer error (a stall; 1 so far); opened again" in dlog
       and "reopened after" in dlog, "D: the stall and the reopening are reported")
 check(len(drecs) == m1 + m2, f"D: {m1} edges before and {m2} after the stall -> {len(drecs)} frames")
 
