@@ -80,18 +80,41 @@ int nc_cli_threads(const char *s, int *out)
 
 void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const char *path)
 {
-    snprintf(buf, len, "camera={sumfile: '%s'}", path);
+    size_t n = (size_t)snprintf(buf, len, "camera={sumfile: '");
+    for (const char *c = path; *c && n + 4 < len; c++) { /* a quote doubled: YAML's single-quoted scalar */
+        if (*c == '\'')
+            buf[n++] = '\'';
+        buf[n++] = *c;
+    }
+    snprintf(buf + n, len > n ? len - n : 0, "'}");
     memmove(sets + 2, sets, (size_t)*nsets * sizeof *sets);
     sets[0] = buf;
     sets[1] = "sun.direction=null"; /* the SUM file's SZ gives it */
     *nsets += 2;
 }
 
-int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out)
+int nc_cli_decimal(const char *s, const char **end, double *out)
+{
+    char *e;
+    *out = strtod(s, &e);
+    *end = e;
+    const char *digits = s + strspn(s, " \t");
+    return e != s && strspn(digits, "0123456789+-.eE") == (size_t)(e - digits) && isfinite(*out) ? 0 : -1;
+}
+
+int nc_cli_whole(const char *s, unsigned long long *out)
 {
     char *end;
-    const double v = strtod(s, &end);
-    if (end == s || *end || !(v >= lo && v <= hi)) {
+    errno = 0;
+    *out = strtoull(s, &end, 10);
+    return *s >= '0' && *s <= '9' && !*end && !errno ? 0 : -1;
+}
+
+int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out)
+{
+    const char *end;
+    double v;
+    if (nc_cli_decimal(s, &end, &v) < 0 || *end || !(v >= lo && v <= hi)) {
         fprintf(stderr, "%s: --%s expects %g..%g, got '%s'\n", name, opt, lo, hi, s);
         return -1;
     }

@@ -25,6 +25,12 @@ int nc_cli_getopt(int argc, char *const argv[], const char *shortopts, const str
  * "navcam CMD: --opt expects lo..hi, got 's'" on stderr and -1. */
 int nc_cli_long(const char *opt, const char *s, long lo, long hi, long *out);
 int nc_cli_double(const char *opt, const char *s, double lo, double hi, double *out);
+/* A decimal number at the start of s (strtod's, without hexadecimal, inf or
+ * nan): 0 and *out, *end after it; -1 when s does not start with one. */
+int nc_cli_decimal(const char *s, const char **end, double *out);
+/* s whole a whole number 0 .. 2^64 - 1 in decimal digits: 0 and *out; -1
+ * (a sign, an empty value, anything after the digits, too large). */
+int nc_cli_whole(const char *s, unsigned long long *out);
 /* --host: 0 for a numeric IPv4 address; -1 with the option named on stderr
  * for anything else (names are never looked up). */
 int nc_cli_host(const char *s);

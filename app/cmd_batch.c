@@ -260,7 +260,8 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
     fprintf(f, "\"distance_m\": %.17g, \"irradiance_w_m2\": %.17g},\n \"bodies\": [", s->sun.distance_m, irr);
     for (int b = 0; b < s->nbodies; b++) {
         const struct nc_body *bd = &s->body[b];
-        fprintf(f, "{\"name\": \"%s\", ", bd->name);
+        fputc('{', f);
+        nc_cli_json_str(f, "name", bd->name); /* a quote or backslash in it escaped */
         v[0] = bd->position_m.x, v[1] = bd->position_m.y, v[2] = bd->position_m.z;
         nc_cli_json_vec(f, "position_m", v, 3, ", ");
         v[0] = bd->attitude_q.w, v[1] = bd->attitude_q.x, v[2] = bd->attitude_q.y, v[3] = bd->attitude_q.z;
@@ -392,11 +393,8 @@ int main(int argc, char **argv)
             }
             break;
         case 'e':
-            exposure = strtod(optarg, &end);
-            if (*end || !(exposure >= 0 && exposure <= 3600)) {
-                fprintf(stderr, "navcam batch: --exposure expects seconds in 0..3600, got '%s'\n", optarg);
+            if (nc_cli_double("exposure", optarg, 0, 3600, &exposure) < 0)
                 goto usage;
-            }
             break;
         case 'K':
             shard_k = strtol(optarg, &end, 10);

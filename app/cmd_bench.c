@@ -218,15 +218,21 @@ int main(int argc, char **argv)
         return nc_cli_fail();
     o.work_dir = dir;
     nc_log_set_level(NC_LOG_WARN); /* not the scene's notes at every load */
-    char path[4096];
-    snprintf(path, sizeof path, "%s/accuracy.csv", dir);
-    FILE *csv = fopen(path, "w");
-    snprintf(path, sizeof path, "%s/accuracy_front.csv", dir);
-    FILE *front = fopen(path, "w");
-    snprintf(path, sizeof path, "%s/accuracy.gp", dir);
-    FILE *gp = fopen(path, "w");
+    /* Written under temporary names and renamed once every scene is measured: a run that measures nothing or
+     * fails leaves an earlier run's results as they were. */
+    static const char *const made[] = {"accuracy.csv", "accuracy_front.csv", "accuracy.gp"};
+    char path[4096], tmp[3][4200];
+    FILE *out[3];
+    for (int i = 0; i < 3; i++) {
+        snprintf(tmp[i], sizeof tmp[i], "%s/.%s.tmp", dir, made[i]);
+        out[i] = fopen(tmp[i], "w");
+    }
+    FILE *csv = out[0], *front = out[1], *gp = out[2];
     if (!csv || !front || !gp) {
         fprintf(stderr, "navcam bench: cannot write into %s: %s\n", dir, strerror(errno));
+        for (int i = 0; i < 3; i++)
+            if (out[i])
+                fclose(out[i]), unlink(tmp[i]);
         return 1;
     }
     fprintf(csv, "scene,method,spp,bounces,soft_shadows,lod_error_px,boulder_min_px,time_ms,rel_rms,rel_p95,dn_rms,"
@@ -281,20 +287,27 @@ int main(int argc, char **argv)
         nplots++;
     }
     fprintf(gp, "unset multiplot\n");
-    fclose(csv);
-    fclose(front);
-    fclose(gp);
-    if (rc < 0)
-        return nc_cli_fail();
-    if (!nplots) { /* no empty results left behind */
-        static const char *const made[] = {"accuracy.csv", "accuracy_front.csv", "accuracy.gp"};
-        for (int i = 0; i < 3; i++) {
-            snprintf(path, sizeof path, "%s/%s", dir, made[i]);
-            unlink(path);
-        }
-        fprintf(stderr, "navcam bench: every scene asked for was skipped: nothing measured, no chart\n");
+    int written = 1;
+    for (int i = 0; i < 3; i++)
+        written &= !ferror(out[i]) & (fclose(out[i]) == 0);
+    if (rc < 0 || !nplots || !written) { /* nothing half-made left behind, nothing earlier lost */
+        for (int i = 0; i < 3; i++)
+            unlink(tmp[i]);
+        if (rc < 0)
+            return nc_cli_fail();
+        fprintf(stderr, "navcam bench: %s\n", !written ? "cannot write the results (a full disk?)"
+                                                      : "every scene asked for was skipped: nothing measured, no chart");
         return 1;
     }
+    for (int i = 0; i < 3; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, made[i]);
+        if (rename(tmp[i], path) < 0) {
+            fprintf(stderr, "navcam bench: %s: %s\n", path, strerror(errno));
+            return 1;
+        }
+    }
+    snprintf(path, sizeof path, "%s/accuracy.png", dir);
+    unlink(path); /* an earlier run's chart does not stand beside these results */
     if (nc_cli_gnuplot(dir, "accuracy.gp") != 0)
         printf("no chart: gnuplot failed or is missing (Debian: gnuplot-nox); %s/accuracy.gp draws it\n", dir);
     else

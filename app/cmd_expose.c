@@ -16,6 +16,7 @@
 #include "camera/camsys.h"
 #include "camera/load.h"
 #include "core/error.h"
+#include "core/version.h"
 #include "render/image_io.h"
 
 static const char expose_help[] =
@@ -60,18 +61,21 @@ int main(int argc, char **argv)
     };
     const char *out = NULL, *cam_path = NULL, *rows = NULL;
     const char **sets = calloc((size_t)argc + 1, sizeof *sets);
-    double L = -1, T = -1, nframes = 1, first = 0;
+    double L = -1, T = -1, nframes = 1;
+    uint64_t first = 0;
     int nsets = 0, dark = 0, c, rc = 2;
     if (!sets)
         return 1;
     optind = 1;
     while ((c = nc_cli_getopt(argc, argv, "L:e:n:do:s:h", opts)) != -1) {
-        char *end;
+        const char *end = "";
         double v = 0;
+        unsigned long long whole = 0;
         if (c == 'L' || c == 'e' || c == 'n' || c == 'F') {
-            v = strtod(optarg, &end);
-            if (*end || !isfinite(v) || v < 0 || ((c == 'n' || c == 'F') && v != floor(v)) ||
-                (c == 'n' && (v < 1 || v > 100000)) || (c == 'e' && v > 3600)) {
+            const int bad = c == 'n' || c == 'F' ? nc_cli_whole(optarg, &whole) : nc_cli_decimal(optarg, &end, &v);
+            if (c == 'n' || c == 'F')
+                v = (double)whole;
+            if (bad || *end || v < 0 || (c == 'n' && (whole < 1 || whole > 100000)) || (c == 'e' && v > 3600)) {
                 fprintf(stderr, "navcam expose: bad value '%s' for --%s (%s)\n", optarg,
                         c == 'L' ? "radiance" : c == 'e' ? "exposure" : c == 'n' ? "frames" : "first-frame",
                         c == 'L'   ? "W m^-2 sr^-1, 0 or more"
@@ -85,7 +89,7 @@ int main(int argc, char **argv)
         case 'L': L = v; break;
         case 'e': T = v; break;
         case 'n': nframes = v; break;
-        case 'F': first = v; break;
+        case 'F': first = whole; break;
         case 'd': dark = 1; break;
         case 'o': out = optarg; break;
         case 'R': rows = optarg; break;
@@ -137,18 +141,28 @@ int main(int argc, char **argv)
         rad[i] = (float)L;
     ok = ok && nc_camsys_electrons(&cs, rad, T, e) >= 0;
     int is_fits = nc_image_is_fits(out);
-    struct nc_image_attr attrs[20];
-    char text[16][200], ltxt[64], ntxt[32];
+    struct nc_image_attr attrs[32];
+    char text[16][200], ltxt[64], ntxt[32], sw[64], intr[160];
     snprintf(ltxt, sizeof ltxt, "%.17g", L);
     snprintf(ntxt, sizeof ntxt, "%zu", nf);
+    snprintf(sw, sizeof sw, "NavCam %s", NC_VERSION_STRING);
+    snprintf(intr, sizeof intr, "[%.17g, %.17g, %.17g, %.17g]", geom.fx_px, geom.fy_px, geom.cx_px, geom.cy_px);
+    /* what every image NavCam writes carries (docs/config.md): the maker, the quantity and its units (FITS BUNIT
+     * adu), the camera's intrinsics */
+    const struct nc_image_attr common[] = {{"Software", sw},          {"navcam:version", NC_VERSION_STRING},
+                                           {"navcam:quantity", "dn"}, {"navcam:units", "DN"},
+                                           {"navcam:intrinsics_fx_fy_cx_cy_px", intr}};
+    const int ncommon = (int)(sizeof common / sizeof common[0]);
     for (size_t k = 0; ok && k < nf; k++) {
-        uint64_t fno = (uint64_t)first + k;
+        uint64_t fno = first + (uint64_t)k;
         ok = nc_camsys_digitise(&cs, e, T, fno, dn + k * n) >= 0;
         if (ok && !is_fits) {
             char path[4200];
             const char *dot = strrchr(out, '.');
             snprintf(path, sizeof path, "%.*s_%04llu%s", (int)(dot - out), out, (unsigned long long)fno, dot);
             int na = nc_camsys_meta(&cs, T, fno, attrs, text, 16);
+            for (int i = 0; i < ncommon; i++)
+                attrs[na++] = common[i];
             attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
             ok = nc_image_write_dn(path, dn + k * n, geom.width_px, geom.height_px, cs.sensor.adc_bits, attrs, na) >= 0;
             if (ok)
@@ -156,7 +170,9 @@ int main(int argc, char **argv)
         }
     }
     if (ok && is_fits) {
-        int na = nc_camsys_meta(&cs, T, (uint64_t)first, attrs, text, 16);
+        int na = nc_camsys_meta(&cs, T, first, attrs, text, 16);
+        for (int i = 0; i < ncommon; i++)
+            attrs[na++] = common[i];
         attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
         attrs[na++] = (struct nc_image_attr){"navcam:frames", ntxt};
         if (rows)

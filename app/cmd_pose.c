@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 
 #include "app/cli.h"
@@ -38,15 +39,16 @@ static const char pose_help[] =
  * NaN or infinity among them. */
 static int parse_vec(const char *s, double *v, int n, const char **why)
 {
-    char *end;
+    const char *end = s;
     for (int i = 0; i < n; i++) {
-        v[i] = strtod(s, &end);
-        if (end == s)
-            return -1;
-        if (!isfinite(v[i])) {
-            *why = "not finite";
+        if (nc_cli_decimal(s, &end, &v[i]) < 0) {
+            const char *t = s + strspn(s, " \t+-");
+            if (!strncasecmp(t, "inf", 3) || !strncasecmp(t, "nan", 3))
+                *why = "not finite";
             return -1;
         }
+        if (i + 1 < n && *end != ',') /* components separated by commas */
+            return -1;
         s = end + (*end == ',');
     }
     return *end ? -1 : 0;

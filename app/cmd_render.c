@@ -101,21 +101,19 @@ int main(int argc, char **argv)
             nc_cli_sumfile(sets, &nsets, sumset, sizeof sumset, optarg);
             break;
         case 'e':
-        case 'f': {
-            char *end;
-            double v = strtod(optarg, &end);
-            if (*end || !(v >= 0) || !isfinite(v) || (c == 'e' && v > 3600) || (c == 'f' && v != floor(v))) {
-                fprintf(stderr, "navcam render: --%s expects %s, got '%s'\n", c == 'e' ? "exposure" : "frame",
-                        c == 'e' ? "seconds in 0..3600" : "a whole number >= 0", optarg);
+            if (nc_cli_double("exposure", optarg, 0, 3600, &exposure) < 0) {
                 free(sets);
                 return 2;
             }
-            if (c == 'e')
-                exposure = v;
-            else
-                frame_no = (unsigned long long)v;
             break;
-        }
+        case 'f':
+            if (nc_cli_whole(optarg, &frame_no) < 0) {
+                fprintf(stderr, "navcam render: --frame expects a whole number 0..18446744073709551615, got '%s'\n",
+                        optarg);
+                free(sets);
+                return 2;
+            }
+            break;
         case 's': sets[nsets++] = optarg; break;
         case 'j':
             if (nc_cli_threads(optarg, &threads) < 0) {

@@ -72,12 +72,11 @@ int main(int argc, char **argv)
     int ch;
     optind = 2;
     while ((ch = nc_cli_getopt(argc, argv, "o:h", opts)) != -1) {
-        char *end;
+        const char *end;
         switch (ch) {
         case 'o': out = optarg; break;
         case 'm':
-            max_mag = strtod(optarg, &end);
-            if (*end || !isfinite(max_mag)) {
+            if (nc_cli_decimal(optarg, &end, &max_mag) < 0 || *end) {
                 fprintf(stderr, "navcam stars: --max-mag: expected a magnitude, got '%s'\n", optarg);
                 return 2;
             }

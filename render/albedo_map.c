@@ -19,6 +19,11 @@ static int load(const char *path, double lon_left_deg, int east, double scale, i
     if (!m)
         return nc_error(-ENOMEM, "out of memory");
     int rc = nc_image_read(path, &m->value, &m->width_px, &m->height_px);
+    if (rc >= 0 && (m->width_px < 1 || m->height_px < 1)) { /* sampled with a wrap and a clamp: a pixel at least */
+        const int w = m->width_px, h = m->height_px;
+        nc_albedo_map_free(m);
+        return nc_error(NC_EIMAGE, "%s: %dx%d pixels: an empty map", path, w, h);
+    }
     if (rc < 0) {
         free(m);
         return rc;

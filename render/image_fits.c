@@ -233,6 +233,10 @@ int nc__fits_read(const char *path, float **px, int *w, int *h)
                             planes != 1 ? ", more than one plane" : "");
         return nc_error(NC_EIMAGE, "%s: ROWORDER '%s': expected 'TOP-DOWN' or 'BOTTOM-UP'", path, order);
     }
+    if (naxes[0] < 1 || naxes[1] < 1) {
+        fits_close_file(f, &status);
+        return nc_error(NC_EIMAGE, "%s: %ldx%ld pixels: an empty image", path, naxes[0], naxes[1]);
+    }
     size_t n = (size_t)naxes[0] * (size_t)naxes[1];
     float *buf = malloc((n ? n : 1) * sizeof *buf);
     double *row = malloc((naxes[0] ? (size_t)naxes[0] : 1) * sizeof *row);

@@ -344,7 +344,12 @@ int nc_mesh_load_ply(const char *path, double scale, struct nc_mesh *out)
                     if ((rc = ply_read(&r, pr->type, &val)) < 0)
                         goto out;
                     if (is_f && p == ilist) {
-                        if (!have_v || val < 0 || val >= (double)m.nv || val != floor(val)) {
+                        if (!have_v) {
+                            rc = nc_error(NC_EMESH, "%s: a face before the vertex element: NavCam reads PLY files "
+                                          "with the vertices first", where(&r));
+                            goto out;
+                        }
+                        if (val < 0 || val >= (double)m.nv || val != floor(val)) {
                             rc = nc_error(NC_EMESH, "%s: vertex index %g out of range (%zu vertices, counted from 0)%s",
                                           where(&r), val, m.nv, r.fmt == PLY_ASCII ? "" : "; is the byte order right?");
                             goto out;

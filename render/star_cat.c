@@ -233,10 +233,11 @@ void nc_star_cat_free(struct nc_star_cat *c)
 
 size_t nc_star_cat_count_to(const struct nc_star_cat *c, double v_mag)
 {
-    size_t lo = 0, hi = c->n; /* first star fainter than v_mag */
+    const float lim = (float)v_mag; /* the catalogue's magnitudes are floats: 6.3 is 6.3000002 there */
+    size_t lo = 0, hi = c->n;        /* first star fainter than lim */
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
-        if (c->star[mid].v_mag <= v_mag)
+        if (c->star[mid].v_mag <= lim)
             lo = mid + 1;
         else
             hi = mid;

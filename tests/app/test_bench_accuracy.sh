@@ -6,7 +6,8 @@
 # crater at low Sun and none for the convex sphere, samples for the
 # sphere's limb (its pilots sample the whole pixel) with a DN error under
 # the camera's noise, every rock where the boulder cut's bias shows, and
-# gnuplot draws the chart.
+# gnuplot draws the chart; a run that measures nothing leaves the results
+# of the one before as they were.
 # Usage: test_bench_accuracy.sh NAVCAM TMPDIR
 set -u
 navcam=$1
@@ -64,3 +65,14 @@ for f in fail:
 print("%d rows checked, %d failures" % (len(rows), len(fail)))
 sys.exit(1 if fail else 0)
 PY
+[ $? -eq 0 ] || exit 1
+# A run that measures nothing (its shape files missing) leaves the results
+# above as they were (it deleted them), and no temporary.
+sum_before=$(cat "$tmp/out/accuracy.csv" "$tmp/out/accuracy_front.csv" | md5sum)
+if "$navcam" bench accuracy -o "$tmp/out" --scene bennu --shapes /nonexistent > "$tmp/log2" 2>&1; then
+  echo "FAIL: bench accuracy with every scene skipped exited 0" >&2; exit 1
+fi
+[ "$(cat "$tmp/out/accuracy.csv" "$tmp/out/accuracy_front.csv" | md5sum)" = "$sum_before" ] &&
+  [ -z "$(ls -A "$tmp/out" | grep '\.tmp$')" ] ||
+  { echo "FAIL: a run that measured nothing changed the results: $(ls -A "$tmp/out")" >&2; exit 1; }
+echo "a run that measured nothing left the results as they were"

@@ -296,6 +296,24 @@ cam="$tmp/cam.yaml"
 printf 'camera: {width_px: 64, height_px: 48, focal_length_m: 0.02, pixel_pitch_m: 1.0e-5}\noptics: {f_number: 4}\nsensor: {read_noise_e: 5, full_well_e: 10000, gain_e_per_dn: 2, bias_dn: 20, adc_bits: 12}\n' > "$cam"
 expect 0 "wrote $tmp/flat.fits: 4 frames of 64x48, 12-bit" -- "$navcam" expose "$cam" -L 3 -e 0.001 -n 4 -o "$tmp/flat.fits"
 expect 0 "wrote $tmp/dark_0005.png" -- "$navcam" expose "$cam" --dark -e 0.5 -n 2 --first-frame 4 -o "$tmp/dark.png"
+# what every image carries (docs/config.md): the maker, the quantity and its units, the intrinsics
+for k in "CREATOR = 'NavCam" "QUANTITY= 'dn" "BUNIT   = 'adu" "INTRINS = '\[" "FRAME   =                    0"; do
+  grep -aq "$k" "$tmp/flat.fits" && ok || bad "navcam expose's FITS header lacks $k"
+done
+# numbers on the command line: decimal digits, a value given, a frame number as typed (-f 1e30 was frame 0)
+expect 2 "--frame expects a whole number" -- "$navcam" render -o "$tmp/x.fits" -f 1e30
+expect 2 "--frame expects a whole number" -- "$navcam" render -o "$tmp/x.fits" -f -1
+expect 2 "--exposure expects 0..3600, got ''" -- "$navcam" render -o "$tmp/x.fits" -e ''
+expect 2 "--exposure expects 0..3600, got '0x10'" -- "$navcam" render -o "$tmp/x.fits" -e 0x10
+expect 2 "bad value '' for --radiance" -- "$navcam" expose "$cam" -L '' -o "$tmp/x.fits"
+expect 2 "bad value '1e30' for --first-frame" -- "$navcam" expose "$cam" -L 1 --first-frame 1e30 -o "$tmp/x.fits"
+# a body's name with a quote and a backslash: the dataset's JSON stays JSON
+"$navcam" batch builtin:approach -o "$tmp/bq" --shard 0/8 --no-geometry "${small[@]}" \
+  --set 'bodies.0.name=rock "A"\1' > /dev/null 2>&1 &&
+  python3 -c "import json, sys; assert json.load(open(sys.argv[1]))['bodies'][0]['name'] == 'rock \"A\"\\\\1'" \
+  "$tmp/bq/frame_000000.json" && ok || bad "batch JSON with a quoted body name: $(head -c 300 "$tmp/bq/frame_000000.json")"
+# a SUM file's path with a quote in it: the file named, not a YAML error about an option never typed
+expect 1 "it's.SUM: No such file or directory" -- "$navcam" render -o "$tmp/s.fits" --sumfile "$tmp/it's.SUM"
 [ -s "$tmp/dark_0004.png" ] && ok || bad "dark_0004.png not written"
 # Same command, same frames: bit for bit.
 "$navcam" expose "$cam" -L 3 -e 0.001 -n 4 -o "$tmp/flat2.fits" >/dev/null
@@ -373,6 +391,15 @@ odd="$tmp/cmp'; touch $tmp/injected; '"
 "$navcam" compare "$tmp/real.fits" "$tmp/moved.fits" -o "$odd" > /dev/null 2>&1 && [ -s "$odd/relative_error.png" ] &&
   [ ! -e "$tmp/injected" ] && [ ! -e "$odd/.compare.gp" ] && ok ||
   bad "navcam compare -o with a quote in the name: $(ls -a "$odd" 2>&1)"
+# gnuplot failing (a stand-in that exits 1): a warning, no plots; the map, the histogram's numbers and the
+# JSON written, no temporaries left
+mkdir -p "$tmp/nognu" && printf '#!/bin/sh\nexit 1\n' > "$tmp/nognu/gnuplot" && chmod +x "$tmp/nognu/gnuplot"
+PATH="$tmp/nognu:$PATH" "$navcam" compare "$tmp/real.fits" "$tmp/moved.fits" -o "$tmp/cmp_nognu" \
+  --json "$tmp/cmp_nognu.json" > /dev/null 2> "$tmp/cmp_nognu.err" && grep -q "no plots: gnuplot failed" \
+  "$tmp/cmp_nognu.err" && [ -s "$tmp/cmp_nognu/relative_error.fits" ] && [ -s "$tmp/cmp_nognu.json" ] &&
+  [ -s "$tmp/cmp_nognu/error_histogram.csv" ] && [ ! -e "$tmp/cmp_nognu/.compare.gp" ] &&
+  [ ! -e "$tmp/cmp_nognu/.relative_error.f32" ] && ok ||
+  bad "navcam compare without gnuplot: $(cat "$tmp/cmp_nognu.err"; ls -A "$tmp/cmp_nognu")"
 "$navcam" render -o "$tmp/other.fits" "${small[@]}" --set camera.width_px=64 > /dev/null 2>&1
 expect 1 "is 96x96 but $tmp/other.fits is 64x96: the images must have the same size" -- \
   "$navcam" compare "$tmp/real.fits" "$tmp/other.fits"

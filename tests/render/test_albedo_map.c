@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "render/albedo_map.h"
 #include "core/error.h"
@@ -89,6 +90,20 @@ int main(void)
     nc_image_write(badp, bad, 2, 2, NULL, 0, NULL);
     CHECK(nc_albedo_map_load(badp, 0, 1, 1, &m) < 0 && nc_test_contains(nc_errmsg(), "negative.exr: pixel (1, 0)"),
           "negative map value: %s", nc_errmsg());
+    { /* a FITS image of 8x0 pixels, header alone: refused (it crashed the render: a division by its 0 width) */
+        char hdr[2880 + 1];
+        const char *cards[] = {"SIMPLE  =                    T", "BITPIX  =                  -32",
+                               "NAXIS   =                    2", "NAXIS1  =                    8",
+                               "NAXIS2  =                    0", "END"};
+        memset(hdr, ' ', 2880);
+        for (int i = 0; i < 6; i++)
+            memcpy(hdr + 80 * i, cards[i], strlen(cards[i]));
+        hdr[2880] = 0;
+        const char *emptyp = nc_test_path("empty.fits");
+        nc_test_write(emptyp, hdr);
+        CHECK(nc_albedo_map_load(emptyp, 0, 1, 1, &m) < 0 && nc_test_contains(nc_errmsg(), "8x0 pixels: an empty image"),
+              "an empty map: %s", nc_errmsg());
+    }
     struct nc_scene s;
     const char *sets[] = {"bodies.0.material.albedo_map.file=/no/such/map.exr"};
     CHECK(nc_test_scene_rc(yaml, sets, 1, &s) < 0 &&
