@@ -295,8 +295,9 @@ int main(int argc, char **argv)
             unlink(tmp[i]);
         if (rc < 0)
             return nc_cli_fail();
-        fprintf(stderr, "navcam bench: %s\n", !written ? "cannot write the results (a full disk?)"
-                                                      : "every scene asked for was skipped: nothing measured, no chart");
+        fprintf(stderr, "navcam bench: %s\n",
+                !written ? "cannot write the results (a full disk?)"
+                         : "every scene asked for was skipped: nothing measured, no chart");
         return 1;
     }
     for (int i = 0; i < 3; i++) {

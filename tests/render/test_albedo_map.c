@@ -101,7 +101,8 @@ int main(void)
         hdr[2880] = 0;
         const char *emptyp = nc_test_path("empty.fits");
         nc_test_write(emptyp, hdr);
-        CHECK(nc_albedo_map_load(emptyp, 0, 1, 1, &m) < 0 && nc_test_contains(nc_errmsg(), "8x0 pixels: an empty image"),
+        CHECK(nc_albedo_map_load(emptyp, 0, 1, 1, &m) < 0 &&
+                  nc_test_contains(nc_errmsg(), "8x0 pixels: an empty image"),
               "an empty map: %s", nc_errmsg());
     }
     struct nc_scene s;
