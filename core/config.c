@@ -11,8 +11,6 @@
 #include <yaml.h>
 
 #include "core/error.h"
-#include "core/grow.h"
-#include "core/lines.h"
 
 static void node_free(struct nc_cfg_node *n)
 {
@@ -301,41 +299,6 @@ int nc_cfg_load_string(struct nc_cfg *cfg, const char *text, const char *origin)
     node_free(cfg->root);
     cfg->root = root;
     return 0;
-}
-
-int nc_cfg_load_file(struct nc_cfg *cfg, const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return nc_error(-errno, "%s: cannot open: %s", path, strerror(errno));
-    struct nc_lines ln; /* a NUL byte named by its line and column */
-    nc_lines_init(&ln, f, path, NC_ECONFIG);
-    char *buf = NULL;
-    size_t len = 0, cap = 0;
-    int rc;
-    while ((rc = nc_lines_next(&ln)) > 0) {
-        if (nc_grow((void **)&buf, &cap, len + ln.len + 1, 1) < 0) {
-            rc = nc_error(-ENOMEM, "%s: out of memory", path);
-            break;
-        }
-        /* the line's end as LF alone: libyaml counts each CR of a CR CR LF as a line break of its own */
-        size_t n = ln.len;
-        const int lf = n > 0 && ln.line[n - 1] == '\n';
-        n -= (size_t)lf;
-        while (n > 0 && ln.line[n - 1] == '\r')
-            n--;
-        memcpy(buf + len, ln.line, n);
-        len += n;
-        if (lf)
-            buf[len++] = '\n';
-        buf[len] = '\0';
-    }
-    nc_lines_free(&ln);
-    fclose(f);
-    if (rc == 0)
-        rc = nc_cfg_load_string(cfg, buf ? buf : "", path);
-    free(buf);
-    return rc;
 }
 
 /* ---- overrides -------------------------------------------------------- */
