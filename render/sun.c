@@ -116,7 +116,9 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
         return rc;
     if (tan(theta) * fmax(c->fx_px, c->fy_px) < SUN_POINTS_PX)
         return sun_points(r, s, sun, theta, irr, f, v);
-    const double L = irr / (2 * M_PI * (1 - cos(theta))), cos_theta = cos(theta);
+    /* a uniform disk of radiance L and angular radius theta gives the irradiance E = integral of L cos(alpha) over
+     * it = pi L sin^2 theta (E / its solid angle drew it (1 + cos theta) / 2 too dim: 6 % at 0.01 au) */
+    const double L = irr / (M_PI * sin(theta) * sin(theta)), cos_theta = cos(theta);
     enum { SUB = 8 };
     long lit = 0, seen = 0;
     for (int y = y0; y <= y1; y++)
@@ -146,9 +148,11 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
                 continue;
             lit += open;
             const double cov = (double)open / (SUB * SUB);
-            const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_dir(c, x, y));
+            const struct nc_vec3 dir = nc_camera_dir(c, x, y);
+            const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, dir);
             f->radiance[(size_t)y * f->width_px + x] += (float)(L * cov);
-            v->drawn_w_m2 += L * cov * omega;
+            /* the irradiance on a plane facing the Sun: cos alpha from the disk's centre */
+            v->drawn_w_m2 += L * cov * omega * nc_v3_dot(nc_quat_rotate(c->attitude_q, nc_v3_unit(dir)), sun);
         }
     v->hidden = seen > 0 && lit == 0;
     return 0;

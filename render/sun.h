@@ -21,8 +21,8 @@ struct nc_sun_view {
 };
 /* Describe the Sun's place relative to the frame of scene s (poses at
  * mid-exposure) and, when its disk reaches the frame, draw it: a uniform
- * disk of the Sun's angular radius theta and radiance E / (2 pi (1 - cos
- * theta)) (E the solar irradiance at the camera), 8 x 8 samples a pixel,
+ * disk of the Sun's angular radius theta and radiance E / (pi sin^2 theta)
+ * (E the solar irradiance at the camera), 8 x 8 samples a pixel,
  * each traced for bodies in front; a disk under 4 px in radius as 1024
  * points spread over it, each a 1024th of E, traced and added to the pixel
  * it falls in. The camera model then saturates and blooms it like any

@@ -329,15 +329,17 @@ int main(void)
      * about 9 px in radius), then 5 and 30 deg off, then behind a body; then
      * from 5 au on the boresight of a 73 deg field (fx 100 px: its disk
      * 0.093 px in radius, which 8 x 8 samples a pixel missed), in the open
-     * and behind the body. */
-    const double offs[] = {1, 5, 30, 1, 0, 0};
-    for (int k = 0; k < 6; k++) {
+     * and behind the body; then from 0.01 au (its disk 27.7 deg in radius,
+     * 53 px: drawn (1 + cos theta) / 2 too dim with E over its solid angle). */
+    const double offs[] = {1, 5, 30, 1, 0, 0, 0};
+    for (int k = 0; k < 7; k++) {
         char sunset[160], rockset[160];
         double o = offs[k] * M_PI / 180;
         snprintf(sunset, sizeof sunset, "sun.direction=[%.17g, 0, %.17g]", sin(o), cos(o));
         snprintf(rockset, sizeof rockset, "bodies.0.position_m=[%.17g, 0, %.17g]", k == 3 ? 1e4 * sin(o) : 0.0,
                  k == 3 || k == 5 ? 1e4 * cos(o) : -1e4);
-        const char *sets[] = {sunset, rockset, "camera.fx_px=100", "camera.fy_px=100", "sun.distance_au=5"};
+        const char *sets[] = {sunset, rockset, "camera.fx_px=100", "camera.fy_px=100",
+                              k == 6 ? "sun.distance_au=0.01" : "sun.distance_au=5"};
         struct nc_scene sc;
         nc_test_scene("bodies:\n  - shape: {type: sphere, radius_m: 200}\n    material: {model: lambert, A: 0.1}\n"
                       "sun: {direction: [0, 0, 1]}\n"
@@ -350,6 +352,7 @@ int main(void)
         char warn[80];
         nc_renderer_init(&rs, &sc, 2);
         nc_frame_alloc(&fs, 128, 128);
+        memset(fs.radiance, 0, 128 * 128 * sizeof *fs.radiance); /* the Sun is added to the body's light */
         CHECK(nc_render_sun(&rs, &sc, NC_SUN_NEAR_DEG, &fs, &sv) == 0, "sun: %s", nc_errmsg());
         nc_sun_view_warning(&sv, warn, sizeof warn);
         struct nc_vec3 sd;
@@ -373,6 +376,15 @@ int main(void)
         if (k == 4)
             CHECK(sv.in_field && !sv.hidden && fabs(sv.drawn_w_m2 / irr - 1) < 1e-9,
                   "the Sun's disk 0.093 px in radius: drawn %.9f of its irradiance", sv.drawn_w_m2 / irr);
+        if (k == 6) { /* the disk's radiance E / (pi sin^2 theta), at its centre pixel */
+            const double th = nc_scene_sun_radius_rad(&sc), disk = irr / (M_PI * sin(th) * sin(th));
+            const double centre = fs.radiance[64 * 128 + 64];
+            printf("the Sun from 0.01 au (radius %.2f deg): radiance %.6g (E / (pi sin^2 theta) %.6g), drawn %.5f of "
+                   "its irradiance\n", th * 180 / M_PI, centre, disk, sv.drawn_w_m2 / irr);
+            CHECK(fabs(centre / disk - 1) < 1e-6 && fabs(sv.drawn_w_m2 / irr - 1) < 0.005,
+                  "the Sun from 0.01 au: radiance %.6g, want %.6g; drawn %.5f of its irradiance", centre, disk,
+                  sv.drawn_w_m2 / irr);
+        }
         nc_frame_free(&fs);
         nc_renderer_free(&rs);
         nc_scene_free(&sc);
