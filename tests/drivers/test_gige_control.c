@@ -3,7 +3,8 @@
  * gets packets in the first second and none once its heartbeat ran out (the
  * device stops the acquisition and closes the stream channel), then a new
  * client streams and reads GevHeartbeatTimeout; in lock-step, refused
- * settings written with one that is not are undone alone; the timestamp
+ * settings written with one that is not are undone alone, TLParamsLocked
+ * locks the payload's features, every bound reads; the timestamp
  * counter's latch and reset; at poll_hz 1 the device idles between its
  * checks, and frames of a region beyond the sensor are not sent; clear
  * errors for a missing
@@ -149,6 +150,23 @@ static void test_lockstep_units(void)
     CHECK(ex == 2500 && rate == rate0 && mode && !strcmp(mode, "Off"),
           "lock-step: ExposureTime %g us (want 2500), AcquisitionFrameRate %g Hz (want %g), TriggerMode %s (want Off)",
           ex, rate, rate0, mode ? mode : "?");
+    /* The XML: the payload's features locked by TLParamsLocked (GenApi clients refuse writes while it is 1), and
+     * bounds a client can read (GevTimestampTickFrequency had none: Aravis's bounds query failed) */
+    GError *err = NULL;
+    gint64 lo = 0, hi = 0;
+    arv_device_get_integer_feature_bounds(d, "GevTimestampTickFrequency", &lo, &hi, &err);
+    CHECK(!err && lo <= 1000000000 && hi >= 1000000000, "GevTimestampTickFrequency bounds: %s",
+          err ? err->message : "out of range");
+    g_clear_error(&err);
+    arv_device_set_integer_feature_value(d, "TLParamsLocked", 1, NULL);
+    int locked = 0;
+    for (int i = 0; i < 3; i++) {
+        static const char *const name[] = {"Width", "Height", "PixelFormat"};
+        ArvGcNode *node = arv_device_get_feature(d, name[i]);
+        locked += node && arv_gc_feature_node_is_locked(ARV_GC_FEATURE_NODE(node), NULL);
+    }
+    arv_device_set_integer_feature_value(d, "TLParamsLocked", 0, NULL);
+    CHECK(locked == 3, "TLParamsLocked 1: %d of Width, Height and PixelFormat locked", locked);
     g_object_unref(c);
     CHECK(stop(pid) == 0, "serve did not exit cleanly");
 }
