@@ -209,7 +209,7 @@ int nc_camsys_digitise(const struct nc_camsys *cs, const float *electrons, doubl
     const int whole = s->blooming || s->cosmic_rate_cm2_s > 0;
     double *e = whole ? malloc(n * sizeof *e) : NULL;
     float *rn = whole ? malloc(n * sizeof *rn) : NULL;
-    float *buf = malloc((size_t)nb * 8 * sizeof *buf);
+    float *buf = calloc((size_t)nb * 8, sizeof *buf); /* b.u read (not used) in rows without low counts */
     uint32_t *words = malloc((size_t)pairs * 4 * sizeof *words);
     float *lam = malloc((size_t)nb * 2 * sizeof *lam), *q = lam + nb;
     if (!buf || !words || !lam || (whole && (!e || !rn))) {
