@@ -44,6 +44,8 @@ static int sumfile_intrinsics(struct nc_cfg_node *map, struct nc_camera *c, stru
     return 0;
 }
 
+static void distort(const struct nc_camera *c, double x, double y, double *xd, double *yd, double J[2][2]);
+
 static int camera_read(struct nc_cfg_node *map, struct nc_camera *c, struct nc_sumfile *sum)
 {
     int rc;
@@ -113,6 +115,24 @@ distortion:;
                 return nc_cfg_error(dist, "this distortion cannot be inverted at pixel (%g, %g): the lens model folds "
                                           "over inside the image",
                                     pts[i][0], pts[i][1]);
+        }
+        /* ... and unfolded on the way there: the round trip holds for any root, also one beyond a fold (k1 -1.2,
+         * k2 0.5 over a 64 px frame of fx 44: pixels 48 and 49 of the middle row saw radii 0.55 and 1.22). Along
+         * the rays from the centre to the corners and the edges' midpoints, the map's Jacobian stays positive. */
+        const double far[8][2] = {{0, 0}, {c->width_px - 1.0, 0}, {0, c->height_px - 1.0},
+                                  {c->width_px - 1.0, c->height_px - 1.0}, {0.5 * c->width_px, 0},
+                                  {0.5 * c->width_px, c->height_px - 1.0}, {0, 0.5 * c->height_px},
+                                  {c->width_px - 1.0, 0.5 * c->height_px}};
+        for (int i = 0; i < 8; i++) {
+            const struct nc_vec3 d = nc_camera_ray(c, far[i][0], far[i][1]);
+            for (int k = 1; k <= 512; k++) {
+                double xd, yd, J[2][2];
+                distort(c, d.x * k / 512, d.y * k / 512, &xd, &yd, J);
+                if (!(J[0][0] * J[1][1] - J[0][1] * J[1][0] > 0))
+                    return nc_cfg_error(dist, "this distortion folds over inside the image (towards pixel (%g, %g), "
+                                              "at %.0f %% of the way): its inverse is not unique",
+                                        far[i][0], far[i][1], 100.0 * k / 512);
+            }
         }
     }
     return 0;

@@ -19,7 +19,8 @@ static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double
     const int W = f->width_px, H = f->height_px;
     const int x0 = (int)floor(x), y0 = (int)floor(y);
     const double ax = x - x0, ay = y - y0;
-    const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_dir(c, x, y));
+    /* the true ray's solid angle: with distortion the pinhole's direction at (x, y) is not the star's */
+    const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_ray(c, x, y));
     const double L = e / omega, w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
     int in = 0;
     for (int k = 0; k < 4; k++) {

@@ -63,7 +63,7 @@ static int sun_points(struct nc_renderer *r, const struct nc_scene *s, struct nc
             const long px = lround(x), py = lround(y);
             if (px < 0 || py < 0 || px >= f->width_px || py >= f->height_px)
                 continue;
-            const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_dir(c, (double)px, (double)py));
+            const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_ray(c, (double)px, (double)py));
             f->radiance[(size_t)py * f->width_px + (size_t)px] += (float)(share / omega);
             v->drawn_w_m2 += share;
         }
@@ -148,7 +148,7 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
                 continue;
             lit += open;
             const double cov = (double)open / (SUB * SUB);
-            const struct nc_vec3 dir = nc_camera_dir(c, x, y);
+            const struct nc_vec3 dir = nc_camera_ray(c, x, y);
             const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, dir);
             f->radiance[(size_t)y * f->width_px + x] += (float)(L * cov);
             /* the irradiance on a plane facing the Sun: cos alpha from the disk's centre */

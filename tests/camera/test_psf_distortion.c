@@ -179,5 +179,17 @@ int main(void)
                               fold, 1, &s);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "camera.distortion: this distortion cannot be inverted"),
           "folding distortion: %s", nc_errmsg());
+    /* One that folds between the centre and the edge, while every tested pixel's ray projects back onto it (the
+     * inverse found a root beyond the fold: pixels 48 and 49 of the middle row saw radii 0.55 and 1.22). */
+    const char *fold2[] = {"camera.distortion={k1: -1.2, k2: 0.5}"};
+    rc = nc_test_scene_rc("bodies: [{shape: {type: sphere, radius_m: 1}, material: {model: lambert, A: 0.1}}]\n"
+                          "sun: {direction: [1, 0, 0]}\n"
+                          "camera: {width_px: 64, height_px: 64, fx_px: 44, fy_px: 44,\n"
+                          "         position_m: [0, 0, -10], attitude_q: [1, 0, 0, 0]}\n",
+                          fold2, 1, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "camera.distortion: this distortion folds over inside the image"),
+          "a fold inside the image: %s", rc < 0 ? nc_errmsg() : "accepted");
+    if (rc == 0)
+        nc_scene_free(&s);
     return nc_test_end();
 }
