@@ -264,7 +264,7 @@ static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const ch
     /* One document: a second one ('---', after a '...' or not) would be
      * dropped unseen, its keys neither read nor refused. */
     yaml_document_t more;
-    if (rc >= 0 && root && yaml_parser_load(&parser, &more)) {
+    if (rc >= 0 && yaml_parser_load(&parser, &more)) { /* (also after an empty first one) */
         yaml_node_t *r2 = yaml_document_get_root_node(&more);
         if (r2) {
             char at[16];

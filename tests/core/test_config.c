@@ -95,6 +95,14 @@ int main(void)
                  "a second YAML document ('---'): one document a file");
     expect_error("a second document after '...'", NULL, "...\n---\nrender: {samples_per_pixel: 3}\n", NULL, 0,
                  "test.yaml:15", "a second YAML document");
+    {
+        struct nc_cfg cfg;
+        nc_cfg_init(&cfg);
+        CHECK(nc_cfg_load_string(&cfg, "---\n---\ncamera: {width_px: 8}\n", "two.yaml") < 0 &&
+                  nc_test_contains(nc_errmsg(), "two.yaml:3: a second YAML document"),
+              "a second document after an empty first: %s", nc_errmsg());
+        nc_cfg_free(&cfg);
+    }
     { /* KEY=null where nothing is: nothing to take out, and no parents made for it (an empty `stars:` was made,
        * and a second body: "bodies[1].shape: missing required key") */
         const char *sets[] = {"stars.magnitude_limit=null", "bodies.1.name=null", "optics.psf.sigma_px=null"};
