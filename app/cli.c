@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/lines.h"
 #include "core/log.h"
 #include "core/texture.h"
 
@@ -96,10 +97,9 @@ void nc_cli_sumfile(const char **sets, int *nsets, char *buf, size_t len, const 
 int nc_cli_decimal(const char *s, const char **end, double *out)
 {
     char *e;
-    *out = strtod(s, &e);
+    *out = nc_strtod_decimal(s, &e);
     *end = e;
-    const char *digits = s + strspn(s, " \t");
-    return e != s && strspn(digits, "0123456789+-.eE") == (size_t)(e - digits) && isfinite(*out) ? 0 : -1;
+    return e != s && isfinite(*out) ? 0 : -1;
 }
 
 int nc_cli_whole(const char *s, unsigned long long *out)

@@ -14,6 +14,7 @@
 #include <strings.h>
 
 #include "core/error.h"
+#include "core/lines.h"
 
 /* ---- readers ---------------------------------------------------------- */
 
@@ -81,12 +82,10 @@ static int scalar_double(struct nc_cfg_node *n, double *out)
     const char *t = n->value + (n->value[0] == '-' || n->value[0] == '+');
     if (!strcasecmp(t, ".nan") || !strcasecmp(t, ".inf"))
         return nc_cfg_error(n, "expected a finite number, got \"%s\"", n->value);
-    double v = strtod(n->value, &end);
-    const char *digits = n->value + strspn(n->value, " ");
-    const int decimal = strspn(digits, "0123456789+-.eE") == (size_t)(end - digits); /* not 0x1p1, inf, nan */
+    double v = nc_strtod_decimal(n->value, &end); /* not 0x1p1, inf, nan */
     while (*end == ' ')
         end++;
-    if (end == n->value || *end || !decimal)
+    if (end == n->value || *end)
         return nc_cfg_error(n, "expected a number, got \"%s\"%s", n->value,
                             strpbrk(n->value, "xX") ? " (decimal digits: no hexadecimal)" : "");
     if (errno == ERANGE)

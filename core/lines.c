@@ -64,3 +64,14 @@ double nc_strtod_fortran(const char *s, char **end)
         *end = (char *)s + (e == num ? 0 : lead + (size_t)(e - num));
     return v;
 }
+
+double nc_strtod_decimal(const char *s, char **end)
+{
+    char *e;
+    const double v = strtod(s, &e);
+    const char *digits = s + strspn(s, " \t");
+    const int decimal = e != s && strspn(digits, "0123456789+-.eE") >= (size_t)(e - digits);
+    if (end)
+        *end = decimal ? e : (char *)s;
+    return decimal ? v : 0;
+}

@@ -33,4 +33,8 @@ void nc_lines_free(struct nc_lines *l);
  * headers write them) read as E. */
 double nc_strtod_fortran(const char *s, char **end);
 
+/* strtod of a decimal number only (digits, sign, point, exponent, after
+ * blanks): hexadecimal (0x1p1), inf and nan read nothing (*end = s). */
+double nc_strtod_decimal(const char *s, char **end);
+
 #endif

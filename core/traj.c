@@ -218,10 +218,9 @@ int nc_traj_read(const char *path, struct nc_traj_row **out)
         int k = 0;
         char *s = line, *end;
         for (; k < l.max; k++) {
-            raw[k] = strtod(s, &end);
-            const char *after = end + strspn(end, " \t"), *digits = s + strspn(s, " \t");
-            if (end == s || (after == end && *after && !strchr(",\r\n", *after)) ||
-                strspn(digits, "0123456789+-.eE") != (size_t)(end - digits))
+            raw[k] = nc_strtod_decimal(s, &end);
+            const char *after = end + strspn(end, " \t");
+            if (end == s || (after == end && *after && !strchr(",\r\n", *after)))
                 break; /* not a decimal number (hexadecimal, inf, nan), or one run into other characters: the field
                         * is reported whole */
             s = (char *)after;

@@ -28,6 +28,13 @@ static void log_reject(struct nc__emu *e, enum nc_reject r, const char *from)
     }
 }
 
+/* A TCP message whose length prefix no message has, counted and logged. */
+static void bad_length(struct nc__emu *e, uint32_t len)
+{
+    atomic_fetch_add(&e->received, 1);
+    log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
+}
+
 /* A message counted and decoded, a rejection counted and logged: its
  * reason, or NC_REJECT_NONE. *answer is set when it carries a CAPTURE that
  * must be answered: accepted, or refused for a value (its header and CRC
@@ -168,8 +175,7 @@ static int client_take(struct nc__emu *e, int i)
     if (len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) {
         /* Too long or too short to be a message, but the prefix still says
          * where the next one starts: counted, and its bytes passed over. */
-        log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
-        atomic_fetch_add(&e->received, 1);
+        bad_length(e, len);
         if (len > SKIP_MAX_BYTES) {
             nc_log_warn("emulator", "a TCP client's length prefix says %u bytes (at most %d): not a NavCam stream; "
                         "disconnected", len, NC_PROTO_MAX_BYTES);
@@ -348,8 +354,7 @@ void nc__serve_answer_unread(struct nc__emu *e)
                 uint32_t len = (uint32_t)c->buf[0] | (uint32_t)c->buf[1] << 8 | (uint32_t)c->buf[2] << 16 |
                                (uint32_t)c->buf[3] << 24;
                 if ((len > NC_PROTO_MAX_BYTES || len < NC_PROTO_HEADER_BYTES + 4) && len <= SKIP_MAX_BYTES) {
-                    atomic_fetch_add(&e->received, 1); /* refused, passed over (client_take) */
-                    log_reject(e, len > NC_PROTO_MAX_BYTES ? NC_REJECT_OVERSIZED : NC_REJECT_TRUNCATED, "a TCP client");
+                    bad_length(e, len); /* refused, passed over (client_take) */
                     c->skip = 4 + len;
                     continue;
                 }
