@@ -458,7 +458,7 @@ int main(int argc, char **argv)
         rc = nc_image_prepare(dotext);
     if (rc >= 0) /* once the configuration is known good: no empty directory left by a mistake in it */
         rc = nc_mkdirs(dir);
-    long done = 0, skipped = 0, busy = 0, mine = 0, no_capture = 0;
+    long done = 0, skipped = 0, busy = 0, mine = 0, no_capture = 0, failed = 0, failed_run = 0;
     double t_all = now_s();
     for (long i = 0; i < nrows && rc >= 0; i++) {
         if (i % shard_n != shard_k)
@@ -490,18 +490,21 @@ int main(int argc, char **argv)
         }
         rc = batch_row(&r, &base, &cs, &sky, &rows[i], i, dir, stem, ext, q, exposure, geometry, geom, rock);
         unlock_row(lock, fd, rc >= 0);
-        if (rc < 0)
-            break;
-        done++;
+        if (rc < 0) { /* named, and the other rows go on: ten failures in a row stop the shard */
+            fprintf(stderr, "navcam batch: row %ld (line %d): %s\n", i, rows[i].line, nc_errmsg());
+            rc = ++failed_run < 10 ? 0 : nc_error(rc, "stopped: ten rows in a row failed");
+            failed++;
+        } else
+            done++, failed_run = 0;
     }
     double el = now_s() - t_all;
     char off[64] = "";
     if (no_capture)
         snprintf(off, sizeof off, " (and %ld with capture 0, not rendered)", no_capture);
     if (rc >= 0)
-        printf("navcam batch: shard %ld/%ld: %ld of %d rows are this shard's%s; %ld rendered, %ld already done%s; "
-               "%.1f s (%.0f frames per hour)\n",
-               shard_k, shard_n, mine, nrows, off, done, skipped, busy_txt(busy), el, el > 0 ? done * 3600 / el : 0.0);
+        printf("navcam batch: shard %ld/%ld: %ld of %d rows are this shard's%s; %ld rendered, %ld failed, %ld already "
+               "done%s; %.1f s (%.0f frames per hour)\n", shard_k, shard_n, mine, nrows, off, done, failed, skipped,
+               busy_txt(busy), el, el > 0 ? done * 3600 / el : 0.0);
     free(geom);
     free(rock);
     free(rows);
@@ -509,7 +512,7 @@ int main(int argc, char **argv)
     nc_scene_free(&base);
     nc_camsys_free(&cs);
     nc_sky_free(&sky);
-    return rc < 0 ? nc_cli_fail() : 0;
+    return rc < 0 ? nc_cli_fail() : failed > 0;
 usage:
     free(sets);
     return 2;

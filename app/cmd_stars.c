@@ -40,7 +40,7 @@ static int info(const char *path)
     printf("%s: %zu stars, V %.2f to %.2f, positions at epoch J%.2f; loaded in %.1f ms\n", path, c.n,
            c.star[0].v_mag, c.star[c.n - 1].v_mag, c.epoch_jyear, ms);
     for (int v = (int)floor(c.star[0].v_mag); v <= (int)floor(c.star[c.n - 1].v_mag); v++)
-        printf("  V < %2d: %zu\n", v + 1, nc_star_cat_count_to(&c, v + 1 - 1e-9));
+        printf("  V < %2d: %zu\n", v + 1, nc_star_cat_count_to(&c, nextafterf((float)(v + 1), -INFINITY)));
     nc_star_cat_free(&c);
     return 0;
 }

@@ -15,6 +15,8 @@ int nc_mkdirs(const char *dir)
     char d[4096];
     if (snprintf(d, sizeof d, "%s", dir) >= (int)sizeof d)
         return nc_error(-ENAMETOOLONG, "%s: path too long", dir);
+    if (!d[0])
+        return nc_error(-ENOENT, "an empty directory name");
     for (char *p = d + 1;; p++) {
         const char c = *p;
         if (c != '/' && c != '\0')

@@ -51,7 +51,7 @@ PY
 
 # One process, two threads: the reference.
 "$navcam" batch traj.csv -o ref "${scene[@]}" -j 2 > ref.log 2> ref.err || { cat ref.err; fail "batch"; }
-grep -q "8 rendered, 0 already done" ref.log || fail "reference: $(tail -1 ref.log)"
+grep -q "8 rendered, 0 failed, 0 already done" ref.log || fail "reference: $(tail -1 ref.log)"
 for i in 0 7; do
   f=ref/frame_00000$i
   for x in .fits _geometry.fits .json _boulders.csv _craters.csv; do [ -s "$f$x" ] || fail "missing $f$x"; done
@@ -86,7 +86,7 @@ cp -r ref crashed
 rm crashed/frame_000005.json crashed/frame_000005.fits
 head -c 1000 ref/frame_000005.fits > crashed/.frame_000005.tmp.fits
 "$navcam" batch traj.csv -o crashed "${scene[@]}" > resume.log 2>&1 || fail "resume"
-grep -q "1 rendered, 7 already done" resume.log || fail "resume: $(tail -1 resume.log)"
+grep -q "1 rendered, 0 failed, 7 already done" resume.log || fail "resume: $(tail -1 resume.log)"
 diff -r -x '.frame_*' ref crashed > /dev/null || fail "resumed dataset differs from the reference"
 
 # A row another process is rendering (its lock held) is left to it, not
@@ -100,9 +100,9 @@ for _ in $(seq 600); do [ -e busy.held ] && break; sleep 0.1; done # a loaded ma
 [ -e busy.held ] || fail "busy: the process holding the lock did not start within 60 s"
 "$navcam" batch traj.csv -o busy "${scene[@]}" > busy.log 2>&1 || fail "busy: $(cat busy.log)"
 kill $holder; wait $holder 2>/dev/null || true
-grep -q "0 rendered, 7 already done, 1 being rendered by another process" busy.log || fail "busy: $(tail -1 busy.log)"
+grep -q "0 rendered, 0 failed, 7 already done, 1 being rendered by another process" busy.log || fail "busy: $(tail -1 busy.log)"
 "$navcam" batch traj.csv -o busy "${scene[@]}" > busy.log 2>&1 || fail "busy, rerun"
-grep -q "1 rendered, 7 already done;" busy.log || fail "busy, rerun: $(tail -1 busy.log)"
+grep -q "1 rendered, 0 failed, 7 already done;" busy.log || fail "busy, rerun: $(tail -1 busy.log)"
 diff -r -x '.frame_*' ref busy > /dev/null || fail "the row rendered after the lock was freed differs"
 
 # -o makes missing parents; a configuration error leaves no directory behind.
@@ -110,6 +110,17 @@ diff -r -x '.frame_*' ref busy > /dev/null || fail "the row rendered after the l
 [ -s nest/a/b/frame_000000.json ] || fail "-o nest/a/b: no frame"
 "$navcam" batch traj.csv -o none/x "${scene[@]}" --set camera.widht_px=3 2> err.txt && fail "a misspelt key accepted"
 [ ! -e none ] || fail "a configuration error left the directory none/"
+
+# A row that cannot be rendered (a body too small an angle for the float rays
+# at this focal length) is named by row and line; the other rows are rendered
+# and the exit status is 1.
+printf 't_s,cam_x_m,cam_y_m,cam_z_m,q_w,q_x,q_y,q_z,sun_x,sun_y,sun_z\n0,0,-3000,0,0.70710678,-0.70710678,0,0,1,-1,0
+1,0,-2e9,0,0.70710678,-0.70710678,0,0,1,-1,0\n2,0,-3000,0,0.70710678,-0.70710678,0,0,1,-1,0\n' > far.csv
+"$navcam" batch far.csv -o far --no-geometry --set camera.width_px=32 --set camera.height_px=32 \
+  --set camera.focal_length_m=100 --set camera.pixel_pitch_m=1e-5 > far.log 2>&1 && fail "a failed row exited 0"
+grep -q "^navcam batch: row 1 (line 3): body 'asteroid' is .* px across" far.log || fail "failed row: $(cat far.log)"
+grep -q "2 rendered, 1 failed, 0 already done" far.log || fail "failed row: $(tail -1 far.log)"
+[ -s far/frame_000002.json ] && [ ! -e far/frame_000001.json ] || fail "failed row: the rows after it not rendered"
 
 # SUM-like rows of the same poses: the same frames (to the pose's rounding).
 "$navcam" batch traj_sum.csv -o sum "${scene[@]}" --no-geometry > /dev/null 2>&1 || fail "SUM-like rows"

@@ -100,6 +100,47 @@ static struct shot shoot(struct nc_vec3 look, struct nc_vec3 rock, struct nc_vec
     return out;
 }
 
+/* The scene file of the last shoot with sets, its sky drawn at the times
+ * t[0..nt-1] (s) in turn with one nc_sky; the electrons of the last. */
+static float *draw_at(const char **sets, int nsets, const double *t, int nt)
+{
+    const char *path = nc_test_path("scene.yaml");
+    struct nc_scene s;
+    struct nc_camsys cs;
+    struct nc_sky sky;
+    CHECK(nc_setup_load(path, sets, nsets, &s, &cs) >= 0 && nc_sky_load(path, sets, nsets, &sky) >= 0 &&
+              nc_sky_prepare(&sky, &cs, &s.camera) >= 0,
+          "set-up: %s", nc_errmsg());
+    struct nc_scene drawn = s;
+    nc_camsys_render_camera(&cs, &s.camera, &drawn.camera);
+    struct nc_renderer r;
+    struct nc_frame f;
+    struct nc_sky_stats st;
+    nc_renderer_init(&r, &drawn, 2);
+    nc_frame_alloc(&f, drawn.camera.width_px, drawn.camera.height_px);
+    struct nc_exposure ex = {.exposure_s = 1.0};
+    float *e = malloc(sizeof(float) * 96 * 96);
+    for (int k = 0; k < nt; k++)
+        CHECK(nc_render_exposure(&r, &drawn, &ex, &f, NULL) == 0 &&
+                  nc_sky_draw(&sky, &r, &cs, &drawn, t[k], 1.0, &f, &st) == 0 &&
+                  nc_camsys_electrons(&cs, f.radiance, 1.0, e) == 0,
+              "render: %s", nc_errmsg());
+    nc_frame_free(&f);
+    nc_renderer_free(&r);
+    nc_sky_free(&sky);
+    nc_camsys_free(&cs);
+    nc_scene_free(&s);
+    return e;
+}
+
+static double centroid_x(const float *e)
+{
+    double m = 0, mx = 0;
+    for (int i = 0; i < 96 * 96; i++)
+        m += e[i], mx += (i % 96) * (double)e[i];
+    return mx / m;
+}
+
 /* Planck photon spectral radiance shape, lambda in m (any constant factor). */
 static double photons(double l, double t)
 {
@@ -293,6 +334,28 @@ int main(void)
     CHECK(!memcmp(e1, e4, sizeof(float) * 96 * 96), "1 and 2 threads: the same frame");
     free(e1);
     free(e4);
+
+    /* 5a. A frame's stars depend on its own time, not on the frames drawn
+     * before it: a star of 10 arcsec/yr along +RA (image -x) drawn at 3 days
+     * after a frame at 0 gives the bytes of a sky drawn at 3 days first
+     * (navcam batch's shards and resumed runs); it moved 10 * 3 / 365.25
+     * arcsec, 0.04 px. */
+    struct nc_star fast = {.ra_rad = 1.0, .dec_rad = 0.4, .pm_ra_mas_yr = 10000, .v_mag = 5.0f, .b_v = 0.65f};
+    struct nc_star_cat one = {.n = 1, .star = &fast, .epoch_jyear = 2000};
+    char fset[1100];
+    snprintf(fset, sizeof fset, "stars.catalogue=%s", nc_test_path("fast.ncs"));
+    const char *fsets[] = {fset};
+    CHECK(nc_star_cat_write(&one, nc_test_path("fast.ncs")) == 0, "write");
+    const double t0[] = {0}, t3[] = {3 * 86400.0}, t03[] = {0, 3 * 86400.0};
+    float *f0 = draw_at(fsets, 1, t0, 1), *f3 = draw_at(fsets, 1, t3, 1), *f03 = draw_at(fsets, 1, t03, 2);
+    const double pm_as = (centroid_x(f0) - centroid_x(f3)) * 1e-5 / AS, want_as = 10 * 3 / 365.25;
+    printf("proper motion in 3 days: %.4f arcsec (%.4f expected); drawn after a frame at 0: %s\n", pm_as, want_as,
+           memcmp(f3, f03, sizeof(float) * 96 * 96) ? "differs" : "the same bytes");
+    CHECK(!memcmp(f3, f03, sizeof(float) * 96 * 96), "a frame's stars depend on the frame drawn before it");
+    CHECK(fabs(pm_as - want_as) < 0.01, "proper motion in 3 days: %.4f arcsec, expected %.4f", pm_as, want_as);
+    free(f0);
+    free(f3);
+    free(f03);
 
     /* 5b. limit_mag auto, by its definition: the faintest V whose star of
      * the most favourable colour (B-V within -0.4..2.0) gives 0.1 of the
