@@ -67,12 +67,13 @@ static int corner_normals(const struct nc_mesh *m, int16_t *cn)
     return 0;
 }
 
-/* The detailed surfaces are one-sided, as the planes' test is: a shadow ray
- * whose origin lies within float rounding under the surface (it starts 4e-6
- * of its camera distance off the point, and the rock's record is placed to a
- * few 1e-5 m in a tile up to kilometres across) leaves through the surface's
- * back, which does not stop it. Outward is away from the rock's centre, the
- * origin of its frame (the surface is the relief on a convex polyhedron). */
+/* The detailed surfaces are one-sided, as the planes' test is, for every
+ * ray: a shadow or bounce ray whose origin lies within float rounding under
+ * the surface (it starts 4e-6 of its camera distance off the point, and the
+ * rock's record is placed to 6e-8 of its tile's spread) leaves through the
+ * surface's back, which neither stops nor lights it, and a camera inside a
+ * rock sees out of it. Outward is away from the rock's centre, the origin of
+ * its frame (the surface is the relief on a convex polyhedron). */
 static void front_faces(const struct RTCFilterFunctionNArguments *a)
 {
     const unsigned N = a->N;
@@ -129,6 +130,7 @@ int nc__rt_rock_meshes(RTCDevice dev, struct nc__rt_rocks *r)
         nc_mesh_free(&m);
         rtcSetSceneFlags(sf->scene, RTC_SCENE_FLAG_COMPACT);
         rtcSetGeometryOccludedFilterFunction(g, front_faces);
+        rtcSetGeometryIntersectFilterFunction(g, front_faces);
         rtcCommitGeometry(g);
         rtcAttachGeometry(sf->scene, g);
         rtcReleaseGeometry(g);

@@ -11,8 +11,8 @@
  * where the rocks' own bins, rt_rock_bins.h, serve a pass, its camera rays
  * test only the rocks listed in their block). The tiles' trees are built once:
  * a pose only moves their instances (the float translation from the camera
- * to a tile's origin costs 6e-8 of that distance, a record 6e-8 of its
- * distance from the origin: under 1e-4 of the rock's own size), so nothing
+ * to a tile's origin, the middle of its rocks, costs 6e-8 of that distance,
+ * a record 6e-8 of its distance from the origin), so nothing
  * is rebuilt when the camera moves. Rocks smaller than a cut are not traced: tiles of
  * octaves wholly below it are disabled, and the rest of the rocks below it
  * are refused in the intersection test by their rank in the list (the list

@@ -180,8 +180,17 @@ int nc__rt_rocks_init(RTCDevice dev, const struct nc_boulder_field *f, struct nc
                 r->tile = t, cap *= 2;
             }
             struct nc__rt_rock_tile *tl = &r->tile[r->ntiles++];
-            tl->origin_m[0] = (key[i].x + 0.5) * S, tl->origin_m[1] = (key[i].y + 0.5) * S;
-            tl->origin_m[2] = (key[i].z + 0.5) * S;
+            /* the records are relative to the middle of the tile's rocks, not of
+             * its cube (up to 0.87 S from them: 1 mm of float error on a 28 km
+             * cube), so they carry 6e-8 of the rocks' spread */
+            for (int c = 0; c < 3; c++) {
+                double lo = INFINITY, hi = -INFINITY;
+                for (size_t q = i; q < e; q++) {
+                    lo = fmin(lo, f->rock[key[q].rock].centre_m[c]);
+                    hi = fmax(hi, f->rock[key[q].rock].centre_m[c]);
+                }
+                tl->origin_m[c] = 0.5 * (lo + hi);
+            }
             tl->octave = k;
             tl->ext = ext + at;
             tl->rec = r->rock + at;
