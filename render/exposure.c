@@ -12,9 +12,40 @@
 #include "render/render.h"
 #include "render/stars.h"
 
-double nc_render_motion_px(const struct nc_scene *s, double T)
+/* Inside a body's bounding sphere the nearest range is what the camera
+ * sees: the least range of a render of 64 x 64 rays over the same field
+ * (one through each probe pixel's centre), at the frame's middle pose.
+ * INFINITY when nothing is hit. */
+static double probe_range_m(struct nc_renderer *r, const struct nc_scene *s)
+{
+    enum { P = 64 };
+    const struct nc_camera *c = &s->camera;
+    const double k = (double)P / (c->width_px > c->height_px ? c->width_px : c->height_px);
+    struct nc_scene z = *s; /* shallow: shares meshes and materials */
+    z.camera.width_px = (int)ceil(c->width_px * k), z.camera.height_px = (int)ceil(c->height_px * k);
+    z.camera.fx_px = c->fx_px * k, z.camera.fy_px = c->fy_px * k;
+    z.camera.cx_px = (c->cx_px + 0.5) * k - 0.5, z.camera.cy_px = (c->cy_px + 0.5) * k - 0.5;
+    z.render.samples_per_pixel = 1;
+    z.render.bounces = 0;
+    z.render.quality_auto = 0;
+    struct nc_frame f;
+    double least = INFINITY;
+    if (nc_frame_alloc(&f, z.camera.width_px, z.camera.height_px) < 0 || nc_render_frame(r, &z, &f) < 0) {
+        nc_frame_free(&f);
+        return -1; /* unknown: as near as can be */
+    }
+    for (size_t i = 0; i < (size_t)f.width_px * f.height_px; i++)
+        if (f.coverage[i] > 0)
+            least = fmin(least, f.range_m[i]);
+    nc_frame_free(&f);
+    return least;
+}
+
+double nc_render_motion_px(struct nc_renderer *r, const struct nc_scene *s, double T)
 {
     const struct nc_camera *c = &s->camera;
+    if (!(T > 0))
+        return 0;
     double f = fmax(c->fx_px, c->fy_px);
     /* Nearest possible range: to any body's bounding sphere. */
     double dmin = INFINITY;
@@ -25,6 +56,8 @@ double nc_render_motion_px(const struct nc_scene *s, double T)
     for (int i = 0; i < s->nbodies; i++)
         lin = fmax(lin, nc_v3_norm(s->body[i].velocity_m_s) + nc_v3_norm(c->velocity_m_s) +
                             nc_v3_norm(s->body[i].angular_velocity_rad_s) * s->body[i].bounding_radius_m);
+    if (lin > 0 && !(dmin > 0) && r) /* half the least range seen, less the way travelled in the exposure */
+        dmin = 0.5 * probe_range_m(r, s) - lin * T;
     if (lin > 0)
         motion += dmin > 0 ? lin * T / dmin * f : INFINITY;
     return motion;
@@ -155,7 +188,7 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
 {
     const double T = ex->exposure_s;
     const int maxk = ex->max_time_samples > 0 ? ex->max_time_samples : 256;
-    double motion = nc_render_motion_px(s, T);
+    double motion = nc_render_motion_px(r, s, T);
     int strata = (int)lround(sqrt((double)s->render.samples_per_pixel)), S = strata > 1 ? strata * strata : 1;
     /* at most 0.5 px of motion between time samples */
     int K = fold_time_samples(motion > 0 ? (int)fmin(maxk, ceil(motion / 0.5)) : 1, S);

@@ -171,8 +171,13 @@ struct nc_exposure {
  * needs (one per 0.5 px of motion, at least 1); *time_samples reports it. */
 int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const struct nc_exposure *ex,
                        struct nc_frame *f, int *time_samples);
-/* Image motion over the exposure, pixels (an upper bound from the rates). */
-double nc_render_motion_px(const struct nc_scene *s, double exposure_s);
+/* Image motion over the exposure, pixels: an upper bound from the rates
+ * and the nearest possible range (the bodies' bounding spheres), 0 for an
+ * exposure of 0. With the camera inside a bounding sphere that range is
+ * half the least range r renders over the field at 64 x 64 rays (less the
+ * camera's travel in the exposure): an estimate, not a bound (NULL r: no
+ * range, as much motion as there can be). */
+double nc_render_motion_px(struct nc_renderer *r, const struct nc_scene *s, double exposure_s);
 void nc_renderer_free(struct nc_renderer *r);
 
 #endif

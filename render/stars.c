@@ -13,8 +13,9 @@
 
 /* ---- drawing ------------------------------------------------------------------- */
 
-/* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance. */
-static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double y, double e)
+/* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance,
+ * and as I/F k times that. */
+static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double y, double e, double k_iof)
 {
     const int W = f->width_px, H = f->height_px;
     const int x0 = (int)floor(x), y0 = (int)floor(y);
@@ -28,6 +29,7 @@ static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double
         if (px < 0 || py < 0 || px >= W || py >= H || w[k] == 0)
             continue;
         f->radiance[(size_t)py * W + px] += (float)(L * w[k]);
+        f->iof[(size_t)py * W + px] += (float)(k_iof * L * w[k]);
         in = 1;
     }
     return in;
@@ -85,7 +87,7 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                                            : c->attitude_q;
                 struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), q->dir); /* camera frame */
                 if (nc_camera_project(c, d, &x, &y) == 0)
-                    shown |= splat(f, c, x, y, q->irradiance_w_m2 / K);
+                    shown |= splat(f, c, x, y, q->irradiance_w_m2 / K, q->iof_per_radiance);
             }
             drawn += shown;
         }
@@ -166,7 +168,12 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
         nc_frame_free(&zf);
         /* the centroid's offset from the line of sight, m, seen from the camera */
         const struct nc_vec3 off = e > 0 ? nc_v3_scale(nc_v3_sub(nc_v3_unit(m), dir), dz) : nc_v3(0, 0, 0);
-        p[n++] = (struct nc_point_source){nc_v3_unit(nc_v3_add(rel, off)), hidden ? 0 : e * (dz / d) * (dz / d)};
+        struct nc_vec3 sdir;
+        double J = s->sun.irradiance_w_m2; /* at the body: its I/F */
+        if (s->sun.has_position)
+            nc_scene_sun_at(s, s->body[b].position_m, &sdir, &J);
+        p[n++] = (struct nc_point_source){nc_v3_unit(nc_v3_add(rel, off)), hidden ? 0 : e * (dz / d) * (dz / d),
+                                          J > 0 ? M_PI / J : 0};
         point[b] = 1;
     }
     memcpy(r->as_point, point, sizeof point);

@@ -50,17 +50,20 @@ struct nc_vec3 nc_aberrate(struct nc_vec3 p, struct nc_vec3 v_m_s);
 
 /* A point source at infinity (a star): its direction (scene frame, unit) and
  * its irradiance at the aperture in the renderer's units (W m^-2 as the
- * solar-equivalent total the camera model's band_fraction applies to). */
+ * solar-equivalent total the camera model's band_fraction applies to);
+ * iof_per_radiance, pi / J for a body lit by the solar irradiance J (its
+ * I/F is pi L / J), 0 for a star (none in the I/F plane). */
 struct nc_point_source {
     struct nc_vec3 dir;
     double irradiance_w_m2;
+    double iof_per_radiance; /* sr m^2 W^-1 */
 };
 
 /* Add point sources to frame f (the scene camera's size; its pose is the
  * one at mid-exposure): each is drawn where the lens images it, its
  * irradiance spread bilinearly over the four pixels around that point (so
- * the centroid keeps the sub-pixel position) as radiance E / Omega_pixel;
- * over the exposure (exposure_s, the camera's rates) it moves as the camera
+ * the centroid keeps the sub-pixel position) as radiance E / Omega_pixel
+ * (and I/F, iof_per_radiance times that); over the exposure (exposure_s, the camera's rates) it moves as the camera
  * turns, in steps of at most 0.1 px. With occlusion, a body in front hides
  * it (traced with r's ray tracer at the scene's poses). Returns how many were drawn (in the
  * frame and not hidden), or < 0 on error; *hidden counts the hidden ones. */

@@ -3,8 +3,9 @@
  * across at zero phase gives the frame exactly its analytic irradiance
  * p J (R/D)^2 (p = 2A/3), at one sample a pixel as at sixteen, with its
  * centroid where it projects; a sphere in front hides it; a resolved body
- * is rendered as before. (A second body, off the Sun's line, is the
- * screen that hides it in one case.) */
+ * is rendered as before; its I/F plane is pi L / J, like a resolved
+ * body's. (A second body, off the Sun's line, is the screen that hides it
+ * in one case.) */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -26,6 +27,8 @@ static const char yaml[] = "bodies:\n"
                            "camera: {width_px: 64, height_px: 48, fx_px: 1000, fy_px: 1000,\n"
                            "         position_m: [0, 0, 0], attitude_q: [1, 0, 0, 0]}\n";
 
+static double iof_sum; /* the last shot's sum of I/F */
+
 static void shoot(const char *const *sets, int nsets, double *sum, double *cx, double *cy)
 {
     struct nc_scene s;
@@ -37,10 +40,12 @@ static void shoot(const char *const *sets, int nsets, double *sum, double *cx, d
     nc_frame_alloc(&f, 64, 48);
     CHECK(nc_render_exposure(&r, &s, &ex, &f, NULL) == 0, "render");
     double m = 0, mx = 0, my = 0;
+    iof_sum = 0;
     for (int y = 0; y < 48; y++)
         for (int x = 0; x < 64; x++) {
             double v = f.radiance[y * 64 + x];
             m += v, mx += x * v, my += y * v;
+            iof_sum += f.iof[y * 64 + x];
         }
     *sum = m;
     *cx = m > 0 ? mx / m : NAN;
@@ -55,7 +60,8 @@ int main(void)
     struct nc_scene s;
     nc_test_scene(yaml, NULL, 0, &s);
     /* sum of radiance = irradiance * fx * fy (each pixel 1 / (fx fy) sr on axis) */
-    const double D = sqrt(3.3 * 3.3 + 1.7 * 1.7 + 1e8), want = 2.0 / 3.0 * s.sun.irradiance_w_m2 * pow(2 / D, 2) * 1e6;
+    const double D = sqrt(3.3 * 3.3 + 1.7 * 1.7 + 1e8), want = 2.0 / 3.0 * s.sun.irradiance_w_m2 * pow(2 / D, 2) * 1e6,
+                 J = s.sun.irradiance_w_m2;
     const double px = 31.5 + 1000 * 3.3 / 10000, py = 23.5 - 1000 * 1.7 / 10000;
     nc_scene_free(&s);
     const char *spp1[] = {"render.samples_per_pixel=1"}, *spp16[] = {"render.samples_per_pixel=16"};
@@ -66,6 +72,9 @@ int main(void)
            sum / want, cx, cy, px, py);
     CHECK(fabs(sum / want - 1) < 0.005, "1 spp: %.5f of the analytic flux", sum / want);
     CHECK(fabs(cx - px) < 0.01 && fabs(cy - py) < 0.01, "centroid (%.4f, %.4f)", cx, cy);
+    printf("its I/F: %.6f of pi L / J\n", iof_sum / (M_PI * sum / J));
+    CHECK(fabs(iof_sum / (M_PI * sum / J) - 1) < 1e-5, "a point body's I/F %.6g, pi L / J %.6g", iof_sum,
+          M_PI * sum / J);
     double sum16;
     shoot(spp16, 1, &sum16, &cx, &cy);
     printf("16 samples a pixel: %.6f; the same light as at 1 (%.2e apart)\n", sum16 / want, fabs(sum16 / sum - 1));

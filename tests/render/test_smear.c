@@ -1,7 +1,8 @@
 /* test_smear.c - motion during the exposure: a point moving a known number of
  * pixels spreads into a streak of that length with its total signal
  * conserved; a rolling shutter skews a vertical bar by the rate times the
- * readout time; without motion neither changes the image. */
+ * readout time; without motion neither changes the image; a camera inside
+ * a body's bounding sphere takes the time samples its view needs. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -166,5 +167,30 @@ int main(void)
     nc_frame_free(&fg);
     nc_frame_free(&fr);
     nc_scene_free(&s);
+
+    /* Inside a body's bounding sphere (a flat ellipsoid 800 m long, 16 m
+     * thick; the camera 100 m from its centre, 92 m from its face): the
+     * motion comes from the range the camera sees, not from no range at all
+     * (before, every exposure in there took the 256 time samples of an
+     * unbounded motion, even one of 0 s). At 1 m/s for 10 ms the face moves
+     * 0.11 px: one time sample; at 100 m/s 10.9 px, which needs 22 samples
+     * (K is estimated from half the least range seen: 64 at 64 strata); and
+     * 0 s takes one. */
+    const char *slab[] = {"bodies.0.shape={type: ellipsoid, radii_m: [400, 8, 8]}", "camera.position_m=[0, 0, -100]"};
+    const double speed[3] = {1, 100, 100}, expo[3] = {0.01, 0.01, 0};
+    const int kmin[3] = {1, 22, 1}, kmax[3] = {1, 64, 1};
+    for (int c = 0; c < 3; c++) {
+        nc_test_scene(yaml, slab, 2, &s);
+        s.camera.velocity_m_s = nc_v3(speed[c], 0, 0);
+        struct nc_exposure e = {.exposure_s = expo[c]};
+        struct nc_frame fs;
+        render(&s, &e, &fs, &k);
+        printf("inside a bounding sphere, 92 m from the face, %g m/s for %g s: %d time samples\n", speed[c], expo[c],
+               k);
+        CHECK(k >= kmin[c] && k <= kmax[c], "%g m/s for %g s: %d time samples, expected %d to %d", speed[c], expo[c],
+              k, kmin[c], kmax[c]);
+        nc_frame_free(&fs);
+        nc_scene_free(&s);
+    }
     return nc_test_end();
 }
