@@ -395,6 +395,15 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
      * PSF's half width), the PSF acts on that larger image, and the sensor
      * sees the middle. */
     cs->margin_px = cs->optics.psf.size > 1 ? cs->optics.psf.size / 2 : 0;
+    double at[2], frac; /* the lens must be unfolded over the margin too: its light came from the other side */
+    if ((rc = nc_camera_unfolded(geom, cs->margin_px, at, &frac)) > 0) {
+        struct nc_cfg_node *psf = om ? nc_cfg_get(om, "psf") : NULL;
+        rc = nc_cfg_error(psf ? psf : om ? om : root, "the PSF's margin (%d px around the image, drawn to spread "
+                          "light from outside the field) reaches where camera.distortion folds over (%s pixel (%g, "
+                          "%g)): its inverse is not unique there; a smaller PSF or a milder distortion",
+                          cs->margin_px, rc == 1 ? "at" : "towards", at[0], at[1]);
+        goto fail;
+    }
     cs->render_width_px = cs->width_px + 2 * cs->margin_px;
     cs->render_height_px = cs->height_px + 2 * cs->margin_px;
     size_t n = (size_t)cs->width_px * (size_t)cs->height_px;

@@ -104,36 +104,13 @@ distortion:;
             if ((rc = nc_cfg_double(dist, keys[i], -100, 100, vals[i])) < 0)
                 return rc;
         c->distorted = c->k1 != 0 || c->k2 != 0 || c->k3 != 0 || c->p1 != 0 || c->p2 != 0;
-        /* The inversion must be unique over the image: check the round trip at
-         * the corners and edge midpoints. */
-        const double pts[][2] = {{0, 0}, {c->width_px - 1.0, 0}, {0, c->height_px - 1.0},
-                                 {c->width_px - 1.0, c->height_px - 1.0}, {0.5 * c->width_px, 0}, {0, 0.5 * c->height_px}};
-        for (int i = 0; i < 6; i++) {
-            double x, y;
-            struct nc_vec3 d = nc_camera_ray(c, pts[i][0], pts[i][1]);
-            if (nc_camera_project(c, d, &x, &y) < 0 || fabs(x - pts[i][0]) > 1e-6 || fabs(y - pts[i][1]) > 1e-6)
-                return nc_cfg_error(dist, "this distortion cannot be inverted at pixel (%g, %g): the lens model folds "
-                                          "over inside the image",
-                                    pts[i][0], pts[i][1]);
-        }
-        /* ... and unfolded on the way there: the round trip holds for any root, also one beyond a fold (k1 -1.2,
-         * k2 0.5 over a 64 px frame of fx 44: pixels 48 and 49 of the middle row saw radii 0.55 and 1.22). Along
-         * the rays from the centre to the corners and the edges' midpoints, the map's Jacobian stays positive. */
-        const double far[8][2] = {{0, 0}, {c->width_px - 1.0, 0}, {0, c->height_px - 1.0},
-                                  {c->width_px - 1.0, c->height_px - 1.0}, {0.5 * c->width_px, 0},
-                                  {0.5 * c->width_px, c->height_px - 1.0}, {0, 0.5 * c->height_px},
-                                  {c->width_px - 1.0, 0.5 * c->height_px}};
-        for (int i = 0; i < 8; i++) {
-            const struct nc_vec3 d = nc_camera_ray(c, far[i][0], far[i][1]);
-            for (int k = 1; k <= 512; k++) {
-                double xd, yd, J[2][2];
-                distort(c, d.x * k / 512, d.y * k / 512, &xd, &yd, J);
-                if (!(J[0][0] * J[1][1] - J[0][1] * J[1][0] > 0))
-                    return nc_cfg_error(dist, "this distortion folds over inside the image (towards pixel (%g, %g), "
-                                              "at %.0f %% of the way): its inverse is not unique",
-                                        far[i][0], far[i][1], 100.0 * k / 512);
-            }
-        }
+        double at[2], frac;
+        if ((rc = nc_camera_unfolded(c, 0, at, &frac)) > 0)
+            return rc == 1 ? nc_cfg_error(dist, "this distortion cannot be inverted at pixel (%g, %g): the lens "
+                                                "model folds over inside the image", at[0], at[1])
+                           : nc_cfg_error(dist, "this distortion folds over inside the image (towards pixel (%g, "
+                                                "%g), at %.0f %% of the way): its inverse is not unique",
+                                          at[0], at[1], 100 * frac);
     }
     return 0;
 }
@@ -198,6 +175,39 @@ static void distort(const struct nc_camera *c, double x, double y, double *xd, d
         J[1][0] = 2 * x * y * drad + 2 * c->p1 * x + 2 * c->p2 * y;
         J[1][1] = rad + 2 * y * y * drad + 6 * c->p1 * y + 2 * c->p2 * x;
     }
+}
+
+int nc_camera_unfolded(const struct nc_camera *c, int margin_px, double at[2], double *frac)
+{
+    if (!c->distorted)
+        return 0;
+    /* The area samples reach: the pixels' edges, margin_px pixels beyond
+     * the image on every side; its corners and edges' midpoints. */
+    const double lo = -margin_px - 0.5, hx = c->width_px - 0.5 + margin_px, hy = c->height_px - 0.5 + margin_px;
+    const double pts[8][2] = {{lo, lo}, {hx, lo}, {lo, hy}, {hx, hy}, {0.5 * (lo + hx), lo}, {0.5 * (lo + hx), hy},
+                              {lo, 0.5 * (lo + hy)}, {hx, 0.5 * (lo + hy)}};
+    for (int i = 0; i < 8; i++) {
+        at[0] = pts[i][0], at[1] = pts[i][1];
+        double x, y;
+        /* the round trip: the inverse unique at that point ... */
+        const struct nc_vec3 d = nc_camera_ray(c, pts[i][0], pts[i][1]);
+        if (nc_camera_project(c, d, &x, &y) < 0 || fabs(x - pts[i][0]) > 1e-6 || fabs(y - pts[i][1]) > 1e-6)
+            return 1;
+        /* ... and unfolded on the way there: the round trip holds for any
+         * root, also one beyond a fold (k1 -1.2, k2 0.5 over a 64 px frame
+         * of fx 44: pixels 48 and 49 of the middle row saw radii 0.55 and
+         * 1.22), so along the ray from the centre the map's Jacobian stays
+         * positive */
+        for (int k = 1; k <= 512; k++) {
+            double xd, yd, J[2][2];
+            distort(c, d.x * k / 512, d.y * k / 512, &xd, &yd, J);
+            if (!(J[0][0] * J[1][1] - J[0][1] * J[1][0] > 0)) {
+                *frac = k / 512.0;
+                return 2;
+            }
+        }
+    }
+    return 0;
 }
 
 struct nc_vec3 nc_camera_ray(const struct nc_camera *c, double px, double py)

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "camera/camsys.h"
+#include "camera/load.h"
 #include "core/error.h"
 #include "render/image_io.h"
 #include "testutil.h"
@@ -191,5 +192,47 @@ int main(void)
           "a fold inside the image: %s", rc < 0 ? nc_errmsg() : "accepted");
     if (rc == 0)
         nc_scene_free(&s);
+    /* Samples reach half a pixel beyond the pixels' centres, and the PSF's
+     * margin more: k1 -0.1424 at fx 44 over 64 x 64 inverts at every pixel
+     * centre but not at the image's corner (-0.5, -0.5), where the inverse
+     * found the ray on the other side of the field (an outside check: 1162
+     * e- in a corner from a sphere 72 deg off the other way); k1 -0.12 is
+     * unfolded over the image but not over a sigma 2 px PSF's 10 px margin,
+     * and is over a 0.3 px one's. */
+    const char *fold3[] = {"camera.distortion={k1: -0.1424}"};
+    rc = nc_test_scene_rc("bodies: [{shape: {type: sphere, radius_m: 1}, material: {model: lambert, A: 0.1}}]\n"
+                          "sun: {direction: [1, 0, 0]}\n"
+                          "camera: {width_px: 64, height_px: 64, fx_px: 44, fy_px: 44,\n"
+                          "         position_m: [0, 0, -10], attitude_q: [1, 0, 0, 0]}\n",
+                          fold3, 1, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "cannot be inverted at pixel (-0.5, -0.5)"),
+          "a fold at the image's corner: %s", rc < 0 ? nc_errmsg() : "accepted");
+    if (rc == 0)
+        nc_scene_free(&s);
+    for (int m = 0; m < 2; m++) {
+        char yaml[1024];
+        snprintf(yaml, sizeof yaml,
+                 "bodies: [{shape: {type: sphere, radius_m: 1}, material: {model: lambert, A: 0.1}}]\n"
+                 "sun: {direction: [1, 0, 0]}\n"
+                 "camera: {width_px: 64, height_px: 64, fx_px: 44, fy_px: 44, distortion: {k1: -0.12},\n"
+                 "         position_m: [0, 0, -10], attitude_q: [1, 0, 0, 0]}\n"
+                 "optics: {f_number: 4, psf: {type: gaussian, sigma_px: %s}}\n"
+                 "sensor: {pixel_pitch_m: 5.5e-6}\n",
+                 m ? "0.3" : "2.0");
+        const char *path = nc_test_path("margin.yaml");
+        nc_test_write(path, yaml);
+        struct nc_camsys cs;
+        rc = nc_setup_load(path, NULL, 0, &s, &cs);
+        if (m == 0)
+            CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "optics.psf: the PSF's margin (10 px around the image") &&
+                      nc_test_contains(nc_errmsg(), "camera.distortion folds over (towards pixel (-10.5, -10.5))"),
+                  "a fold in the PSF's margin: %s", rc < 0 ? nc_errmsg() : "accepted");
+        else
+            CHECK(rc >= 0, "unfolded over a 0.3 px PSF's margin: %s", nc_errmsg());
+        if (rc >= 0) {
+            nc_camsys_free(&cs);
+            nc_scene_free(&s);
+        }
+    }
     return nc_test_end();
 }
