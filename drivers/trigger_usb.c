@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/random.h>
 
 #include "core/clock.h"
 #include "core/error.h"
@@ -263,6 +264,10 @@ static int usb_open(void *priv, struct nc_cfg_node *opts, const struct nc_trigge
     snprintf(u->serial, sizeof u->serial, "%s", serial ? serial : "");
     u->input = (int)input, u->strobe_out = (int)strobe, u->sync_ns = (int64_t)(sync_s * 1e9);
     u->dither = 0x2545f4914f6cdd1dull;
+    /* HELLO's tag from a random start: an INFO still queued in the adapter for a process before this one (one
+     * that died waiting for it) does not answer this one's HELLO */
+    if (getrandom(&u->tag, sizeof u->tag, 0) != (ssize_t)sizeof u->tag)
+        u->tag = (uint32_t)nc_mono_ns();
     if ((rc = libusb_init(&u->usb)) < 0) {
         u->usb = NULL;
         return nc_error(NC_EUNSUPPORTED, "usb trigger: libusb_init: %s", libusb_strerror(rc));
@@ -354,10 +359,9 @@ static int usb_control(void *priv, const char *request, void *arg)
     const struct nc_trigger_window *w = arg;
     struct nc_ut_msg m = {.type = NC_UT_STROBE, .line = (uint8_t)u->strobe_out};
     pthread_mutex_lock(&u->lock);
-    if (u->state == NC__USB_READY && !u->gone && nc_clock_map_to_device(&u->map, w->start_mono_ns, &m.t0_ns) == 0 &&
-        nc_clock_map_to_device(&u->map, w->end_mono_ns, &m.t1_ns) == 0 && nc__usb_send_msg(u, &m) == 0)
-        u->strobes++;
-    else
+    /* one sent is counted when its transfer is done (out_done: delivered, or skipped after all) */
+    if (!(u->state == NC__USB_READY && !u->gone && nc_clock_map_to_device(&u->map, w->start_mono_ns, &m.t0_ns) == 0 &&
+          nc_clock_map_to_device(&u->map, w->end_mono_ns, &m.t1_ns) == 0 && nc__usb_send_msg(u, &m) == 0))
         u->strobes_skipped++;
     pthread_mutex_unlock(&u->lock);
     return 0;

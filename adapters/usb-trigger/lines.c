@@ -191,6 +191,10 @@ void *lines_thread(void *arg)
         }
         if (p[0].revents & POLLIN)
             read_edges(a);
+        else if (p[0].revents & (POLLERR | POLLHUP | POLLNVAL)) { /* the chip went away: said once, not polled */
+            fprintf(stderr, "navcam-usb-adapter: the GPIO chip's events ended (the chip removed?): no more edges\n");
+            p[0].fd = -1;
+        }
     }
     for (int i = 0; i < a->n_out; i++)
         gpiod_line_set_value(a->out[i].line, !strcmp(a->strobe_active, "low"));

@@ -20,12 +20,24 @@
 static void LIBUSB_CALL out_done(struct libusb_transfer *t)
 {
     struct nc__usb_trig *u = t->user_data;
+    const int strobe = t->buffer[0] == NC_UT_STROBE; /* nc_ut_encode: the type first */
     pthread_mutex_lock(&u->lock);
     u->inflight--;
-    if (t->status == LIBUSB_TRANSFER_NO_DEVICE)
+    if (strobe && t->status == LIBUSB_TRANSFER_COMPLETED)
+        u->strobes++;
+    else if (strobe)
+        u->strobes_skipped++;
+    if (t->status == LIBUSB_TRANSFER_NO_DEVICE) {
         u->gone = 1;
-    else if (t->status != LIBUSB_TRANSFER_COMPLETED && t->status != LIBUSB_TRANSFER_CANCELLED)
+    } else if (t->status == LIBUSB_TRANSFER_TIMED_OUT) {
         nc_log_warn(LOG, "adapter %s: sending a request: %s", u->desc, libusb_error_name(t->status));
+    } else if (t->status != LIBUSB_TRANSFER_COMPLETED && t->status != LIBUSB_TRANSFER_CANCELLED) {
+        /* a stall, an I/O error: every request after it would fail as well (the clock map going stale), so the
+         * session ends as on the IN side, and the adapter is opened again with its halts cleared */
+        if (!u->gone)
+            u->session_error = (int)t->status;
+        u->gone = 1;
+    }
     pthread_mutex_unlock(&u->lock);
 }
 
@@ -172,15 +184,19 @@ static void LIBUSB_CALL in_done(struct libusb_transfer *t)
 
 /* ---- sessions (event thread) --------------------------------------------- */
 
-/* The adapter's interface on dev: 0 and its endpoints, or -1. */
+/* The adapter's interface on dev: 0 and its endpoints, -1 if it has none,
+ * -ENODEV if dev is gone (its configuration no longer readable). */
 static int find_interface(struct nc__usb_trig *u, libusb_device *dev)
 {
     struct libusb_device_descriptor dd;
     struct libusb_config_descriptor *cfg;
     if (libusb_get_device_descriptor(dev, &dd) < 0 || (u->vid >= 0 && (dd.idVendor != u->vid || dd.idProduct != u->pid)))
         return -1;
-    if (libusb_get_active_config_descriptor(dev, &cfg) < 0)
-        return -1;
+    snprintf(u->desc, sizeof u->desc, "%04x:%04x at bus %d device %d", dd.idVendor, dd.idProduct,
+             libusb_get_bus_number(dev), libusb_get_device_address(dev));
+    const int rc = libusb_get_active_config_descriptor(dev, &cfg);
+    if (rc < 0)
+        return rc == LIBUSB_ERROR_NO_DEVICE ? -ENODEV : -1;
     int found = -1;
     for (int i = 0; i < cfg->bNumInterfaces && found < 0; i++) {
         const struct libusb_interface_descriptor *d = &cfg->interface[i].altsetting[0];
@@ -201,17 +217,18 @@ static int find_interface(struct nc__usb_trig *u, libusb_device *dev)
             found = 0, u->iface = d->bInterfaceNumber;
     }
     libusb_free_config_descriptor(cfg);
-    snprintf(u->desc, sizeof u->desc, "%04x:%04x at bus %d device %d", dd.idVendor, dd.idProduct,
-             libusb_get_bus_number(dev), libusb_get_device_address(dev));
     return found;
 }
 
 int nc__usb_try_open(struct nc__usb_trig *u, libusb_device *dev)
 {
-    if (find_interface(u, dev) < 0)
+    int rc = find_interface(u, dev);
+    if (rc == -ENODEV) /* unplugged: libusb reads the configuration from sysfs, gone with the device */
+        return nc_error(-ENODEV, "usb trigger: adapter %s is gone", u->desc);
+    if (rc < 0)
         return 0;
     libusb_device_handle *h;
-    int rc = libusb_open(dev, &h);
+    rc = libusb_open(dev, &h);
     if (rc == LIBUSB_ERROR_NO_DEVICE)
         return nc_error(-ENODEV, "usb trigger: adapter %s is gone", u->desc);
     if (rc < 0)

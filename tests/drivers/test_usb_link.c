@@ -2,12 +2,30 @@
  * (drivers/usb/usb_link.h, docs/usb-trigger.md): a message of a type this
  * host does not know is skipped and counted as unknown, and its sequence
  * number is taken like any other's, so it is not a gap (lost); a real gap
- * is. The USB path itself is tested against the kernel's gadget drivers in
- * tests/vm. */
+ * is. A request whose OUT transfer ends on a stall ends the session (the
+ * adapter is opened again, its halts cleared), and a STROBE counts as sent
+ * only once its transfer is done. The USB path itself is tested against the
+ * kernel's gadget drivers in tests/vm. */
 #include <string.h>
 
 #include "drivers/usb/usb_link.h"
 #include "testutil.h"
+
+/* libusb's submission, taken here (the executable's symbol comes first):
+ * the transfer is kept, and ended by the test as libusb would end it. */
+static struct libusb_transfer *submitted;
+int libusb_submit_transfer(struct libusb_transfer *t)
+{
+    submitted = t;
+    return 0;
+}
+
+static void end_transfer(enum libusb_transfer_status status)
+{
+    submitted->status = status;
+    submitted->callback(submitted);
+    libusb_free_transfer(submitted); /* libusb would, by its flags */
+}
 
 static void put(uint8_t *buf, int type, uint32_t seq)
 {
@@ -32,5 +50,25 @@ int main(void)
     nc__usb_receive(&u, buf, NC_UT_MSG_BYTES, 0);
     CHECK(u.edges == 3 && u.lost == 2, "a gap of two: edges %lu, lost %lu (want 3, 2)", u.edges, u.lost);
     CHECK(u.nunsynced == 3, "edges before the first clock exchange are held: %d (want 3)", u.nunsynced);
+
+    static struct nc__usb_trig o;
+    pthread_mutex_init(&o.lock, NULL);
+    o.state = NC__USB_READY, o.ep_out = 0x02;
+    const struct nc_ut_msg strobe = {.type = NC_UT_STROBE, .t0_ns = 1000, .t1_ns = 2000};
+    CHECK(nc__usb_send_msg(&o, &strobe) == 0, "send");
+    end_transfer(LIBUSB_TRANSFER_COMPLETED);
+    CHECK(o.strobes == 1 && o.strobes_skipped == 0 && !o.gone, "a STROBE delivered: strobes %lu, skipped %lu, gone %d",
+          o.strobes, o.strobes_skipped, o.gone);
+    CHECK(nc__usb_send_msg(&o, &strobe) == 0, "send");
+    end_transfer(LIBUSB_TRANSFER_TIMED_OUT);
+    CHECK(o.strobes == 1 && o.strobes_skipped == 1 && !o.gone, "a STROBE timed out: strobes %lu, skipped %lu, gone %d",
+          o.strobes, o.strobes_skipped, o.gone);
+    CHECK(nc__usb_send_msg(&o, &strobe) == 0, "send");
+    end_transfer(LIBUSB_TRANSFER_STALL);
+    CHECK(o.strobes == 1 && o.strobes_skipped == 2 && o.gone && o.session_error == LIBUSB_TRANSFER_STALL,
+          "a STROBE stalled: strobes %lu, skipped %lu, gone %d, session error %d (want 1, 2, 1, stall)", o.strobes,
+          o.strobes_skipped, o.gone, o.session_error);
+    CHECK(o.inflight == 0, "transfers in flight: %d", o.inflight);
+    pthread_mutex_destroy(&o.lock);
     return nc_test_end();
 }
