@@ -60,7 +60,7 @@ void nc_frame_flip(struct nc_frame *f, int rows, int cols)
  * direction R (u, v, 1); the standard coordinates east and north of the
  * boresight b are u R_x . e + v R_y . e (e east) and the same with north:
  * linear in (u, v), so the CD matrix is exact. */
-static int wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out)
+int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out)
 {
     if (c->distorted)
         return 0;
@@ -230,7 +230,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
         extra[nextra++] = (struct nc_image_attr){"navcam:sumfile_utc", scene->camera.sumfile_utc};
     char wcsval[8][32];
     if (sky->on)
-        nextra += wcs_attrs(&scene->camera, wcsval, extra + nextra);
+        nextra += nc_shot_wcs_attrs(&scene->camera, wcsval, extra + nextra);
     for (int i = 0; i < nextra_in && nextra < 48; i++)
         extra[nextra++] = extra_in[i];
     if (rc >= 0 && q <= NC_Q_ROCK_ID)

@@ -106,11 +106,16 @@ static int file_submit(void *priv, const struct nc_frame_record *r)
     /* The sidecar has the wall-clock times; the image only what a rerun
      * reproduces, so that lock-step frame files are identical byte for byte. */
     int jl = nc_frame_record_json(r, 1, json, sizeof json), ml = nc_frame_record_json(r, 0, meta, sizeof meta);
-    const struct nc_image_attr attrs[] = {
-        {"navcam:quantity", "dn"}, {"navcam:units", "DN"}, {"navcam:adc_bits", adc}, {"navcam:frame", fr},
-        {"navcam:frame_record", ml > 0 ? meta : ""}, {"navcam:fits_row_order", f->bottom_up ? "bottom_up" : "top_down"},
-    };
-    int rc = nc_image_write_dn(path, r->dn, r->width_px, r->height_px, r->adc_bits, attrs, f->bottom_up ? 6 : 5);
+    /* the record's metadata (navcam render's of a dn frame), else the least a reader needs */
+    struct nc_image_attr attrs[72] = {
+        {"navcam:quantity", "dn"}, {"navcam:units", "DN"}, {"navcam:adc_bits", adc}, {"navcam:frame", fr}};
+    int n = 4;
+    if (r->attrs && r->nattrs > 0 && r->nattrs <= 70)
+        memcpy(attrs, r->attrs, sizeof *attrs * (size_t)r->nattrs), n = r->nattrs;
+    attrs[n++] = (struct nc_image_attr){"navcam:frame_record", ml > 0 ? meta : ""};
+    if (f->bottom_up)
+        attrs[n++] = (struct nc_image_attr){"navcam:fits_row_order", "bottom_up"};
+    int rc = nc_image_write_dn(path, r->dn, r->width_px, r->height_px, r->adc_bits, attrs, n);
     if (rc < 0)
         return rc;
     /* every line whole on disk when the frame is reported delivered: else the frame is not (a full disk) */

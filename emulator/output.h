@@ -15,6 +15,8 @@
 #include "core/pose.h"
 #include "emulator/trigger.h"
 
+struct nc_image_attr;
+
 /* Everything known about one delivered frame. The pixel buffers belong to
  * the emulator and are valid during submit() only. */
 struct nc_frame_record {
@@ -44,6 +46,12 @@ struct nc_frame_record {
     double render_ms, camera_ms; /* render (incl. smear) and camera model time */
     int width_px, height_px, adc_bits;
     const uint16_t *dn;          /* the digitised frame */
+    /* The frame's metadata as image attributes (render/image_io.h), as
+     * navcam render gives a dn frame's: the camera and Sun at its pose,
+     * the camera model, the detail, a celestial WCS with stars; valid
+     * during submit. */
+    const struct nc_image_attr *attrs;
+    int nattrs;
 };
 
 /* One JSON object (no newline) describing a record; returns its length or a

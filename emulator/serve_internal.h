@@ -25,6 +25,7 @@
 #include "emulator/timeline.h"
 #include "emulator/trigger.h"
 #include "navcam/protocol.h"
+#include "render/image_io.h"
 #include "render/render.h"
 #include "render/scene.h"
 
@@ -83,8 +84,11 @@ static inline void nc__job_exposure(const struct nc__job *j, int64_t *start_sim,
 
 /* A finished job on its way to the outputs: a frame, or (lock-step) a drop
  * that must be answered in request order. */
+#define NC__SLOT_ATTRS 48
 struct nc__slot {
     struct nc_frame_record rec;
+    struct nc_image_attr attrs[NC__SLOT_ATTRS]; /* rec.attrs, and their values */
+    char attr_text[30][200], attr_detail[3][40], attr_wcs[8][32];
     struct nc__job job;
     uint16_t *dn;
     int64_t render_start_mono_ns; /* the job left the queue and its pose was there: the render began */

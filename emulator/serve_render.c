@@ -11,7 +11,9 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "camera/load.h"
 #include "camera/quality.h"
+#include "camera/shot.h"
 #include "emulator/serve_internal.h"
 
 /* The next job, or 0 when the thread is to end (what is still queued then
@@ -198,6 +200,28 @@ struct stage {
     int full, end, inuse[2];
 };
 
+/* A frame's metadata as image attributes into sl (rec.attrs): those of
+ * navcam render's dn frame at its pose, with its camera model's settings,
+ * its detail, and a WCS when the scene has stars. */
+static int frame_attrs(const struct nc__emu *e, const struct staged *x, const struct nc_camsys *cs, uint64_t frame,
+                       struct nc__slot *sl)
+{
+    struct nc_scene at = e->scene; /* shallow: shares meshes and materials */
+    nc_scene_apply_pose(&at, &x->pose);
+    at.render = x->used;
+    int n = nc_frame_meta(&at, NC_Q_DN, sl->attrs, sl->attr_text, 24);
+    n += nc_camsys_meta(cs, x->j.exposure_s, frame, sl->attrs + n, sl->attr_text + 24, 6);
+    static const char *const detail[3] = {"navcam:lod_error_m", "navcam:boulder_min_m", "navcam:boulder_mesh_px"};
+    const double dv[3] = {x->lod_error_m, x->boulder_min_m, x->boulder_mesh_px};
+    for (int k = 0; k < 3; k++) {
+        snprintf(sl->attr_detail[k], sizeof sl->attr_detail[k], "%.17g", dv[k]);
+        sl->attrs[n++] = (struct nc_image_attr){detail[k], sl->attr_detail[k]};
+    }
+    if (e->sky.on)
+        n += nc_shot_wcs_attrs(&at.camera, sl->attr_wcs, sl->attrs + n);
+    return n;
+}
+
 /* The camera model of one rendered frame into a slot for the output thread. */
 static void finish_frame(struct stage *st, const struct staged *x)
 {
@@ -253,7 +277,8 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .hit_samples = x->hits, .back_samples = x->back_hits, .in_rock1 = x->in_rock + 1,
         .in_rock_body = x->in_rock_body, .render_ms = (x->t1 - x->t0) * 1e-6,
         .camera_ms = (t2 - t1) * 1e-6, .width_px = cs.width_px, .height_px = cs.height_px,
-        .adc_bits = cs.sensor.adc_bits, .dn = sl->dn};
+        .adc_bits = cs.sensor.adc_bits, .dn = sl->dn, .attrs = sl->attrs};
+    sl->rec.nattrs = frame_attrs(e, x, &cs, frame, sl);
     fill_slot(e);
 }
 

@@ -64,6 +64,29 @@ cmp -s <(strip "$tmp/lock1/frames/frames.jsonl") <(strip "$tmp/lock2/frames/fram
   || bad "lock-step metadata differs: $(diff <(strip "$tmp/lock1/frames/frames.jsonl") <(strip "$tmp/lock2/frames/frames.jsonl") | head -3)"
 [ "$(wc -l < "$tmp/lock1/frames/frames.jsonl")" -eq 8 ] && ok || bad "sidecar lines"
 [ "$(json "$tmp/lock1/stats.json" "d['frames_delivered']")" = 8 ] && ok || bad "stats: frames_delivered"
+# Each file carries navcam render's metadata of a dn frame (docs/config.md), at the frame's own pose.
+python3 - "$tmp/lock1/frames" <<'PY' && ok || bad "file output metadata"
+import json, struct, sys, zlib
+d = open(sys.argv[1] + "/frame_000003.png", "rb").read()
+i, meta = 8, {}
+while i < len(d):  # the PNG's text chunks
+    n, = struct.unpack(">I", d[i:i + 4]); t, c = d[i + 4:i + 8], d[i + 8:i + 8 + n]; i += 12 + n
+    if t == b"tEXt":
+        k, v = c.split(b"\0", 1); meta[k.decode()] = v.decode("latin1")
+    elif t in (b"zTXt", b"iTXt"):
+        k, r = c.split(b"\0", 1)
+        if t == b"zTXt":
+            meta[k.decode()] = zlib.decompress(r[1:]).decode("latin1")
+        else:
+            comp, r = r[0], r[2:]; r = r.split(b"\0", 2)[2]; meta[k.decode()] = (zlib.decompress(r) if comp else r).decode()
+rec = [json.loads(l) for l in open(sys.argv[1] + "/frames.jsonl")][3]
+need = ["navcam:exposure_s", "navcam:gain_e_per_dn", "navcam:bias_dn", "navcam:intrinsics_fx_fy_cx_cy_px",
+        "navcam:sun_direction_scene", "navcam:light", "navcam:frame"]
+assert all(k in meta for k in need), sorted(meta)
+pos = json.loads(meta["navcam:camera_position_m"])
+assert max(abs(a - b) for a, b in zip(pos, rec["pose"]["camera_position_m"])) < 1e-6, (pos, rec["pose"])
+assert float(meta["navcam:exposure_s"]) == rec["exposure_s"] and meta["navcam:frame"] == "3", meta
+PY
 
 # A sidecar that cannot be written (a full disk: /dev/full) fails the file
 # output's submit, frame by frame, with the reason; the frames go on to the
