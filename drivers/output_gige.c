@@ -124,6 +124,7 @@ static void control_ended(struct gige *g)
 {
     const int acquiring = arv_fake_camera_get_acquisition_status(g->fc) != 0;
     nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_ACQUISITION, 0);
+    nc__gige_reg_set(g->fc, REG_ACQ_COMMAND, REG_ACQ_NONE); /* nor a command of the client gone */
     nc__gige_reg_set(g->fc, REG_HOST_PORT, 0);
     nc_log_info("output/gige", "the controlling client released the device or its heartbeat (%u ms) ran out%s",
                 nc__gige_reg(g->fc, REG_HEARTBEAT), acquiring ? ": acquisition stopped, stream channel closed" : "");
@@ -151,10 +152,18 @@ static void *poll_thread(void *arg)
             nc__gige_probe(g->probe_fd);
             next_probe_ns = now + 250000000;
         }
+        /* AcquisitionStart and Stop write a command the device takes here, the last one written: so a Stop
+         * and a Start since the last look are a restart (the status register alone, 1 before and after, hid
+         * it: frames exposed before the Start went out after it). */
+        const uint32_t cmd = nc__gige_reg(g->fc, REG_ACQ_COMMAND);
+        if (cmd != REG_ACQ_NONE) {
+            nc__gige_reg_set(g->fc, REG_ACQ_COMMAND, REG_ACQ_NONE);
+            nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_ACQUISITION, cmd == 1);
+        }
         int acquiring = controlled && arv_fake_camera_get_acquisition_status(g->fc) != 0;
         check_registers(g);
         apply_settings(g);
-        if (acquiring && !atomic_load(&g->acq_start_ns))
+        if (acquiring && (cmd == 1 || !atomic_load(&g->acq_start_ns)))
             atomic_store(&g->acq_start_ns, nc_mono_ns());
         else if (!acquiring)
             atomic_store(&g->acq_start_ns, 0);
@@ -215,6 +224,15 @@ static int stream_dest(struct gige *g, struct sockaddr_in *dest)
     return ok;
 }
 
+/* Since when frames are sent (CLOCK_MONOTONIC; 0: none): a command the
+ * poll thread has not taken yet decides, a Stop at once, a Start (a restart)
+ * from its look on (the settings written before it apply from then). */
+static int64_t sending_from(struct gige *g)
+{
+    const uint32_t cmd = nc__gige_reg(g->fc, REG_ACQ_COMMAND);
+    return cmd == 0 ? 0 : cmd == 1 ? INT64_MAX : atomic_load(&g->acq_start_ns);
+}
+
 /* Each frame packed is sent at once, unless no client acquires or it was
  * exposed before AcquisitionStart. */
 static void *sender_thread(void *arg)
@@ -230,7 +248,7 @@ static void *sender_thread(void *arg)
         g->ready = g->send;
         g->send = k;
         g->pending = 0;
-        int64_t start = atomic_load(&g->acq_start_ns);
+        int64_t start = sending_from(g);
         struct sockaddr_in dest;
         if (!start || !stream_dest(g, &dest)) {
             g->not_acquiring++;
@@ -392,6 +410,7 @@ static int gige_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     static const uint32_t pfs[] = {PF_MONO8, PF_MONO12, PF_MONO16};
     nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, pfs[fmt]);
     nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_MODE, 1);
+    nc__gige_reg_set(g->fc, REG_ACQ_COMMAND, REG_ACQ_NONE);
     /* Loopback carries big packets; real links start at the safe 1400. */
     nc__gige_reg_set(g->fc, REG_PACKET_SIZE, (uint32_t)(packet > 0 ? packet : !strcmp(g->iface, "lo") ? 65000 : 1400));
     /* Internal: the device itself never streams (its software trigger is
@@ -427,7 +446,7 @@ static int gige_submit(void *priv, const struct nc_frame_record *r)
     /* buf[fill] is submit()'s alone: laid out, handed over, then packed
      * while the sender streams the rows already done. Only submit() swaps
      * fill, so no one writes buf[k] meanwhile. */
-    int64_t start = atomic_load(&g->acq_start_ns);
+    int64_t start = sending_from(g);
     int early = start && r->exposure_start_mono_ns < start;
     int ok = start && !early && layout(g, r) == 0, k = g->fill;
     pthread_mutex_lock(&g->lock);

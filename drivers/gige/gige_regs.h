@@ -23,6 +23,7 @@ enum {
     REG_TRIGGER_DELAY = 0x1020,  /* double, us */
     REG_RESULTING_RATE = 0x1028, /* double, Hz, read-only */
     REG_META_ROWS = 0x1030,      /* 0 or 1 */
+    REG_ACQ_COMMAND = 0x1034,    /* a client writes 1 (AcquisitionStart) or 0 (Stop); REG_ACQ_NONE once taken */
     REG_PACKET_SIZE = 0xd04,     /* stream channel 0: packet size in the low 16 bits */
     REG_HOST_PORT = 0xd00,       /* stream channel 0: the client's port in the low 16 bits */
     REG_HEARTBEAT = 0x938,       /* heartbeat timeout, ms */
@@ -33,6 +34,8 @@ enum {
     REG_VERSION = 0x88,
     REG_INFO = 0xa8,
 };
+
+#define REG_ACQ_NONE 0xffffffffu
 
 uint32_t nc__gige_reg(ArvFakeCamera *fc, uint32_t a);
 void nc__gige_reg_set(ArvFakeCamera *fc, uint32_t a, uint32_t v);

@@ -26,6 +26,7 @@ const char *navcam, *tmp;
 unsigned long incomplete; /* buffers that arrived with missing packets */
 unsigned long unfilled;   /* buffers Aravis gave back as they were (start()'s datagrams) */
 uint64_t frame_id;        /* of the last frame next_frame returned */
+uint64_t frame_arrived_ns; /* its system timestamp */
 int rig_packet_size = 8192;
 
 int rig_args(int argc, char **argv, const char *prog)
@@ -206,6 +207,7 @@ int next_frame(struct stream *st, double timeout_s, uint8_t *out, uint64_t *ts)
             if (ts)
                 *ts = arv_buffer_get_timestamp(b);
             frame_id = arv_buffer_get_frame_id(b);
+            frame_arrived_ns = arv_buffer_get_system_timestamp(b);
         }
         arv_stream_push_buffer(st->s, b);
         if (ok)

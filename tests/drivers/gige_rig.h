@@ -19,6 +19,7 @@ extern const char *navcam, *tmp;
 extern unsigned long incomplete; /* buffers that arrived with missing packets */
 extern unsigned long unfilled;   /* buffers Aravis gave back as they were (start()'s datagrams) */
 extern uint64_t frame_id;        /* the GVSP block id of the last frame next_frame returned */
+extern uint64_t frame_arrived_ns; /* and when Aravis received it (its system timestamp: CLOCK_REALTIME, ns) */
 extern int rig_packet_size;      /* GevSCPSPacketSize open_camera sets (8192: frames of several packets); 0: as is */
 
 struct stream {
