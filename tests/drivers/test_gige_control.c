@@ -6,7 +6,8 @@
  * settings written with one that is not are undone alone, TLParamsLocked
  * locks the payload's features, every bound reads; the timestamp
  * counter's latch and reset; at poll_hz 1 the device idles between its
- * checks, and frames of a region beyond the sensor are not sent; clear
+ * checks, and frames of a region beyond the sensor are not sent; a Stop
+ * and a Start at once send no frame exposed before the Start; clear
  * errors for a missing
  * interface, a taken port 3956, an invalid XML (also one named relative to
  * a configuration file in another directory), a model name too long, a
@@ -16,6 +17,7 @@
 #include <arpa/inet.h>
 #include <arv.h>
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -344,6 +346,61 @@ static void test_slow_poll(void)
     free(log);
 }
 
+/* A restart at once: AcquisitionStop; ExposureTime=X; AcquisitionStart
+ * with no pause (the device's poll, 1 ms apart, sees at most the last),
+ * at 30 phases of the 100 ms frame period, the render slowed to 16 samples a
+ * pixel so that a frame is being made at many of them: no frame exposed
+ * before the start arrives after it (its first packet more than 2 ms
+ * after the call), and every frame exposed after it has exposure X. Before,
+ * the device saw no restart (its acquisition register read 1 before and
+ * after) and sent frames exposed up to 20 ms before the start 12-37 ms
+ * after it (an outside check: 8 of 45 restarts). */
+static void test_quick_restart(void)
+{
+    char dir[4096];
+    pid_t pid;
+    ArvCamera *c = begin("quick_restart", "outputs=[{driver: gige, pixel_format: Mono12, metadata_row: 1}]",
+                         "render.samples_per_pixel=16", &pid, dir, sizeof dir);
+    if (!c)
+        return;
+    uint8_t *img = malloc((size_t)W * (H + 1) * 2);
+    struct stream st = {0};
+    CHECK(start(c, &st) == 0, "stream");
+    int late = 0, wrong = 0, after = 0;
+    for (int k = 0; k < 30; k++) {
+        next_frame(&st, 3, img, NULL);
+        usleep((useconds_t)(k * 3400)); /* 0 to 99 ms after a frame */
+        const double x_us = k % 2 ? 1000 : 2000;
+        arv_camera_stop_acquisition(c, NULL);
+        arv_camera_set_exposure_time(c, x_us, NULL);
+        struct timespec rt;
+        clock_gettime(CLOCK_REALTIME, &rt);
+        const uint64_t t_start = (uint64_t)(now_s() * 1e9), real_ns = (uint64_t)rt.tv_sec * 1000000000u + rt.tv_nsec;
+        arv_camera_start_acquisition(c, NULL);
+        for (double t0 = now_s(); now_s() - t0 < 0.25;) {
+            uint64_t ts, frame;
+            double ex, gain;
+            if (next_frame(&st, 0.1, img, &ts) < 0 || meta(img, &frame, &ex, &gain) < 0)
+                continue;
+            if (ts < t_start && frame_arrived_ns > real_ns + 2000000) {
+                late++;
+                printf("frame %llu exposed %.3f ms before AcquisitionStart, received %.3f ms after it\n",
+                       (unsigned long long)frame, (t_start - ts) * 1e-6, (frame_arrived_ns - real_ns) * 1e-6);
+            }
+            after += ts >= t_start;
+            wrong += ts >= t_start && fabs(ex - x_us * 1e-6) > 1e-9;
+        }
+    }
+    printf("30 restarts at once: %d frames exposed after them, %d of them with the old exposure; %d exposed "
+           "before a start and received after it\n", after, wrong, late);
+    CHECK(late == 0 && wrong == 0 && after >= 30, "restarts at once: %d late, %d with the old exposure, %d after",
+          late, wrong, after);
+    finish(c, &st);
+    free(img);
+    g_object_unref(c);
+    CHECK(stop(pid) == 0, "serve did not exit cleanly");
+}
+
 int main(int argc, char **argv)
 {
     if (rig_args(argc, argv, "test_gige_control") < 0)
@@ -352,6 +409,7 @@ int main(int argc, char **argv)
     test_lockstep_units();
     test_timestamps();
     test_slow_poll();
+    test_quick_restart();
     test_errors();
     return nc_test_end();
 }
