@@ -59,6 +59,20 @@ static void check_kernel(const char *label, const struct nc_psf *psf)
            s - 1, rel, worst);
 }
 
+/* A 64 x 64 camera of fx 44 px with set refused, the message holding want. */
+static void refused_64(const char *set, const char *want)
+{
+    struct nc_scene s;
+    int rc = nc_test_scene_rc("bodies: [{shape: {type: sphere, radius_m: 1}, material: {model: lambert, A: 0.1}}]\n"
+                              "sun: {direction: [1, 0, 0]}\n"
+                              "camera: {width_px: 64, height_px: 64, fx_px: 44, fy_px: 44,\n"
+                              "         position_m: [0, 0, -10], attitude_q: [1, 0, 0, 0]}\n",
+                              &set, 1, &s);
+    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), want), "%s: %s", set, rc < 0 ? nc_errmsg() : "accepted");
+    if (rc == 0)
+        nc_scene_free(&s);
+}
+
 int main(void)
 {
     struct nc_psf g = {0}, a = {0}, im = {0};
@@ -182,16 +196,7 @@ int main(void)
           "folding distortion: %s", nc_errmsg());
     /* One that folds between the centre and the edge, while every tested pixel's ray projects back onto it (the
      * inverse found a root beyond the fold: pixels 48 and 49 of the middle row saw radii 0.55 and 1.22). */
-    const char *fold2[] = {"camera.distortion={k1: -1.2, k2: 0.5}"};
-    rc = nc_test_scene_rc("bodies: [{shape: {type: sphere, radius_m: 1}, material: {model: lambert, A: 0.1}}]\n"
-                          "sun: {direction: [1, 0, 0]}\n"
-                          "camera: {width_px: 64, height_px: 64, fx_px: 44, fy_px: 44,\n"
-                          "         position_m: [0, 0, -10], attitude_q: [1, 0, 0, 0]}\n",
-                          fold2, 1, &s);
-    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "camera.distortion: this distortion folds over inside the image"),
-          "a fold inside the image: %s", rc < 0 ? nc_errmsg() : "accepted");
-    if (rc == 0)
-        nc_scene_free(&s);
+    refused_64("camera.distortion={k1: -1.2, k2: 0.5}", "camera.distortion: this distortion folds over inside the image");
     /* Samples reach half a pixel beyond the pixels' centres, and the PSF's
      * margin more: k1 -0.1424 at fx 44 over 64 x 64 inverts at every pixel
      * centre but not at the image's corner (-0.5, -0.5), where the inverse
@@ -199,16 +204,7 @@ int main(void)
      * e- in a corner from a sphere 72 deg off the other way); k1 -0.12 is
      * unfolded over the image but not over a sigma 2 px PSF's 10 px margin,
      * and is over a 0.3 px one's. */
-    const char *fold3[] = {"camera.distortion={k1: -0.1424}"};
-    rc = nc_test_scene_rc("bodies: [{shape: {type: sphere, radius_m: 1}, material: {model: lambert, A: 0.1}}]\n"
-                          "sun: {direction: [1, 0, 0]}\n"
-                          "camera: {width_px: 64, height_px: 64, fx_px: 44, fy_px: 44,\n"
-                          "         position_m: [0, 0, -10], attitude_q: [1, 0, 0, 0]}\n",
-                          fold3, 1, &s);
-    CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "cannot be inverted at pixel (-0.5, -0.5)"),
-          "a fold at the image's corner: %s", rc < 0 ? nc_errmsg() : "accepted");
-    if (rc == 0)
-        nc_scene_free(&s);
+    refused_64("camera.distortion={k1: -0.1424}", "cannot be inverted at pixel (-0.5, -0.5)");
     for (int m = 0; m < 2; m++) {
         char yaml[1024];
         snprintf(yaml, sizeof yaml,
