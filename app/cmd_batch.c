@@ -483,8 +483,8 @@ int main(int argc, char **argv)
                 break;
             continue;
         }
-        if (access(path, F_OK) == 0) { /* finished by another process while we took the lock */
-            unlock_row(lock, fd, 0);
+        if (access(path, F_OK) == 0) { /* finished by another process while we took the lock: done */
+            unlock_row(lock, fd, 1);
             skipped++;
             continue;
         }
