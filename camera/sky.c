@@ -161,8 +161,8 @@ int nc_sky_draw(struct nc_sky *sky, struct nc_renderer *r, const struct nc_camsy
         sky->dir_jyear = jyear;
     }
     /* Candidates: within the cone around the boresight that holds the
-     * frame's corners, grown by the turn over the exposure, the aberration
-     * (v / c) and two pixels. */
+     * frame's corners, grown by the turn over the exposure and a rolling
+     * shutter's rows, the aberration (v / c) and two pixels. */
     const struct nc_vec3 z = nc_quat_rotate(c->attitude_q, nc_v3(0, 0, 1));
     double half = 0;
     const double cx[2] = {-0.5, c->width_px - 0.5}, cy[2] = {-0.5, c->height_px - 0.5};
@@ -171,7 +171,8 @@ int nc_sky_draw(struct nc_sky *sky, struct nc_renderer *r, const struct nc_camsy
         half = fmax(half, acos(fmin(1, d.z)));
     }
     const struct nc_vec3 v = nc_v3_add(sky->observer_velocity_m_s, c->velocity_m_s);
-    half += 0.5 * nc_v3_norm(c->angular_velocity_rad_s) * exposure_s + 1.1 * nc_v3_norm(v) / NC_LIGHT_M_S +
+    const double rows_s = cs->sensor.shutter == NC_SHUTTER_ROLLING ? cs->sensor.line_time_s * c->height_px : 0;
+    half += 0.5 * nc_v3_norm(c->angular_velocity_rad_s) * (exposure_s + rows_s) + 1.1 * nc_v3_norm(v) / NC_LIGHT_M_S +
             2.0 / fmin(c->fx_px, c->fy_px);
     const double cmin = half < M_PI ? cos(half) : -1;
     size_t m = 0;
@@ -180,7 +181,8 @@ int nc_sky_draw(struct nc_sky *sky, struct nc_renderer *r, const struct nc_camsy
             continue;
         sky->pts[m++] = (struct nc_point_source){nc_aberrate(sky->dir[i], v), sky->e_w_m2[i], 0}; /* no I/F */
     }
-    long hidden = 0, drawn = nc_render_points(r, s, exposure_s, sky->pts, m, 1, f, &hidden);
+    const double line_s = cs->sensor.shutter == NC_SHUTTER_ROLLING ? cs->sensor.line_time_s : 0;
+    long hidden = 0, drawn = nc_render_points(r, s, exposure_s, line_s, sky->pts, m, 1, f, &hidden);
     if (drawn < 0)
         return (int)drawn;
     st->considered = (long)m;

@@ -35,7 +35,7 @@ static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double
     return in;
 }
 
-long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s,
+long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s, double line_time_s,
                       const struct nc_point_source *p, size_t n, int occlusion, struct nc_frame *f, long *hidden)
 {
     const struct nc_camera *c = &s->camera;
@@ -50,13 +50,17 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
      * at infinity: only the camera's rotation moves them). */
     const double turn_px = nc_v3_norm(c->angular_velocity_rad_s) * exposure_s * fmax(c->fx_px, c->fy_px);
     const int K = turn_px > 0 ? (int)fmin(4096, ceil(turn_px / 0.1)) : 1;
+    /* A rolling shutter exposes row y (y - (H - 1) / 2) line_time_s after
+     * the middle row: the camera has turned by then, by up to roll_px. */
+    const double mid_row = 0.5 * (c->height_px - 1),
+                 roll_px = nc_v3_norm(c->angular_velocity_rad_s) * line_time_s * mid_row * fmax(c->fx_px, c->fy_px);
     /* Only the stars the frame can show: projected at mid-exposure within
      * the frame, grown by the turn and a pixel. */
     size_t *in = malloc((n ? n : 1) * sizeof *in), m = 0;
     if (!in)
         return nc_error(-ENOMEM, "out of memory");
     const struct nc_quat to_cam = nc_quat_conj(c->attitude_q);
-    const double grow = turn_px + 2;
+    const double grow = turn_px + roll_px + 2;
     for (size_t i = 0; i < n; i++) {
         double x, y;
         struct nc_vec3 d = nc_quat_rotate(to_cam, p[i].dir);
@@ -80,9 +84,20 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                 ++*hidden;
                 continue;
             }
+            /* the time of the row it falls on (rolling): found by fixed-point
+             * iteration, each step the row where the camera of the last sees it
+             * (the turn over a row's time is a small fraction of a row) */
+            double t_row = 0;
+            for (int it = 0; it < 4 && roll_px > 0; it++) {
+                double x, y;
+                const struct nc_quat a = nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, t_row);
+                if (nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), q->dir), &x, &y) < 0)
+                    break;
+                t_row = (y - mid_row) * line_time_s;
+            }
             int shown = 0;
             for (int k = 0; k < K; k++) {
-                double dt = exposure_s * ((k + 0.5) / K - 0.5), x, y;
+                double dt = t_row + exposure_s * ((k + 0.5) / K - 0.5), x, y;
                 struct nc_quat a = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt)
                                            : c->attitude_q;
                 struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), q->dir); /* camera frame */

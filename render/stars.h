@@ -63,11 +63,14 @@ struct nc_point_source {
  * one at mid-exposure): each is drawn where the lens images it, its
  * irradiance spread bilinearly over the four pixels around that point (so
  * the centroid keeps the sub-pixel position) as radiance E / Omega_pixel
- * (and I/F, iof_per_radiance times that); over the exposure (exposure_s, the camera's rates) it moves as the camera
- * turns, in steps of at most 0.1 px. With occlusion, a body in front hides
- * it (traced with r's ray tracer at the scene's poses). Returns how many were drawn (in the
+ * (and I/F, iof_per_radiance times that); over the exposure (exposure_s,
+ * the camera's rates) it moves as the camera turns, in steps of at most
+ * 0.1 px; with a rolling shutter (line_time_s > 0; 0: global) its exposure
+ * is that of the row it falls on, (row - (H - 1) / 2) line_time_s from the
+ * middle one. With occlusion, a body in front hides it (traced with r's
+ * ray tracer at the scene's poses). Returns how many were drawn (in the
  * frame and not hidden), or < 0 on error; *hidden counts the hidden ones. */
-long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s,
+long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s, double line_time_s,
                       const struct nc_point_source *p, size_t n, int occlusion, struct nc_frame *f, long *hidden);
 
 /* The scene's bodies that are smaller than a pixel from its camera (their

@@ -101,8 +101,9 @@ static struct shot shoot(struct nc_vec3 look, struct nc_vec3 rock, struct nc_vec
 }
 
 /* The scene file of the last shoot with sets, its sky drawn at the times
- * t[0..nt-1] (s) in turn with one nc_sky; the electrons of the last. */
-static float *draw_at(const char **sets, int nsets, const double *t, int nt)
+ * t[0..nt-1] (s) in turn with one nc_sky, exposures of expo s; the
+ * electrons of the last. */
+static float *draw_at(const char **sets, int nsets, const double *t, int nt, double expo)
 {
     const char *path = nc_test_path("scene.yaml");
     struct nc_scene s;
@@ -118,12 +119,12 @@ static float *draw_at(const char **sets, int nsets, const double *t, int nt)
     struct nc_sky_stats st;
     nc_renderer_init(&r, &drawn, 2);
     nc_frame_alloc(&f, drawn.camera.width_px, drawn.camera.height_px);
-    struct nc_exposure ex = {.exposure_s = 1.0};
+    struct nc_exposure ex = {.exposure_s = expo};
     float *e = malloc(sizeof(float) * 96 * 96);
     for (int k = 0; k < nt; k++)
         CHECK(nc_render_exposure(&r, &drawn, &ex, &f, NULL) == 0 &&
-                  nc_sky_draw(&sky, &r, &cs, &drawn, t[k], 1.0, &f, &st) == 0 &&
-                  nc_camsys_electrons(&cs, f.radiance, 1.0, e) == 0,
+                  nc_sky_draw(&sky, &r, &cs, &drawn, t[k], expo, &f, &st) == 0 &&
+                  nc_camsys_electrons(&cs, f.radiance, expo, e) == 0,
               "render: %s", nc_errmsg());
     nc_frame_free(&f);
     nc_renderer_free(&r);
@@ -347,7 +348,8 @@ int main(void)
     const char *fsets[] = {fset};
     CHECK(nc_star_cat_write(&one, nc_test_path("fast.ncs")) == 0, "write");
     const double t0[] = {0}, t3[] = {3 * 86400.0}, t03[] = {0, 3 * 86400.0};
-    float *f0 = draw_at(fsets, 1, t0, 1), *f3 = draw_at(fsets, 1, t3, 1), *f03 = draw_at(fsets, 1, t03, 2);
+    float *f0 = draw_at(fsets, 1, t0, 1, 1.0), *f3 = draw_at(fsets, 1, t3, 1, 1.0),
+          *f03 = draw_at(fsets, 1, t03, 2, 1.0);
     const double pm_as = (centroid_x(f0) - centroid_x(f3)) * 1e-5 / AS, want_as = 10 * 3 / 365.25;
     printf("proper motion in 3 days: %.4f arcsec (%.4f expected); drawn after a frame at 0: %s\n", pm_as, want_as,
            memcmp(f3, f03, sizeof(float) * 96 * 96) ? "differs" : "the same bytes");
@@ -356,6 +358,28 @@ int main(void)
     free(f0);
     free(f3);
     free(f03);
+
+    /* 5c. A rolling shutter: a star 30 rows below the middle one is exposed
+     * 30 line times (1e-5 s each) after it; the camera turning at 0.02
+     * rad/s about its y axis has moved it -0.02 * 3e-4 * 1e5 = -0.6 px along
+     * x by then, against the global shutter's frame (an exposure of 1 ms: 2
+     * px of smear about that place). */
+    {
+        const struct nc_vec3 north = nc_v3_unit(nc_v3_sub(nc_v3(0, 0, 1), nc_v3_scale(look, look.z)));
+        const struct nc_vec3 up30 = nc_v3_unit(nc_v3_add(look, nc_v3_scale(north, 30e-5)));
+        char at[200];
+        snprintf(at, sizeof at, "camera.look_at_m=[%.17g, %.17g, %.17g]", up30.x, up30.y, up30.z);
+        const char *glob[] = {at, "camera.angular_velocity_rad_s=[0, 0.02, 0]", "stars.limit_mag=6"};
+        const char *roll[] = {at, "camera.angular_velocity_rad_s=[0, 0.02, 0]", "stars.limit_mag=6",
+                              "sensor.shutter=rolling", "sensor.line_time_s=1e-5"};
+        const double at0[] = {0};
+        float *fg = draw_at(glob, 3, at0, 1, 1e-3), *fr = draw_at(roll, 5, at0, 1, 1e-3);
+        const double dx = centroid_x(fr) - centroid_x(fg);
+        printf("rolling shutter: a star 30 rows below the middle moved %.4f px along x (-0.6 expected)\n", dx);
+        CHECK(fabs(dx + 0.6) < 0.02, "a star under a rolling shutter moved %.4f px, expected -0.6", dx);
+        free(fg);
+        free(fr);
+    }
 
     /* 5b. limit_mag auto, by its definition: the faintest V whose star of
      * the most favourable colour (B-V within -0.4..2.0) gives 0.1 of the
