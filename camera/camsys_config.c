@@ -444,7 +444,12 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
         for (int x = 0; x < cs->render_width_px; x++) {
             struct nc_vec3 d = nc_camera_ray(geom, x - m, y - m);
             double theta = acos(d.z / nc_v3_norm(d));
-            cs->response[(size_t)y * (size_t)cs->render_width_px + (size_t)x] = (float)(k * vignette(o, theta));
+            /* a distorted pixel sees the solid angle nc_camera_pixel_sr_at gives, not the pinhole's (1/fx fy
+             * times cos^3, in k and V): flux is conserved (a barrel lens's edge pixels see more sky) */
+            const double omega = geom->distorted ? nc_camera_pixel_sr_at(geom, x - m, y - m) /
+                                                       nc_camera_pixel_sr(geom->fx_px, geom->fy_px, d)
+                                                 : 1.0;
+            cs->response[(size_t)y * (size_t)cs->render_width_px + (size_t)x] = (float)(k * vignette(o, theta) * omega);
         }
     for (int y = 0; y < cs->height_px; y++)
         for (int x = 0; x < cs->width_px; x++) {

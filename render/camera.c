@@ -232,6 +232,18 @@ struct nc_vec3 nc_camera_ray(const struct nc_camera *c, double px, double py)
     return nc_v3(x, y, 1.0);
 }
 
+double nc_camera_pixel_sr_at(const struct nc_camera *c, double px, double py)
+{
+    const struct nc_vec3 d = nc_camera_ray(c, px, py);
+    double det = 1;
+    if (c->distorted) { /* a pixel's area in the undistorted plane is 1 / (fx fy det J) */
+        double xd, yd, J[2][2];
+        distort(c, d.x, d.y, &xd, &yd, J);
+        det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+    }
+    return nc_camera_pixel_sr(c->fx_px, c->fy_px, d) / det;
+}
+
 int nc_camera_project(const struct nc_camera *c, struct nc_vec3 d, double *px, double *py)
 {
     if (!(d.z > 0))

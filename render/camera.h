@@ -60,15 +60,20 @@ static inline double nc_camera_pixel_sr(double fx_px, double fy_px, struct nc_ve
     return pow(nc_v3_norm(dir) / dir.z, -3.0) / (fx_px * fy_px);
 }
 
-/* The ray (camera frame, unnormalised, z = 1) that the lens images onto
- * pixel coordinates (x, y): the distortion is inverted exactly (Newton). */
 /* Whether c's distortion has a unique inverse over the area its samples
  * reach (pixel centres +- 0.5 px, and margin_px pixels more on every side;
  * c is the image's camera, without the margin): 0 if so; 1 if the inverse
  * fails at pixel at[] (the image's pixels: negative in the margin); 2 if
  * the map folds frac of the way from the centre towards at[]. */
 int nc_camera_unfolded(const struct nc_camera *c, int margin_px, double at[2], double *frac);
+
+/* The ray (camera frame, unnormalised, z = 1) that the lens images onto
+ * pixel coordinates (x, y): the distortion is inverted exactly (Newton). */
 struct nc_vec3 nc_camera_ray(const struct nc_camera *c, double x, double y);
+/* The solid angle (sr) pixel (x, y) of c sees through its lens: the
+ * pinhole's at its true ray (nc_camera_ray) over the distortion's area
+ * Jacobian there (det of d(xd, yd) / d(x, y)); the pinhole's without one. */
+double nc_camera_pixel_sr_at(const struct nc_camera *c, double x, double y);
 /* Pixel coordinates of camera-frame direction d (d.z > 0); returns -1 when
  * d is behind the camera. */
 int nc_camera_project(const struct nc_camera *c, struct nc_vec3 d, double *x, double *y);

@@ -20,8 +20,8 @@ static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double
     const int W = f->width_px, H = f->height_px;
     const int x0 = (int)floor(x), y0 = (int)floor(y);
     const double ax = x - x0, ay = y - y0;
-    /* the true ray's solid angle: with distortion the pinhole's direction at (x, y) is not the star's */
-    const double omega = nc_camera_pixel_sr(c->fx_px, c->fy_px, nc_camera_ray(c, x, y));
+    /* the solid angle the pixel sees through the lens (its true ray's, over the distortion's area Jacobian) */
+    const double omega = nc_camera_pixel_sr_at(c, x, y);
     const double L = e / omega, w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
     int in = 0;
     for (int k = 0; k < 4; k++) {
@@ -127,16 +127,22 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
     unsigned char point[NC_MAX_BODIES] = {0};
     int n = 0;
     memset(r->as_point, 0, sizeof r->as_point);
+    /* Traced, a body must meet a sample whatever its place: one through each
+     * pixel's centre (one sample a pixel) misses a disk under sqrt 2 px
+     * across (centred on a pixel corner), n x n jittered strata one under
+     * 2 sqrt 2 / n (one that holds no whole stratum): under that it is a point. */
+    const int strata = (int)lround(sqrt((double)s->render.samples_per_pixel));
+    const double px_min = strata <= 1 ? M_SQRT2 : fmax(1.0, 2 * M_SQRT2 / strata);
     for (int b = 0; b < s->nbodies; b++) {
         const struct nc_vec3 rel = nc_v3_sub(s->body[b].position_m, c->position_m);
         const double d = nc_v3_norm(rel), R = s->body[b].bounding_radius_m;
         const double px = 2 * asin(R / d) * fmax(c->fx_px, c->fy_px); /* its angular diameter in pixels */
-        if (d > R && px >= 1.0 && R / d < NC_RESOLVED_MIN_RAD)
+        if (d > R && px >= px_min && R / d < NC_RESOLVED_MIN_RAD)
             return nc_error(NC_ERANGE, "body '%s' is %.3g px across but its bounding sphere spans only %.3g rad "
                             "(%.3g m at %.3g m): the float rays (6e-8 rad a step) cannot trace a body under %g rad; "
-                            "under one pixel it is drawn as a point, which takes a focal length under %.3g px",
-                            s->body[b].name, px, R / d, R, d, NC_RESOLVED_MIN_RAD, 0.5 / asin(R / d));
-        if (!(d > R) || px >= 1.0)
+                            "under %.3g px it is drawn as a point, which takes a focal length under %.3g px",
+                            s->body[b].name, px, R / d, R, d, NC_RESOLVED_MIN_RAD, px_min, 0.5 * px_min / asin(R / d));
+        if (!(d > R) || px >= px_min)
             continue;
         enum { Z = 32 };
         const struct nc_vec3 dir = nc_v3_scale(rel, 1 / d);

@@ -59,6 +59,51 @@ static void check_kernel(const char *label, const struct nc_psf *psf)
            s - 1, rel, worst);
 }
 
+/* The electrons of a Lambert sphere 6 px across, 30 deg off the axis, seen
+ * through distortion k1 (no PSF, 64 samples a pixel), summed. */
+static double sphere_electrons(double k1)
+{
+    char yaml[1024];
+    const double th = 30 * M_PI / 180, d = 1e4, radius = d * sin(atan(3.0 / 100));
+    snprintf(yaml, sizeof yaml,
+             "bodies: [{shape: {type: sphere, radius_m: %.17g}, material: {model: lambert, A: 0.5},\n"
+             "          position_m: [%.17g, 0, %.17g]}]\n"
+             "sun: {direction: [%.17g, 0, %.17g]}\n"
+             "camera: {width_px: 128, height_px: 96, focal_length_m: 0.001, pixel_pitch_m: 1.0e-5,\n"
+             "         distortion: {k1: %g}, position_m: [0, 0, 0], attitude_q: [1, 0, 0, 0]}\n"
+             "render: {samples_per_pixel: 64}\n"
+             "optics: {f_number: 2.8, vignetting: cos4, psf: {type: none}}\n",
+             radius, d * sin(th), d * cos(th), -sin(th), -cos(th), k1);
+    const char *path = nc_test_path("resolved.yaml");
+    nc_test_write(path, yaml);
+    struct nc_scene s;
+    struct nc_camsys cs;
+    double sum = 0;
+    if (nc_setup_load(path, NULL, 0, &s, &cs) < 0) {
+        CHECK(0, "k1 %g: %s", k1, nc_errmsg());
+        return 0;
+    }
+    struct nc_scene drawn = s;
+    nc_camsys_render_camera(&cs, &s.camera, &drawn.camera);
+    struct nc_renderer r;
+    struct nc_frame f;
+    struct nc_exposure ex = {.exposure_s = 0.01};
+    const size_t n = (size_t)drawn.camera.width_px * drawn.camera.height_px;
+    float *e = malloc(n * sizeof *e);
+    CHECK(e && nc_renderer_init(&r, &drawn, 2) == 0 && nc_frame_alloc(&f, drawn.camera.width_px,
+                                                                      drawn.camera.height_px) == 0 &&
+              nc_render_exposure(&r, &drawn, &ex, &f, NULL) == 0 && nc_camsys_electrons(&cs, f.radiance, 0.01, e) == 0,
+          "k1 %g: %s", k1, nc_errmsg());
+    for (size_t i = 0; e && i < n; i++)
+        sum += e[i];
+    free(e);
+    nc_frame_free(&f);
+    nc_renderer_free(&r);
+    nc_camsys_free(&cs);
+    nc_scene_free(&s);
+    return sum;
+}
+
 /* A 64 x 64 camera of fx 44 px with set refused, the message holding want. */
 static void refused_64(const char *set, const char *want)
 {
@@ -205,6 +250,16 @@ int main(void)
      * unfolded over the image but not over a sigma 2 px PSF's 10 px margin,
      * and is over a 0.3 px one's. */
     refused_64("camera.distortion={k1: -0.1424}", "cannot be inverted at pixel (-0.5, -0.5)");
+    /* The lens conserves flux: a barrel (k1 -0.15) or pincushion (+0.1)
+     * lens changes how many pixels a body 30 deg off the axis covers and the
+     * solid angle each sees, not the electrons it gives (an outside check:
+     * 0.807 and 1.136 of them before the pixels' solid angle came into the
+     * response, when the same body drawn as a point gave 1.000). */
+    const double e0 = sphere_electrons(0), eb = sphere_electrons(-0.15), ep = sphere_electrons(0.1);
+    printf("a sphere 6 px across 30 deg off the axis: electrons through k1 -0.15 and +0.1 are %.4f and %.4f of "
+           "those without distortion\n", eb / e0, ep / e0);
+    CHECK(fabs(eb / e0 - 1) < 0.005 && fabs(ep / e0 - 1) < 0.005, "flux through distortion: %.4f, %.4f", eb / e0,
+          ep / e0);
     for (int m = 0; m < 2; m++) {
         char yaml[1024];
         snprintf(yaml, sizeof yaml,

@@ -79,6 +79,14 @@ int main(void)
     shoot(spp16, 1, &sum16, &cx, &cy);
     printf("16 samples a pixel: %.6f; the same light as at 1 (%.2e apart)\n", sum16 / want, fabs(sum16 / sum - 1));
     CHECK(fabs(sum16 / sum - 1) < 1e-6, "1 and 16 samples a pixel: %.6f vs %.6f", sum / want, sum16 / want);
+    /* 1.2 px across, centred on a pixel corner: the centres nearest it 0.71
+     * px away, so one sample a pixel met none (no light at all); a point. */
+    const char *corner[] = {"bodies.0.position_m=[0, 0, 10000]", "bodies.0.shape={type: sphere, radius_m: 6}",
+                            "render.samples_per_pixel=1"};
+    shoot(corner, 3, &sum, &cx, &cy);
+    const double want6 = 2.0 / 3.0 * J * pow(6 / 1e4, 2) * 1e6;
+    printf("1.2 px across on a pixel corner, 1 sample a pixel: %.6f of p J (R/D)^2\n", sum / want6);
+    CHECK(fabs(sum / want6 - 1) < 0.005, "1.2 px on a pixel corner: %.5f of the analytic flux", sum / want6);
     shoot(front, 2, &sum, &cx, &cy);
     printf("behind a black sphere: %.3g of the flux\n", sum / want);
     CHECK(sum < 1e-9 * want, "a body in front hides it: %.3g", sum / want);
