@@ -123,6 +123,15 @@ int nc_cfg_int(struct nc_cfg_node *parent, const char *key, long min, long max, 
     char *end;
     errno = 0;
     long v = strtol(n->value, &end, 10);
+    if (end != n->value && (*end == '.' || *end == 'e' || *end == 'E') && !errno) {
+        /* a whole number written as a decimal (1e3, 64.0): taken when it is one exactly */
+        errno = 0;
+        const double d = nc_strtod_decimal(n->value, &end);
+        if (!*end && !errno && d == floor(d) && fabs(d) <= 9007199254740992.0)
+            v = (long)d;
+        else
+            end = n->value;
+    }
     if (end == n->value || *end || errno)
         return nc_cfg_error(n, "expected a whole number, got \"%s\"", n->value);
     if (v < min || v > max)

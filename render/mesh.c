@@ -37,7 +37,7 @@ int nc_mesh_check_extent(struct nc_mesh *m, const char *what)
 {
     for (size_t i = 0; i < m->nv; i++) {
         const double *p = m->v + 3 * i, r = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-        if (!(r <= NC_MESH_MAX_M)) {
+        if (!(r <= NC_MESH_MAX_M * (1 + 1e-9))) { /* a globe of the largest radius, to its vertices' rounding */
             nc_mesh_free(m);
             return nc_error(NC_EMESH, "%s: vertex %zu (counted from 1) lies %g m from the origin, beyond %g m "
                             "(a wrong unit or scale?)", what, i + 1, r, NC_MESH_MAX_M);

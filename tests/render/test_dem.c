@@ -170,6 +170,15 @@ static void check_globe(void)
     CHECK(ok && far_from_equator > 1000 && s.body[0].shape == NC_SHAPE_MESH, "globe radii off the map (%zu vertices)",
           far_from_equator);
     nc_scene_free(&s);
+    /* the largest radius a globe takes, 1e10 m, at subdivisions 4: its vertices a rounding beyond it (refused) */
+    for (int i = 0; i < MW * MH; i++)
+        map[i] = 0;
+    CHECK(nc_image_write(file, map, MW, MH, NULL, 0, NULL) == 0, "%s", nc_errmsg());
+    const char *largest[] = {"bodies[0].shape.radius_m=1e10", "camera.position_m=[3e10, 0, 0]"};
+    const int rc = nc_test_scene_rc(yaml, largest, 2, &s);
+    CHECK(rc >= 0, "a globe of radius 1e10 m: %s", nc_errmsg());
+    if (rc >= 0)
+        nc_scene_free(&s);
     /* errors name the key */
     const char *base = "bodies:\n  - shape: {type: dem, file: nowhere.fits}\n    material: {model: lambert, A: 0.1}\n"
                        "sun: {direction: [1, 0, 0]}\ncamera: {width_px: 8, height_px: 8, fx_px: 8, fy_px: 8, "
