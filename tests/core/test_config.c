@@ -58,6 +58,19 @@ int main(void)
     CHECK(s.camera.cx_px == 31.5 && s.camera.cy_px == 23.5, "centred principal point (%g, %g)", s.camera.cx_px,
           s.camera.cy_px);
     CHECK(s.sun.irradiance_w_m2 == 1361.0, "1 au irradiance %g", s.sun.irradiance_w_m2);
+    { /* a whole number written as a decimal that is whole is taken; one that is not, refused */
+        const char *sci[] = {"camera.width_px=6.4e1", "camera.height_px=48.0"};
+        struct nc_scene w;
+        const int rc = nc_test_scene_rc(base, sci, 2, &w);
+        CHECK(rc == 0 && w.camera.width_px == 64 && w.camera.height_px == 48, "width 6.4e1, height 48.0: %s",
+              rc ? nc_errmsg() : "other values");
+        if (rc == 0)
+            nc_scene_free(&w);
+        const char *half[] = {"camera.width_px=64.5"}, *huge[] = {"camera.width_px=1e400"};
+        expect_error("a whole number 64.5", NULL, NULL, half, 1, "camera.width_px: expected a whole number, got \"64.5\"",
+                     NULL);
+        expect_error("a whole number 1e400", NULL, NULL, huge, 1, "expected a whole number, got \"1e400\"", NULL);
+    }
     nc_scene_free(&s);
 
     expect_error("unknown key", "  width_px: 64\n", "  width_px: 64\n  exposure: 3\n", NULL, 0,
