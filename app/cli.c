@@ -2,6 +2,7 @@
 #include "app/cli.h"
 
 #include <arpa/inet.h>
+#include <ctype.h>
 #include <errno.h>
 #include <getopt.h>
 #include <libgen.h>
@@ -34,9 +35,14 @@ int nc_cli_fail(void)
 int nc_cli_getopt(int argc, char *const argv[], const char *shortopts, const struct option *opts)
 {
     const int c = getopt_long(argc, argv, shortopts, opts, NULL);
-    /* a value of its own argument (not --output=--x or -o--x, which say what they mean) */
-    if (c == -1 || c == '?' || !optarg || optind < 2 || optarg != argv[optind - 1] || strncmp(optarg, "--", 2) != 0 ||
-        !optarg[2])
+    /* a value of its own argument (not --output=--x or -o--x, which say what they mean) that is a long option,
+     * or one of this command's short ones (-q; a negative number, -1, stays a value) */
+    if (c == -1 || c == '?' || !optarg || optind < 2 || optarg != argv[optind - 1])
+        return c;
+    const int is_long = !strncmp(optarg, "--", 2) && optarg[2],
+              is_short = optarg[0] == '-' && isalpha((unsigned char)optarg[1]) && !optarg[2] &&
+                         strchr(shortopts, optarg[1]);
+    if (!is_long && !is_short)
         return c;
     fprintf(stderr, "%s: %s needs a value, got the option '%s'\n", name, argv[optind - 2], optarg);
     return '?';

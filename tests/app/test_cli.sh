@@ -149,6 +149,8 @@ expect 2 "navcam render: unrecognized option '--bogus'" -- "$navcam" render --bo
 expect 2 "navcam render: --set needs a value, got the option '--set'" -- "$navcam" render --set --set a=1 -o x.exr
 expect 2 "navcam batch: -o needs a value, got the option '--json'" -- "$navcam" batch builtin:approach -o --json
 expect 2 "navcam pose send: --host needs a value, got the option '--port'" -- "$navcam" pose send --host --port 1
+expect 2 "navcam render: -o needs a value, got the option '-q'" -- "$navcam" render -o -q iof
+expect 2 "navcam render: --set needs a value, got the option '-j'" -- "$navcam" render --set -j -o x.exr
 expect 0 "wrote --x.png" -- env -C "$tmp" "$navcam" render --output=--x.png "${small[@]}" # attached: as written
 expect 0 "navcam stars info INDEX" -- "$navcam" stars info --help
 # Number options: the whole argument a number in range, else exit 2 naming it.
