@@ -351,7 +351,8 @@ static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
                 return rc;
             continue;
         }
-        if (nc__cfg_is_null(c)) { /* key: null takes the base's key out */
+        /* key: null (~, or nothing after the colon: YAML's null too) takes the base's key out */
+        if (nc__cfg_is_null(c) || (c->kind == NC_CFG_SCALAR && c->value && !c->value[0] && !c->quoted)) {
             node_remove(b, old);
             continue;
         }

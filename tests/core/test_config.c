@@ -349,9 +349,10 @@ int main(void)
     nc_test_write(path, "base: builtin:default\ncamera:\n  width_px: 64\n  height_px: forty\n");
     rc = nc_scene_load(path, NULL, 0, &s);
     CHECK(rc < 0 && nc_test_contains(nc_errmsg(), "over.yaml:4: camera.height_px"), "overlay error: %s", nc_errmsg());
-    /* key: null in the file laid over takes the base's key out: the look-at
-     * camera of the default scene becomes one given by its attitude */
-    nc_test_write(path, "base: builtin:default\ncamera:\n  look_at_m: null\n  up: ~\n  attitude_q: [1, 0, 0, 0]\n");
+    /* key: null in the file laid over takes the base's key out (~, and a
+     * key with nothing after it: an error before): the look-at camera of
+     * the default scene becomes one given by its attitude */
+    nc_test_write(path, "base: builtin:default\ncamera:\n  look_at_m: ~\n  up:\n  attitude_q: [1, 0, 0, 0]\n");
     nc_cfg_init(&cfg);
     rc = nc_cfg_load_scene(&cfg, path, NULL, 0);
     if (rc >= 0)
