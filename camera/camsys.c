@@ -40,8 +40,8 @@ static void scale_row(const float *restrict radiance, const float *restrict resp
 int nc_camsys_electrons(const struct nc_camsys *cs, const float *radiance, double exposure_s, float *electrons)
 {
     if (!(cs->sensor.pixel_pitch_m > 0))
-        return nc_error(NC_ECONFIG, "electrons and DN need the pixel pitch: set camera.focal_length_m with "
-                                    "camera.pixel_pitch_m, or sensor.pixel_pitch_m");
+        return nc_error(NC_ECONFIG, "%s: electrons and DN need the pixel pitch: set camera.focal_length_m with "
+                                    "camera.pixel_pitch_m, or sensor.pixel_pitch_m", cs->where);
     const int RW = cs->render_width_px, RH = cs->render_height_px, m = cs->margin_px;
     if (cs->optics.psf.size <= 1) { /* no margin: straight into the sensor's image */
         scale_row(radiance, cs->response, exposure_s, (size_t)RW * (size_t)RH, electrons);

@@ -82,6 +82,7 @@ struct nc_camsys {
      * reaches the edge pixels as through a real lens. */
     int margin_px, render_width_px, render_height_px;
     double exposure_s;           /* default exposure (config `exposure.time_s`) */
+    char where[320];             /* the camera section's file, line and path, for later errors */
     float *response;             /* e- per (W m^-2 sr^-1) per second, per rendered pixel (optics, QE, vignetting) */
     float *prnu_map;             /* 1 + PRNU pattern, per sensor pixel */
     float *dark_map;             /* e-/s per sensor pixel at the operating temperature */

@@ -372,6 +372,11 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
     cs->width_px = geom->width_px;
     cs->height_px = geom->height_px;
     cs->exposure_s = 0.01;
+    const struct nc_cfg_node *cam = nc_cfg_get(root, "camera");
+    if (cam)
+        nc_cfg_where(cam, cs->where, sizeof cs->where);
+    else
+        snprintf(cs->where, sizeof cs->where, "camera");
     struct nc_cfg_node *om = NULL, *sm = NULL, *em = NULL;
     int rc;
     if ((rc = nc_cfg_map(root, "optics", &om)) < 0 || (rc = nc_cfg_map(root, "sensor", &sm)) < 0 ||

@@ -154,7 +154,7 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
         if ((rc = nc_quat_look_at(c->position_m, target, up, &c->attitude_q)) < 0) {
             char why[256];
             snprintf(why, sizeof why, "%s", nc_errmsg());
-            return nc_cfg_key_error(map, "look_at_m", "%s", why);
+            return nc_cfg_key_error(map, hu ? "up" : "look_at_m", "%s (from position_m to look_at_m)", why);
         }
     } else if (!hq) {
         return nc_cfg_missing(map, "attitude_q", "[w, x, y, z] camera-to-scene, or look_at_m");

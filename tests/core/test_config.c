@@ -71,6 +71,11 @@ int main(void)
                      NULL);
         expect_error("a whole number 1e400", NULL, NULL, huge, 1, "expected a whole number, got \"1e400\"", NULL);
     }
+    { /* an 'up' along the line of sight is blamed on up, where it was given */
+        const char *up[] = {"camera.attitude_q=null", "camera.look_at_m=[0, 0, 0]", "camera.up=[0, 0, 1]"};
+        expect_error("up along the line of sight", NULL, NULL, up, 3, "--set camera.up=[0, 0, 1]: camera.up: look-at",
+                     "parallel to the line of sight");
+    }
     nc_scene_free(&s);
 
     expect_error("unknown key", "  width_px: 64\n", "  width_px: 64\n  exposure: 3\n", NULL, 0,
