@@ -44,13 +44,13 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
             enum nc_quantity q, double exposure_s, double t_sim_s, uint64_t frame_no, const char *path,
             const struct nc_image_attr *extra, int nextra, struct nc_shot_info *info);
 
-/* The geometry planes (render.h, enum nc_geom_plane) of scene at pixel
- * centres: one sample a pixel, direct light only, no time samples; then
- * mirrored as the stored image is. geom: NC_GEOM_PLANES x w x h floats. */
 /* A celestial WCS (TAN, ICRS) of camera c's stored image as FITS
  * attributes ("fits:CTYPE1", ...) into out[14], their numbers' text in
  * val; 0 (none) for a distorted camera. Returns how many. */
 int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out);
+/* The geometry planes (render.h, enum nc_geom_plane) of scene at pixel
+ * centres: one sample a pixel, direct light only, no time samples; then
+ * mirrored as the stored image is. geom: NC_GEOM_PLANES x w x h floats. */
 int nc_shot_geometry(struct nc_renderer *r, const struct nc_scene *scene, float *geom, int32_t *rock_id);
 
 #endif

@@ -341,6 +341,11 @@ int nc__cfg_is_null(const struct nc_cfg_node *v)
             !strcmp(v->value, "~"));
 }
 
+int nc__cfg_is_null_or_empty(const struct nc_cfg_node *v)
+{
+    return nc__cfg_is_null(v) || (v->kind == NC_CFG_SCALAR && v->value && !v->value[0] && !v->quoted);
+}
+
 static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
 {
     for (size_t i = 0; i < n->nchild; i++) {
@@ -352,7 +357,7 @@ static int overlay_node(struct nc_cfg_node *b, struct nc_cfg_node *n)
             continue;
         }
         /* key: null (~, or nothing after the colon: YAML's null too) takes the base's key out */
-        if (nc__cfg_is_null(c) || (c->kind == NC_CFG_SCALAR && c->value && !c->value[0] && !c->quoted)) {
+        if (nc__cfg_is_null_or_empty(c)) {
             node_remove(b, old);
             continue;
         }

@@ -54,6 +54,8 @@ struct nc_cfg_node *nc__cfg_find(struct nc_cfg_node *map, const char *key);
 /* Whether a scalar is YAML's null (null, Null, NULL, ~ unquoted), which --set and a
  * file laid over another take as "leave this key out" (config.c). */
 int nc__cfg_is_null(const struct nc_cfg_node *v);
+/* ... or a key with nothing after it (an unquoted empty scalar: YAML's null in a file). */
+int nc__cfg_is_null_or_empty(const struct nc_cfg_node *v);
 /* Edit distance of two keys, two swapped neighbours counting one (config_read.c). */
 size_t nc__cfg_edits(const char *a, const char *b);
 /* The one of names[0..n-1] nearest key within a third of its letters'

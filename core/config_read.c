@@ -242,8 +242,7 @@ static int vcfg_error(const struct nc_cfg_node *node, const char *key, const cha
     if (!node) /* no place to name (a caller's nc_cfg_get of an absent key) */
         return key ? nc_error(NC_ECONFIG, "config: %s: %s", key, msg) : nc_error(NC_ECONFIG, "config: %s", msg);
     /* A plain file's key: null (or nothing, or ~) is a value, not the default. */
-    if (!key && node->kind == NC_CFG_SCALAR && node->value &&
-        (nc__cfg_is_null(node) || (!node->value[0] && !node->quoted)))
+    if (!key && nc__cfg_is_null_or_empty(node))
         snprintf(msg + strlen(msg), sizeof msg - strlen(msg), " (%s: give a value, or leave the key out for its "
                  "default)", node->value[0] ? "YAML's null" : "no value");
     nc_cfg_path(node, path, sizeof path);

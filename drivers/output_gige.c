@@ -157,6 +157,11 @@ static void *poll_thread(void *arg)
          * it: frames exposed before the Start went out after it). */
         const uint32_t cmd = nc__gige_reg(g->fc, REG_ACQ_COMMAND);
         if (cmd != REG_ACQ_NONE) {
+            /* what the senders go by (sending_from) decided before the command is cleared: a Start sends
+             * nothing until its settings are applied and its time taken below, a Stop nothing at once.
+             * (A command written between the read above and the clear is lost, as a TriggerSoftware latch
+             * can be: Aravis's registers are plain memory, with no exchange.) */
+            atomic_store(&g->acq_start_ns, cmd == 1 ? INT64_MAX : 0);
             nc__gige_reg_set(g->fc, REG_ACQ_COMMAND, REG_ACQ_NONE);
             nc__gige_reg_set(g->fc, ARV_FAKE_CAMERA_REGISTER_ACQUISITION, cmd == 1);
         }
@@ -202,7 +207,7 @@ static int layout(struct gige *g, const struct nc_frame_record *r)
                                        .timestamp_ns = nc__gige_clock_at(&g->clock, r->exposure_start_mono_ns),
                                        .ready = &g->packed[k]};
     g->rec[k] = *r;
-    g->rec[k].dn = NULL;
+    g->rec[k].dn = NULL, g->rec[k].attrs = NULL, g->rec[k].nattrs = 0; /* the submit's alone */
     return 0;
 }
 

@@ -153,7 +153,7 @@ static void *usb_thread(void *arg)
         }
         if (u->state == NC__USB_HELLO_SENT && !u->gone && now >= u->next_sync_ns) {
             /* An adapter still starting up: ask again every second. */
-            struct nc_ut_msg hello = {.type = NC_UT_HELLO, .tag = ++u->tag};
+            struct nc_ut_msg hello = {.type = NC_UT_HELLO, .tag = nc__usb_next_tag(u)};
             u->hello_tag = hello.tag;
             nc__usb_send_msg(u, &hello);
             u->next_sync_ns = now + 1000000000;
@@ -176,6 +176,8 @@ static void *usb_thread(void *arg)
         }
         if (arrived) {
             int rc = nc__usb_try_open(u, arrived);
+            if (rc == -ENODEV && !from_retry)
+                rc = 0; /* a device that came and went at once */
             pthread_mutex_lock(&u->lock);
             const int left = from_retry && rc == -ENODEV; /* unplugged, though udev has not said so yet */
             if (from_retry)
@@ -234,7 +236,8 @@ static int open_first(struct nc__usb_trig *u)
         return nc_error(NC_EUNSUPPORTED, "usb trigger: listing USB devices: %s", libusb_strerror((int)n));
     int rc = 0;
     for (ssize_t i = 0; i < n && rc == 0; i++)
-        rc = nc__usb_try_open(u, list[i]);
+        if ((rc = nc__usb_try_open(u, list[i])) == -ENODEV)
+            rc = 0; /* a device gone while listed: not ours to name (nothing identified it as the adapter) */
     libusb_free_device_list(list, 1);
     if (rc != 0)
         return rc < 0 ? rc : 0;

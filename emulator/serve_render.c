@@ -217,6 +217,7 @@ static int frame_attrs(const struct nc__emu *e, const struct staged *x, const st
         snprintf(sl->attr_detail[k], sizeof sl->attr_detail[k], "%.17g", dv[k]);
         sl->attrs[n++] = (struct nc_image_attr){detail[k], sl->attr_detail[k]};
     }
+    at.camera.flip_rows = at.camera.flip_cols = 0; /* the emulator's frames are the view, unmirrored */
     if (e->sky.on)
         n += nc_shot_wcs_attrs(&at.camera, sl->attr_wcs, sl->attrs + n);
     return n;

@@ -154,7 +154,9 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
         if ((rc = nc_quat_look_at(c->position_m, target, up, &c->attitude_q)) < 0) {
             char why[256];
             snprintf(why, sizeof why, "%s", nc_errmsg());
-            return nc_cfg_key_error(map, hu ? "up" : "look_at_m", "%s (from position_m to look_at_m)", why);
+            /* the target on the camera is look_at_m's fault; an 'up' zero or along the sight, up's if given */
+            const int up_at_fault = hu && !nc_v3_is_zero(nc_v3_sub(target, c->position_m));
+            return nc_cfg_key_error(map, up_at_fault ? "up" : "look_at_m", "%s (from position_m to look_at_m)", why);
         }
     } else if (!hq) {
         return nc_cfg_missing(map, "attitude_q", "[w, x, y, z] camera-to-scene, or look_at_m");

@@ -63,9 +63,16 @@ int nc__usb_send_msg(struct nc__usb_trig *u, const struct nc_ut_msg *m)
     return 0;
 }
 
+uint32_t nc__usb_next_tag(struct nc__usb_trig *u)
+{
+    if (!++u->tag) /* 0 is no request's (a reply of tag 0 matches none) */
+        ++u->tag;
+    return u->tag;
+}
+
 void nc__usb_send_time_req(struct nc__usb_trig *u)
 {
-    struct nc_ut_msg m = {.type = NC_UT_TIME_REQ, .tag = ++u->tag};
+    struct nc_ut_msg m = {.type = NC_UT_TIME_REQ, .tag = nc__usb_next_tag(u)};
     const unsigned k = u->nreq++ % NC__USB_N_REQ;
     u->req[k].tag = m.tag;
     u->req[k].t1 = nc_mono_ns();
@@ -263,7 +270,7 @@ int nc__usb_try_open(struct nc__usb_trig *u, libusb_device *dev)
         if (libusb_submit_transfer(u->in[i]) == 0)
             u->inflight++;
     }
-    struct nc_ut_msg hello = {.type = NC_UT_HELLO, .tag = ++u->tag};
+    struct nc_ut_msg hello = {.type = NC_UT_HELLO, .tag = nc__usb_next_tag(u)};
     u->hello_tag = hello.tag;
     u->state = NC__USB_HELLO_SENT;
     u->next_sync_ns = nc_mono_ns() + 1000000000; /* when HELLO is sent again, unanswered */

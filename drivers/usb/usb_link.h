@@ -76,6 +76,8 @@ void nc__usb_receive(struct nc__usb_trig *u, const uint8_t *buf, int len, int64_
 
 /* Queue one message to the adapter. Lock held. */
 int nc__usb_send_msg(struct nc__usb_trig *u, const struct nc_ut_msg *m);
+/* The next request tag (HELLO, TIME_REQ): the last plus one, never 0. Lock held. */
+uint32_t nc__usb_next_tag(struct nc__usb_trig *u);
 /* Send a clock exchange's request. Lock held. */
 void nc__usb_send_time_req(struct nc__usb_trig *u);
 /* Open dev if it is the adapter asked for and start a session (HELLO

@@ -348,10 +348,12 @@ static void test_slow_poll(void)
 
 /* A restart at once: AcquisitionStop; ExposureTime=X; AcquisitionStart
  * with no pause (the device's poll, 1 ms apart, sees at most the last),
- * at 30 phases of the 100 ms frame period, the render slowed to 16 samples a
+ * at 30 phases of the 100 ms frame period, the render slowed to 64 samples a
  * pixel so that a frame is being made at many of them: no frame exposed
- * before the start arrives after it (its first packet more than 2 ms
- * after the call), and every frame exposed after it has exposure X. Before,
+ * before the start arrives well after it (its first packet received more
+ * than 15 ms after the call: a frame sent before the Stop can be taken
+ * late by a client's thread on a loaded machine, 4.5 ms seen), and every
+ * frame exposed after it has exposure X. Before,
  * the device saw no restart (its acquisition register read 1 before and
  * after) and sent frames exposed up to 20 ms before the start 12-37 ms
  * after it (an outside check: 8 of 45 restarts). */
@@ -360,7 +362,7 @@ static void test_quick_restart(void)
     char dir[4096];
     pid_t pid;
     ArvCamera *c = begin("quick_restart", "outputs=[{driver: gige, pixel_format: Mono12, metadata_row: 1}]",
-                         "render.samples_per_pixel=16", &pid, dir, sizeof dir);
+                         "render.samples_per_pixel=64", &pid, dir, sizeof dir);
     if (!c)
         return;
     uint8_t *img = malloc((size_t)W * (H + 1) * 2);
@@ -382,7 +384,7 @@ static void test_quick_restart(void)
             double ex, gain;
             if (next_frame(&st, 0.1, img, &ts) < 0 || meta(img, &frame, &ex, &gain) < 0)
                 continue;
-            if (ts < t_start && frame_arrived_ns > real_ns + 2000000) {
+            if (ts < t_start && frame_arrived_ns > real_ns + 15000000) {
                 late++;
                 printf("frame %llu exposed %.3f ms before AcquisitionStart, received %.3f ms after it\n",
                        (unsigned long long)frame, (t_start - ts) * 1e-6, (frame_arrived_ns - real_ns) * 1e-6);

@@ -69,6 +69,8 @@ int main(void)
           "a STROBE stalled: strobes %lu, skipped %lu, gone %d, session error %d (want 1, 2, 1, stall)", o.strobes,
           o.strobes_skipped, o.gone, o.session_error);
     CHECK(o.inflight == 0, "transfers in flight: %d", o.inflight);
+    o.tag = UINT32_MAX; /* tags start at random: the wrap skips 0, which no reply matches */
+    CHECK(nc__usb_next_tag(&o) == 1, "the tag after 2^32 - 1: %u", o.tag);
     pthread_mutex_destroy(&o.lock);
     return nc_test_end();
 }
