@@ -204,7 +204,8 @@ int nc_render_exposure(struct nc_renderer *r, const struct nc_scene *s, const st
         rc = K > 1 ? time_samples_into(r, s, ex, K, S, f) : ex->rolling ? rolling_into(r, s, ex, f)
                                                                           : nc_render_frame(r, s, f);
     if (rc >= 0 && np > 0) { /* what is in front of them: in their own renders and occlusion rays */
-        long hidden, drawn = nc_render_points(r, s, T, ex->rolling ? ex->line_time_s : 0, pts, (size_t)np, 0, f, &hidden);
+        const double line_s = ex->rolling ? ex->line_time_s : 0;
+        long hidden, drawn = nc_render_points(r, s, T, line_s, pts, (size_t)np, 0, f, &hidden);
         rc = drawn < 0 ? (int)drawn : 0;
     }
     memset(r->as_point, 0, sizeof r->as_point);

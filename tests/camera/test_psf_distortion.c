@@ -241,7 +241,8 @@ int main(void)
           "folding distortion: %s", nc_errmsg());
     /* One that folds between the centre and the edge, while every tested pixel's ray projects back onto it (the
      * inverse found a root beyond the fold: pixels 48 and 49 of the middle row saw radii 0.55 and 1.22). */
-    refused_64("camera.distortion={k1: -1.2, k2: 0.5}", "camera.distortion: this distortion folds over inside the image");
+    refused_64("camera.distortion={k1: -1.2, k2: 0.5}",
+               "camera.distortion: this distortion folds over inside the image");
     /* Samples reach half a pixel beyond the pixels' centres, and the PSF's
      * margin more: k1 -0.1424 at fx 44 over 64 x 64 inverts at every pixel
      * centre but not at the image's corner (-0.5, -0.5), where the inverse

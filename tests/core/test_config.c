@@ -67,8 +67,8 @@ int main(void)
         if (rc == 0)
             nc_scene_free(&w);
         const char *half[] = {"camera.width_px=64.5"}, *huge[] = {"camera.width_px=1e400"};
-        expect_error("a whole number 64.5", NULL, NULL, half, 1, "camera.width_px: expected a whole number, got \"64.5\"",
-                     NULL);
+        expect_error("a whole number 64.5", NULL, NULL, half, 1,
+                     "camera.width_px: expected a whole number, got \"64.5\"", NULL);
         expect_error("a whole number 1e400", NULL, NULL, huge, 1, "expected a whole number, got \"1e400\"", NULL);
     }
     { /* an 'up' along the line of sight is blamed on up, where it was given */
