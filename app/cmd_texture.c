@@ -45,7 +45,8 @@ static const char texture_help[] =
     "                      0.5th and 99.5th percentiles)\n"
     "  -R, --region R      all: every finite pixel (default); otsu: those above\n"
     "                      Otsu's threshold (a body against the sky)\n"
-    "  -b, --band FLO,FHI  the spectrum's band, cycles per pixel, 0 < FLO < FHI <= 0.5\n"
+    "  -b, --band FLO,FHI  the spectrum's band, cycles per pixel, 0 < FLO < FHI <= 0.5,\n"
+    "                      at most 32 octaves (FHI / FLO <= 2^32)\n"
     "                      (default 0.015625,0.25: wavelengths of 4 to 64 px)\n"
     "  -c, --crop X,Y,W,H  measure only W x H pixels of each image from column X,\n"
     "                      row Y (0-based; row 0 is the top row: FITS files are\n"
@@ -149,8 +150,10 @@ int main(int argc, char **argv)
             o.otsu = !strcmp(optarg, "otsu");
             break;
         case 'b':
-            if (pair(optarg, &o.f_lo, &o.f_hi) < 0 || !(o.f_lo > 0) || !(o.f_hi > o.f_lo) || !(o.f_hi <= 0.5))
-                return usage("--band expects FLO,FHI cycles per pixel with 0 < FLO < FHI <= 0.5", optarg);
+            if (pair(optarg, &o.f_lo, &o.f_hi) < 0 || !(o.f_lo > 0) || !(o.f_hi > o.f_lo) || !(o.f_hi <= 0.5) ||
+                !(o.f_hi <= 4294967296.0 * o.f_lo)) /* the spectrum's 8 bins an octave, at most 256 */
+                return usage("--band expects FLO,FHI cycles per pixel with 0 < FLO < FHI <= 0.5 and FHI / FLO at most "
+                             "2^32 (32 octaves)", optarg);
             break;
         case 'g':
             gsd = strtod(optarg, &end);

@@ -20,8 +20,8 @@ double nc_otsu_threshold(const float *px, size_t n)
             lo = fmin(lo, px[i]);
             hi = fmax(hi, px[i]);
         }
-    if (!(hi > lo))
-        return isfinite(lo) ? lo : 0.0;
+    if (!(hi > lo)) /* one value: no upper class (nothing is at or above) */
+        return isfinite(lo) ? nextafter(lo, INFINITY) : 0.0;
     size_t hist[NB] = {0}; /* 32 KiB: reentrant */
     size_t total = 0;
     double sum = 0;
@@ -48,7 +48,7 @@ double nc_otsu_threshold(const float *px, size_t n)
             cut = b;
         }
     }
-    return lo + (hi - lo) * (cut + 1) / NB; /* values above it are foreground */
+    return lo + (hi - lo) * (cut + 1) / NB; /* the lower edge of the upper class's first bin: values at or above it */
 }
 
 /* Keys (1981) cubic convolution kernel, a = -0.5. */
@@ -243,8 +243,8 @@ int nc_imgcmp(const float *real, const float *render, int w, int h, enum nc_imgc
     for (size_t i = 0; i < n; i++) {
         /* a pixel missing in either image is missing from both silhouettes */
         const int both = isfinite(real[i]) && isfinite(render[i]);
-        int a = both && real[i] > out->threshold_real;
-        int b = both && render[i] > out->threshold_render;
+        int a = both && real[i] >= out->threshold_real;
+        int b = both && render[i] >= out->threshold_render;
         inter += a && b;
         uni += a || b;
         fg[i] = a && real[i] > 0 && isfinite(render[i]);

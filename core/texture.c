@@ -172,7 +172,7 @@ static int cmp_float(const void *a, const void *b)
 int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_opts *o, struct nc_texture *out)
 {
     memset(out, 0, sizeof *out);
-    out->psd_beta = out->psd_r2 = out->grad_kurtosis = NAN;
+    out->psd_beta = out->psd_r2 = out->grad_mean = out->grad_rms = out->grad_kurtosis = NAN; /* null if undefined */
     if (w < 7 || h < 7)
         return nc_error(NC_ERANGE, "texture: a %dx%d image is too small (at least 7x7)", w, h);
     const size_t n = (size_t)w * (size_t)h;
@@ -187,7 +187,7 @@ int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_o
     size_t m = 0;
     double mean = 0;
     for (size_t i = 0; i < n; i++) {
-        region[i] = isfinite(img[i]) && (o->mask ? o->mask[i] != 0 : img[i] > thr);
+        region[i] = isfinite(img[i]) && (o->mask ? o->mask[i] != 0 : img[i] >= thr);
         if (region[i]) {
             sorted[m++] = img[i];
             mean += img[i];
@@ -207,9 +207,10 @@ int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_o
         out->lo = sorted[(size_t)(0.005 * (double)(m - 1) + 0.5)];
         out->hi = sorted[(size_t)(0.995 * (double)(m - 1) + 0.5)];
     }
+    /* LO = HI (99.5 % of the region one value: a star field, a point): LO and below 0, above it 255 */
     const double k = out->hi > out->lo ? 255.0 / (out->hi - out->lo) : 0.0;
     for (size_t i = 0; i < n; i++) {
-        const double v = isfinite(img[i]) ? floor((img[i] - out->lo) * k + 0.5) : 0.0;
+        const double v = !isfinite(img[i]) ? 0.0 : k > 0 ? floor((img[i] - out->lo) * k + 0.5) : img[i] > out->lo ? 255 : 0;
         u8[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
     }
     for (size_t i = 0; i < n; i++) /* the finite pixels: filled's bytes, before the spectrum needs it */
@@ -235,8 +236,8 @@ int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_o
                 const size_t i = (size_t)y * (size_t)w + (size_t)x;
                 if (!region[i] || !region[i - 1] || !region[i + 1] || !region[i - (size_t)w] || !region[i + (size_t)w])
                     continue;
-                const double gx = 0.5 * (img[i + 1] - img[i - 1]) / mean,
-                             gy = 0.5 * (img[i + (size_t)w] - img[i - (size_t)w]) / mean;
+                const double gx = 0.5 * ((double)img[i + 1] - img[i - 1]) / mean, /* in double: +-3e38 apart */
+                             gy = 0.5 * ((double)img[i + (size_t)w] - img[i - (size_t)w]) / mean;
                 if (pass == 0) {
                     sg += sqrt(gx * gx + gy * gy);
                     sg2 += gx * gx + gy * gy;

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/imgcmp.h"
 #include "core/texture.h"
 #include "testutil.h"
 
@@ -171,6 +172,39 @@ static void check_gradients(void)
         img[i] = NAN;
     CHECK(nc_texture_measure(img, W, H, &o, &t) < 0, "no finite pixel: an error");
     CHECK(nc_texture_measure(img, 6, 6, &o, &t) < 0, "6x6: too small");
+
+    /* Edge cases an outside check found: (1) a flat image with one bright
+     * pixel, LO = HI at the percentiles: above them is 255 (every pixel was
+     * 0, no corner); (2) gradients where no region pixel has its 4
+     * neighbours in the region: null, not 0; (3) values 4e38 apart: the
+     * gradients taken in double (their float differences overflowed); (4)
+     * a pixel on Otsu's threshold is in the upper class. */
+    o.otsu = 0;
+    for (int i = 0; i < W * H; i++)
+        img[i] = 20;
+    img[32 * W + 64] = 250;
+    CHECK(nc_texture_measure(img, W, H, &o, &t) == 0 && t.lo == 20 && t.hi == 20 && t.corners == 1,
+          "one bright pixel on a flat image: scale [%g, %g], %zu corners (1)", t.lo, t.hi, t.corners);
+    o.otsu = 1;
+    CHECK(nc_texture_measure(img, W, H, &o, &t) == 0 && t.region_px == 1 && isnan(t.grad_mean) &&
+              isnan(t.grad_rms) && isnan(t.grad_kurtosis),
+          "Otsu's region of one pixel: %zu px, gradients %g %g %g (null)", t.region_px, t.grad_mean, t.grad_rms,
+          t.grad_kurtosis);
+    o.otsu = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            img[y * W + x] = (x + y) % 2 ? 3e38f : -1e38f; /* differences of 4e38: beyond a float */
+    CHECK(nc_texture_measure(img, W, H, &o, &t) == 0 && isfinite(t.grad_mean) && isfinite(t.grad_rms),
+          "a 3e38, -1e38 checkerboard: gradients %g %g (finite)", t.grad_mean, t.grad_rms);
+    for (int i = 0; i < W * H; i++) /* 0 .. 4096: the cut's edges at whole values */
+        img[i] = (float)(i % 4097);
+    const double thr = nc_otsu_threshold(img, (size_t)W * H);
+    size_t at_or_above = 0;
+    for (int i = 0; i < W * H; i++)
+        at_or_above += img[i] >= thr;
+    o.otsu = 1;
+    CHECK(thr == floor(thr) && nc_texture_measure(img, W, H, &o, &t) == 0 && t.region_px == at_or_above,
+          "Otsu's threshold %g (whole): region %zu px, at or above it %zu", thr, t.region_px, at_or_above);
 }
 
 int main(void)
