@@ -60,6 +60,18 @@ void nc_frame_flip(struct nc_frame *f, int rows, int cols)
  * direction R (u, v, 1); the standard coordinates east and north of the
  * boresight b are u R_x . e + v R_y . e (e east) and the same with north:
  * linear in (u, v), so the CD matrix is exact. */
+int nc_shot_detail_attrs(double lod_error_m, double boulder_min_m, double boulder_mesh_px, char (*val)[40],
+                         struct nc_image_attr *out)
+{
+    static const char *const names[3] = {"navcam:lod_error_m", "navcam:boulder_min_m", "navcam:boulder_mesh_px"};
+    const double v[3] = {lod_error_m, boulder_min_m, boulder_mesh_px};
+    for (int k = 0; k < 3; k++) {
+        snprintf(val[k], sizeof val[k], "%.17g", v[k]);
+        out[k] = (struct nc_image_attr){names[k], val[k]};
+    }
+    return 3;
+}
+
 int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out)
 {
     if (c->distorted)
@@ -194,11 +206,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     info->stars_ms = t2 - ts0;
     if (q <= NC_Q_ROCK_ID) /* the sensor's quantities are mirrored after the optics (write_sensor_frame) */
         nc_frame_flip(&f, scene->camera.flip_rows, scene->camera.flip_cols);
-    /* Levels of detail and the smallest boulder traced (0: every rock). */
-    char lod[40], rocks[40], mesh[40];
-    snprintf(lod, sizeof lod, "%.17g", nc_rt_lod_error_m(r->rt));
-    snprintf(rocks, sizeof rocks, "%.17g", nc_rt_boulder_min_m(r->rt));
-    snprintf(mesh, sizeof mesh, "%.17g", nc_rt_boulder_mesh_px(r->rt));
+    char detail[3][40];
     /* How each mesh is shaded: name=flat or name=smooth, comma-separated. */
     char normals[NC_MAX_BODIES * 72] = "";
     for (int i = 0, o = 0; i < scene->nbodies; i++)
@@ -213,9 +221,9 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
                           r->fold_theta_bar_deg[i]);
     char flip[40];
     snprintf(flip, sizeof flip, "rows=%d columns=%d", scene->camera.flip_rows, scene->camera.flip_cols);
-    struct nc_image_attr extra[48] = {
-        {"navcam:lod_error_m", lod}, {"navcam:boulder_min_m", rocks}, {"navcam:boulder_mesh_px", mesh}};
-    int nextra = 3;
+    struct nc_image_attr extra[48];
+    int nextra = nc_shot_detail_attrs(nc_rt_lod_error_m(r->rt), nc_rt_boulder_min_m(r->rt),
+                                      nc_rt_boulder_mesh_px(r->rt), detail, extra);
     if (suninfo[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:sun_view", suninfo};
     if (starinfo[0])

@@ -48,6 +48,11 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
  * attributes ("fits:CTYPE1", ...) into out[14], their numbers' text in
  * val; 0 (none) for a distorted camera. Returns how many. */
 int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out);
+/* The detail a frame was rendered with (levels of detail's error, m; the
+ * boulder cut, m, 0: every rock; the detailed surfaces' threshold, px) as
+ * attributes into out[3], their text in val. Returns 3. */
+int nc_shot_detail_attrs(double lod_error_m, double boulder_min_m, double boulder_mesh_px, char (*val)[40],
+                         struct nc_image_attr *out);
 /* The geometry planes (render.h, enum nc_geom_plane) of scene at pixel
  * centres: one sample a pixel, direct light only, no time samples; then
  * mirrored as the stored image is. geom: NC_GEOM_PLANES x w x h floats. */

@@ -211,12 +211,7 @@ static int frame_attrs(const struct nc__emu *e, const struct staged *x, const st
     at.render = x->used;
     int n = nc_frame_meta(&at, NC_Q_DN, sl->attrs, sl->attr_text, 24);
     n += nc_camsys_meta(cs, x->j.exposure_s, frame, sl->attrs + n, sl->attr_text + 24, 6);
-    static const char *const detail[3] = {"navcam:lod_error_m", "navcam:boulder_min_m", "navcam:boulder_mesh_px"};
-    const double dv[3] = {x->lod_error_m, x->boulder_min_m, x->boulder_mesh_px};
-    for (int k = 0; k < 3; k++) {
-        snprintf(sl->attr_detail[k], sizeof sl->attr_detail[k], "%.17g", dv[k]);
-        sl->attrs[n++] = (struct nc_image_attr){detail[k], sl->attr_detail[k]};
-    }
+    n += nc_shot_detail_attrs(x->lod_error_m, x->boulder_min_m, x->boulder_mesh_px, sl->attr_detail, sl->attrs + n);
     at.camera.flip_rows = at.camera.flip_cols = 0; /* the emulator's frames are the view, unmirrored */
     if (e->sky.on)
         n += nc_shot_wcs_attrs(&at.camera, sl->attr_wcs, sl->attrs + n);
