@@ -170,6 +170,7 @@ struct nc__emu {
     /* state */
     atomic_int stop; /* 1: stop taking input; 2: render exits; 3: output exits */
     atomic_int warm; /* 1: the render thread has made its warm-up frame */
+    double warm_busy_ms; /* ... and the time it kept the camera busy (busy_ms's), ms; set before warm */
     atomic_int failed; /* < 0: a thread gave up with this error (logged): navcam serve fails */
     uint64_t next_frame;
     int64_t start_mono_ns;
@@ -228,7 +229,8 @@ void *nc__serve_output_thread(void *arg);
 
 /* serve_stats.c */
 /* The median time the last 16 frames kept the camera busy (busy_ms), ms,
- * or with slowest the longest of them (0: none yet). */
+ * before the first the warm-up frame's (0: it failed), or with slowest the
+ * longest of them (0: none yet). */
 double nc__serve_busy_ms(struct nc__emu *e, int slowest);
 /* The frame rate the camera can deliver now: the requested rate (free-run),
  * capped by 1 / the longest busy time of the last 16 frames, so that it

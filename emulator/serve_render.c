@@ -361,7 +361,7 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
             nc__serve_drop(e, &j, NC__DROP_OVERRUN);
             continue;
         }
-        double est_ms = nc__serve_busy_ms(e, 0); /* 0 before the first frame: no tick waits for it */
+        double est_ms = nc__serve_busy_ms(e, 0); /* 0: the warm-up failed, and no frame yet */
         atomic_store(&e->readout_end_ns, est_ms > 0 ? x.t0 + llround(est_ms * 1e6) : INT64_MAX);
         struct nc_quality_choice qc; /* render.quality: auto, per frame (its pilots count as render time) */
         x.rc = at.render.quality_auto ? nc_quality_auto(&e->renderer, &at, &e->cs, j.exposure_s, &qc) : 0;
@@ -418,8 +418,16 @@ void *nc__serve_render_thread(void *arg)
         nc_scene_pose(&e->scene, 0, &p0);
         nc_scene_apply_pose(&warm, &p0);
         nc_camsys_render_camera(&e->cs, &warm.camera, &warm.camera);
-        if (nc_render_frame(&e->renderer, &warm, &st.f[0]) >= 0)
+        const int64_t t0 = nc_mono_ns();
+        if (nc_render_frame(&e->renderer, &warm, &st.f[0]) >= 0) {
+            const int64_t t1 = nc_mono_ns();
             nc_camsys_electrons(&e->cs, st.f[0].radiance, e->cs.exposure_s, st.el);
+            /* the busy time until a frame served gives one (nc__serve_busy_ms): a slight overestimate, the
+             * warm-up's first touches in it (infinite before: every trigger in the first frame's time an
+             * overrun) */
+            const double render_ms = (t1 - t0) * 1e-6, camera_ms = (nc_mono_ns() - t1) * 1e-6;
+            e->warm_busy_ms = overlap ? fmax(render_ms, camera_ms) : render_ms + camera_ms;
+        }
     }
     int err = ok && overlap ? pthread_create(&cam, NULL, camera_thread, &st) : 0;
     if (err) {

@@ -58,7 +58,7 @@ double nc__serve_busy_ms(struct nc__emu *e, int slowest)
         r[i] = e->busy_ms[(e->nlat - 1 - i) % NC_SERVE_LAT_SAMPLES];
     pthread_mutex_unlock(&e->stat_lock);
     if (n == 0)
-        return 0.0;
+        return slowest ? 0.0 : e->warm_busy_ms;
     qsort(r, n, sizeof *r, cmpd);
     return r[slowest ? n - 1 : n / 2];
 }

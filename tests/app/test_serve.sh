@@ -334,6 +334,20 @@ print(f"pose at mid-exposure vs the analytic line: {interpolated} frames, worst 
 assert interpolated >= 60
 PY
 
+# 5b. Trigger mode, a 10 Hz timer whose exposures start 0.15 s after their
+# edges (more than a period): the render (a few ms) keeps up, so every edge
+# is a frame. Until session 64 the camera counted as busy without end until
+# its first frame was delivered, and the second edge was an overrun.
+start delay 20 --set serve.mode=trigger --set "serve.trigger={driver: timer, rate_hz: 10, delay_s: 0.15}"
+sleep 1.3
+stop
+python3 - "$tmp/delay" <<'PY' && ok || bad "a trigger delay longer than the period"
+import json, sys
+s = json.load(open(sys.argv[1] + "/stats.json"))
+print(f"trigger delay 0.15 s at 10 Hz: {s['frames_delivered']} frames, dropped {s['dropped']}")
+assert s["dropped"]["overrun"] == 0 and s["frames_delivered"] >= 8, s
+PY
+
 # 6. Trigger mode, software source (the default): TRIGGER messages and POSE
 # with CAPTURE each give one frame at the requested simulation time.
 start software 10 --set serve.mode=trigger --set serve.max_extrapolation_s=10
