@@ -27,10 +27,11 @@
 
 struct recorder {
     struct nc_ray16 *cam, *shadow;
+    int *frame; /* each shadow packet's */
     size_t ncam, nshadow, capcam, capshadow;
 };
 
-static void record(void *user, int shadow, const struct nc_ray16 *ray)
+static void record(void *user, int shadow, const struct nc_ray16 *ray, int frame)
 {
     struct recorder *r = user;
     struct nc_ray16 **a = shadow ? &r->shadow : &r->cam;
@@ -38,11 +39,15 @@ static void record(void *user, int shadow, const struct nc_ray16 *ray)
     if (*n == *cap) {
         *cap = *cap ? 2 * *cap : 4096;
         *a = realloc(*a, *cap * sizeof **a);
-        if (!*a) {
+        if (shadow)
+            r->frame = realloc(r->frame, *cap * sizeof *r->frame);
+        if (!*a || (shadow && !r->frame)) {
             fprintf(stderr, "out of memory\n");
             exit(1);
         }
     }
+    if (shadow)
+        r->frame[*n] = frame;
     (*a)[(*n)++] = *ray;
 }
 
@@ -120,7 +125,8 @@ int main(int argc, char **argv)
            cam_rays, rec.ncam, sh_rays, rec.nshadow, 100.0 * covered / ((double)f.width_px * f.height_px));
 
     struct nc_rt_batch *bc, *bs;
-    if (nc_rt_batch_create(rec.cam, rec.ncam, 0, &bc) < 0 || nc_rt_batch_create(rec.shadow, rec.nshadow, 1, &bs) < 0) {
+    if (nc_rt_batch_create(rec.cam, NULL, rec.ncam, 0, &bc) < 0 ||
+        nc_rt_batch_create(rec.shadow, rec.frame, rec.nshadow, 1, &bs) < 0) {
         fprintf(stderr, "bench: %s\n", nc_errmsg());
         return 1;
     }
@@ -224,6 +230,7 @@ int main(int argc, char **argv)
     free(upd);
     free(rec.cam);
     free(rec.shadow);
+    free(rec.frame);
     nc_rt_batch_destroy(bc);
     nc_rt_batch_destroy(bs);
     nc_frame_free(&f);

@@ -211,6 +211,8 @@ struct job {
     int cull; /* skip 4x4 blocks whose rays cannot reach any body (block_can_hit) */
     int bins; /* camera rays through nc_rt_intersect_block (a pinhole at rest over meshes) */
     int plain; /* meshes only, no albedo maps, the Sun at infinity: surface16's lanes without exceptions */
+    int far[NC_MAX_BODIES];        /* shadow rays leaving the body in its far frame (nc_rt_far_frame) */
+    double far_scale[NC_MAX_BODIES]; /* ... and the scale of its float coordinates there, m */
 };
 
 /* Whether any ray of the 4x4 pixel block at (px0, py0) can reach a body's
@@ -274,6 +276,10 @@ struct surf {
     int outside[NC_PACKET];   /* the ray came from the outer side of the surface */
     double t[NC_PACKET];      /* ray parameter, m */
     double scale[NC_PACKET];  /* the float error's scale there, m: t, or more for a refined mesh hit */
+    /* The frame its shadow rays go in (nc_rt_far_frame): -1, the camera's;
+     * b, body b's far frame (shadow_start) */
+    int frame[NC_PACKET];
+    const uint32_t *prim; /* ... and the triangles met (nc_hit16.prim), to refine a far frame's point */
     struct nc_vec3 p[NC_PACKET];    /* position relative to the camera, scene frame, m */
     struct nc_vec3 n[NC_PACKET];    /* unit normal, turned to face the ray's origin */
     struct nc_vec3 d[NC_PACKET];    /* the ray's unit direction */
@@ -328,6 +334,34 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
     }
 }
 
+/* s's shadow-ray frames: a body's own surface (not its rocks) seen from
+ * farther than a bounding radius off its bounding sphere in its far frame,
+ * anything else in the camera's. */
+static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, struct surf *s)
+{
+    s->prim = hit->prim;
+    for (int i = 0; i < NC_PACKET; i++) {
+        const int b = s->body[i], k = b >= 0 ? b : 0;
+        s->frame[i] = (b >= 0) & (hit->rock[i] < 0) & j->far[k] ? b : -1;
+    }
+}
+
+/* Where lane i's shadow ray starts, before its offset along the normal: its
+ * point in its frame (*p: camera-relative, or from the body's origin in
+ * its far frame), and the scale of the float errors there (returned, m: the
+ * point's, or in a far frame the larger of its distance from the origin
+ * and the body's bounding radius; a mesh hit is refined once a ray from it
+ * is traced: occluded_in). Branch-free, for loops the compiler vectorises. */
+static inline double shadow_start(const struct job *j, const struct surf *s, int i, struct nc_vec3 *p)
+{
+    const int fr = s->frame[i], k = fr >= 0 ? fr : 0;
+    const struct nc_vec3 q = s->p[i], o = j->body_rel[k];
+    const double x = q.x - o.x, y = q.y - o.y, z = q.z - o.z, r = sqrt(x * x + y * y + z * z);
+    const double sc = j->far_scale[k];
+    *p = fr >= 0 ? nc_v3(x, y, z) : q;
+    return fr >= 0 ? (r > sc ? r : sc) : s->scale[i];
+}
+
 /* Fill s from a packet's hits, for rays from orig along the unit dir. */
 static void surface16(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
                       const struct nc_vec3 *dir, struct surf *s)
@@ -341,6 +375,7 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
         nc_rt_refine_mesh16(j->rt, hit, orig, dir, s->t, s->scale);
     if (j->plain) {
         plain_lanes(j, hit, orig, dir, (const double(*)[NC_PACKET])un, s);
+        shadow_frames(j, hit, s);
         return;
     }
     for (int i = 0; i < NC_PACKET; i++) {
@@ -378,6 +413,7 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
         }
         s->factor[i] = factor;
     }
+    shadow_frames(j, hit, s);
 }
 
 /* r (1/sr) for the lanes listed, each with its own body's material, in one
@@ -411,21 +447,79 @@ struct tile_counts {
     unsigned long shadow_culled, shadow_traced, hits, back_hits;
 };
 
-/* Shadow rays' lanes that meet nothing: culled (proven) or traced. */
-static void unoccluded16(struct job *j, struct nc_ray16 *shadow, const int *from, int any, int *lit,
-                         struct tile_counts *cnt)
+/* The valid lanes of shadow, rays from the points of sf, all in frame fr:
+ * occluded[i] and blocked[i] set where they meet something
+ * (nc_rt_shadow_cull16, nc_rt_occluded16); returns how many were proven
+ * clear. In a body's far frame the rays left to trace start from their
+ * points refined (nc_rt_refine_far16), 4e-6 of shadow_start's scale off. */
+static int occluded_in(struct job *j, const struct surf *sf, struct nc_ray16 *shadow, const int *from, int fr,
+                       int *occluded, int *blocked)
 {
-    int occluded[NC_PACKET] = {0}, blocked[NC_PACKET] = {0}, left = 0;
-    int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, shadow, from, blocked);
-    cnt->shadow_culled += (unsigned long)culled;
-    cnt->shadow_traced += (unsigned long)(any - culled);
+    int culled = j->r->no_shadow_cull ? 0 : nc_rt_shadow_cull16(j->rt, shadow, from, blocked, fr), left = 0;
     for (int i = 0; i < NC_PACKET; i++)
         left |= shadow->valid[i];
-    if (left) { /* else every ray proven lit, or blocked by a rock */
-        if (j->r->ray_hook)
-            j->r->ray_hook(j->r->ray_hook_user, 1, shadow);
-        nc_rt_occluded16(j->rt, shadow, occluded);
+    if (!left) /* every ray proven lit, or blocked by a rock */
+        return culled;
+    if (fr >= 0) {
+        double t[NC_PACKET];
+        int done[NC_PACKET];
+        struct nc_vec3 o[NC_PACKET]; /* the rays' origins, to 1e-16 of t */
+        for (int i = 0; i < NC_PACKET; i++)
+            o[i] = nc_v3_sub(sf->p[i], nc_v3_scale(sf->d[i], sf->t[i]));
+        memcpy(t, sf->t, sizeof t);
+        nc_rt_refine_far16(j->rt, fr, shadow->valid, sf->prim, o, sf->d, t, done);
+        for (int i = 0; i < NC_PACKET; i++) {
+            if (!shadow->valid[i])
+                continue;
+            /* a point not refined: 1e-7 of the range off, the offset as in the camera's frame */
+            struct nc_vec3 p;
+            const double escale = shadow_start(j, sf, i, &p), eps = 4e-6 * (done[i] ? escale : fmax(escale, t[i]));
+            p = nc_v3_add(p, nc_v3_scale(sf->d[i], t[i] - sf->t[i]));
+            shadow->ox[i] = (float)(p.x + eps * sf->n[i].x);
+            shadow->oy[i] = (float)(p.y + eps * sf->n[i].y);
+            shadow->oz[i] = (float)(p.z + eps * sf->n[i].z);
+        }
     }
+    int occ[NC_PACKET];
+    if (j->r->ray_hook)
+        j->r->ray_hook(j->r->ray_hook_user, 1, shadow, fr);
+    nc_rt_occluded16(j->rt, shadow, occ, fr);
+    for (int i = 0; i < NC_PACKET; i++)
+        occluded[i] |= occ[i];
+    return culled;
+}
+
+/* Shadow rays' lanes that meet nothing: culled (proven) or traced, each
+ * in its frame (usually one for the packet). */
+static void unoccluded16(struct job *j, const struct surf *sf, struct nc_ray16 *shadow, const int *from, int any,
+                         int *lit, struct tile_counts *cnt)
+{
+    const int *frame = sf->frame;
+    int occluded[NC_PACKET] = {0}, blocked[NC_PACKET] = {0}, culled = 0, first = -1, one = 1;
+    for (int i = 0; i < NC_PACKET; i++)
+        if (shadow->valid[i] && first < 0)
+            first = i;
+        else if (shadow->valid[i])
+            one &= frame[i] == frame[first];
+    if (first >= 0 && one) {
+        culled = occluded_in(j, sf, shadow, from, frame[first], occluded, blocked);
+    } else if (first >= 0) {
+        int todo[NC_PACKET];
+        memcpy(todo, shadow->valid, sizeof todo);
+        for (int i0 = 0; i0 < NC_PACKET; i0++) {
+            if (!todo[i0])
+                continue;
+            struct nc_ray16 part = *shadow;
+            const int fr = frame[i0];
+            for (int i = 0; i < NC_PACKET; i++) {
+                part.valid[i] = todo[i] && frame[i] == fr ? -1 : 0;
+                todo[i] &= !part.valid[i];
+            }
+            culled += occluded_in(j, sf, &part, from, fr, occluded, blocked);
+        }
+    }
+    cnt->shadow_culled += (unsigned long)culled;
+    cnt->shadow_traced += (unsigned long)(any - culled);
     for (int i = 0; i < NC_PACKET; i++)
         lit[i] = lit[i] && !occluded[i] && !blocked[i];
 }
@@ -434,15 +528,19 @@ static void unoccluded16(struct job *j, struct nc_ray16 *shadow, const int *from
  * branch-free loop (AVX-512 or AVX2 where the CPU has it, without
  * contraction: the same bits as the loop lane by lane): a lane with no
  * point, or facing away from the Sun or the camera, gets lit 0 and an
- * invalid ray (its other fields unused); a ray starts 4e-6 t off the
- * surface, as in sunlight16. Returns how many are lit. */
+ * invalid ray (its other fields unused); a ray starts 4e-6 of its float
+ * error's scale off the surface, in its frame, as in sunlight16. Returns
+ * how many are lit. */
 __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static int
-hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *shadow, int *from, int *lit)
+hard_lanes(const struct job *j, const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *shadow, int *from,
+           int *lit)
 {
     int any = 0;
     for (int i = 0; i < NC_PACKET; i++) {
-        const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i], p = s->p[i];
-        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->scale[i];
+        const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i];
+        struct nc_vec3 p;
+        const double escale = shadow_start(j, s, i, &p);
+        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * escale;
         const int on = (s->body[i] >= 0) & (mu0 > 0) & (mu > 0);
         geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, d), s->factor[i]};
         shadow->ox[i] = (float)(p.x + eps * nrm.x);
@@ -481,7 +579,7 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
             r_hard[i] = 0;
     }
     if (!depth && !(j->sun_tan_radius > 0) && !j->r->lane_by_lane) {
-        any = hard_lanes(s, geo, &shadow, from, lit);
+        any = hard_lanes(j, s, geo, &shadow, from, lit);
     } else {
         for (int i = 0; i < NC_PACKET; i++) {
             shadow.valid[i] = lit[i] = 0;
@@ -494,10 +592,12 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
                 continue;
             geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, s->d[i]), s->factor[i]};
             /* Offset the origin off the surface by a few float ulps of the
-             * camera-relative coordinates (a bounce's t can be far shorter than
-             * the point's distance from the camera); tnear stays 0. */
-            double eps = 4e-6 * (depth ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : s->scale[i]);
-            struct nc_vec3 p = s->p[i];
+             * coordinates in the ray's frame (the camera's: a bounce's t can be
+             * far shorter than the point's distance from the camera); tnear
+             * stays 0. */
+            struct nc_vec3 p;
+            const double escale = shadow_start(j, s, i, &p);
+            double eps = 4e-6 * (depth && s->frame[i] < 0 ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : escale);
             shadow.ox[i] = (float)(p.x + eps * nrm.x);
             shadow.oy[i] = (float)(p.y + eps * nrm.y);
             shadow.oz[i] = (float)(p.z + eps * nrm.z);
@@ -546,9 +646,9 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
             lit_hard[i] = lit[i];
             from_hard[i] = lit[i] && s->outside[i] && nc_v3_dot(s->n[i], s->sdir[i]) > 0 ? s->body[i] : -1;
         }
-        unoccluded16(j, &centre, from_hard, any, lit_hard, cnt);
+        unoccluded16(j, s, &centre, from_hard, any, lit_hard, cnt);
     }
-    unoccluded16(j, &shadow, from, any, lit, cnt);
+    unoccluded16(j, s, &shadow, from, any, lit, cnt);
     int todo[NC_PACKET], ntodo = 0;
     for (int i = 0; i < NC_PACKET; i++)
         if (lit[i] || (twin && lit_hard[i]))
@@ -649,7 +749,7 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
             ray.tfar[i] = INFINITY;
         }
         if (j->r->ray_hook)
-            j->r->ray_hook(j->r->ray_hook_user, 2, &ray);
+            j->r->ray_hook(j->r->ray_hook_user, 2, &ray, -1);
         nc_rt_intersect16(j->rt, &ray, &hit, 0);
         for (int i = 0; i < NC_PACKET; i++)
             if (!ray.valid[i])
@@ -770,7 +870,7 @@ static void trace_camera(const struct job *j, int px0, int py0, const struct nc_
 {
     if (j->bins) { /* a pinhole at rest: the block's own triangles */
         for (int q = 0; q < ns && j->r->ray_hook; q++)
-            j->r->ray_hook(j->r->ray_hook_user, 0, &ray[q]);
+            j->r->ray_hook(j->r->ray_hook_user, 0, &ray[q], -1);
         if (j->r->one_sample_packets)
             for (int q = 0; q < ns; q++)
                 nc_rt_intersect_block(j->rt, px0, py0, &ray[q], &hit[q], 1);
@@ -781,7 +881,7 @@ static void trace_camera(const struct job *j, int px0, int py0, const struct nc_
     if (ns == 1 || j->r->one_sample_packets) {
         for (int q = 0; q < ns; q++) {
             if (j->r->ray_hook)
-                j->r->ray_hook(j->r->ray_hook_user, 0, &ray[q]);
+                j->r->ray_hook(j->r->ray_hook_user, 0, &ray[q], -1);
             nc_rt_intersect16(j->rt, &ray[q], &hit[q], 1);
         }
         return;
@@ -805,7 +905,7 @@ static void trace_camera(const struct job *j, int px0, int py0, const struct nc_
             pk.tnear[k] = rq->tnear[i], pk.tfar[k] = rq->tfar[i], pk.valid[k] = rq->valid[i];
         }
         if (j->r->ray_hook)
-            j->r->ray_hook(j->r->ray_hook_user, 0, &pk);
+            j->r->ray_hook(j->r->ray_hook_user, 0, &pk, -1);
         nc_rt_intersect16(j->rt, &pk, &hk, 1);
         for (int k = 0; k < NC_PACKET; k++) {
             const int i = ik[k];
@@ -1107,6 +1207,7 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
         j.body_R[b] = nc_quat_to_mat(s->body[b].attitude_q);
         j.body_rel[b] = nc_v3_sub(s->body[b].position_m, c->position_m);
         j.mat[b] = s->body[b].material;
+        j.far[b] = nc_rt_far_frame(r->rt, b, &j.far_scale[b]);
         r->fold_theta_bar_deg[b] = -1;
         if (s->render.boulder_fold && st.boulder_cut_cover[b] > 0)
             r->fold_theta_bar_deg[b] = nc_material_fold_rocks(&s->body[b].material, st.boulder_cut_cover[b], &j.mat[b]);

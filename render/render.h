@@ -66,8 +66,10 @@ struct nc_renderer {
     struct nc_pool *pool; /* pool_threads - 1 workers, started by the first frame */
     int pool_threads;
     /* Optional observer of every traced packet (benchmarks record the exact
-     * rays with it); called from render threads, so use with threads = 1. */
-    void (*ray_hook)(void *user, int shadow, const struct nc_ray16 *ray);
+     * rays with it): kind 0 camera rays, 1 shadow rays, 2 bounce rays, in
+     * frame (nc_rt_occluded16's: -1 the camera's, b body b's far frame);
+     * called from render threads, so use with threads = 1. */
+    void (*ray_hook)(void *user, int kind, const struct nc_ray16 *ray, int frame);
     void *ray_hook_user;
     /* 1: trace every block, even those whose rays cannot reach a body's
      * bounding sphere (tests compare the two; the frames are identical). */

@@ -6,6 +6,9 @@
  * axes of the scene frame. Each body is an instance whose geometry is stored
  * relative to an anchor point near the camera, in double-precision-derived
  * float coordinates, so that precision follows the camera, not the body origin.
+ * Shadow rays leaving a body seen from afar go in that body's far frame
+ * instead (nc_rt_far_frame: the same axes, its origin at the body's), where
+ * they start as near its surface as its own size allows.
  */
 #ifndef NC_RT_H
 #define NC_RT_H
@@ -117,8 +120,33 @@ int nc_rt_refine_on(const struct nc_rt *rt);
  * refined keep t[i] and scale[i]. */
 void nc_rt_refine_mesh16(const struct nc_rt *rt, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
                          const struct nc_vec3 *dir, double *t, double *scale);
-/* Occlusion: on return occluded[i] is nonzero for blocked active rays. */
-void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded);
+/* For body b's own triangles prim[i] met by the lanes of nonzero lanes[i]
+ * (rays orig[i] + t[i] dir[i], dir unit, camera-relative scene frame), when
+ * its shadow rays go in its far frame (nc_rt_far_frame): t[i] recomputed in
+ * double precision, so that the point is known to 1.2e-7 of the body's
+ * radius instead of 1e-7 of the range, and done[i] set (0 where the double
+ * ray meets the triangle's plane edge-on or far from t[i]: at an edge,
+ * another triangle's; t[i] then stands). Analytic shapes' hits are refined
+ * already (nc_rt_refine): left as they are, done. */
+void nc_rt_refine_far16(const struct nc_rt *rt, int b, const int *lanes, const uint32_t *prim,
+                        const struct nc_vec3 *orig, const struct nc_vec3 *dir, double *t, int *done);
+/* Occlusion: on return occluded[i] is nonzero for blocked active rays.
+ * frame: -1, rays in the camera-relative scene frame; b >= 0, rays in body
+ * b's far frame (nc_rt_far_frame). */
+void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded, int frame);
+/* Whether the shadow rays leaving body b's own surface (its mesh or shape,
+ * not its rocks) go in its far frame at the last update: relative to its
+ * origin, scene axes, where float rays and geometry carry 6e-8 of the
+ * body's size instead of the range (the camera is farther than a bounding
+ * radius from its bounding sphere; an analytic shape is left out of its own
+ * far frame: a convex shape cannot shadow itself). The frame's origin is
+ * the body's, at s->body[b].position_m - s->camera.position_m from the
+ * camera; *scale_m: the scale of its float coordinates there (its bounding
+ * radius). Hits on its mesh are known to 1e-7 of the range along the ray:
+ * enough for nc_rt_shadow_cull16's proof, which takes no ray within the
+ * grid's margin of the mesh, and refined by nc_rt_refine_far16 before a
+ * ray is traced from there. */
+int nc_rt_far_frame(const struct nc_rt *rt, int b, double *scale_m);
 /* The same for n (at most NC_PACKET) rays from the camera along the unit
  * scene-frame directions dir, each to distance tfar_m (INFINITY: the whole
  * way): stars, the Sun's disk, a far body's line of sight. */
@@ -129,8 +157,9 @@ void nc_rt_occluded_dirs(struct nc_rt *rt, const struct nc_vec3 *dir, int n, dou
  * body's own, the bounding spheres for the others) are made inactive; where
  * boulders are traced they are traced through the rocks alone first, and
  * one that meets a rock is marked in blocked[i] (which the caller zeroes).
+ * frame as for nc_rt_occluded16 (the rays leaving body b in its far frame).
  * Returns how many were proven to meet nothing. */
-int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked);
+int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked, int frame);
 /* Add to the shadow-ray counts of nc_rt_get_stats (callers add a tile's
  * worth at a time: the counters are shared by every render thread). */
 void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced);
@@ -167,9 +196,12 @@ size_t nc_rt_rock_mesh_triangles(const struct nc_rt *rt, int b);
  * converted once (untimed); nc_rt_batch_trace() then only resets each packet
  * and calls rtcIntersect16 (coherent) or rtcOccluded16 (or, with single, the
  * same rays one by one through rtcIntersect1/rtcOccluded1), spread over
- * `threads` threads in chunks, and returns the wall time in ms. */
+ * `threads` threads in chunks, and returns the wall time in ms. frames: each
+ * packet's frame as nc_rt_occluded16 takes it (NULL: every one the
+ * camera's). */
 struct nc_rt_batch;
-int nc_rt_batch_create(const struct nc_ray16 *rays, size_t npackets, int occlusion, struct nc_rt_batch **out);
+int nc_rt_batch_create(const struct nc_ray16 *rays, const int *frames, size_t npackets, int occlusion,
+                       struct nc_rt_batch **out);
 double nc_rt_batch_trace(struct nc_rt *rt, struct nc_rt_batch *b, int threads, int single);
 void nc_rt_batch_destroy(struct nc_rt_batch *b);
 void nc_rt_destroy(struct nc_rt *rt);

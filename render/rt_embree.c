@@ -23,6 +23,11 @@
 #include "render/rt_rocks.h"
 #include "render/shadow_grid.h"
 
+/* An ellipsoid's centre and radii in its geometry's frame, m. */
+struct ell {
+    double centre[3], radii[3];
+};
+
 struct rt_body {
     const struct nc_body *src;
     /* One Embree scene per level of detail (mesh_lod.c; analytic shapes and
@@ -37,7 +42,9 @@ struct rt_body {
     float *verts; /* anchor-relative vertices of every level, padded for Embree's 16-byte loads */
     float *vnormal; /* smooth shading: unit normals at the vertices, body frame (NULL: flat) */
     const unsigned *tri[NC_LOD_MAX_LEVELS]; /* each level's triangles (Embree's index buffer) */
-    float *facet_n[NC_LOD_MAX_LEVELS];      /* each level's facet normals, body frame (nc_rt_bin_camera) */
+    /* each level's facets' planes, body frame (nc_rt_bin_camera, nc_rt_refine_mesh16): the normal n
+     * and n . v0, 4 floats each (nc__bins_facets) */
+    float *facet[NC_LOD_MAX_LEVELS];
     struct nc__bins_cluster *cluster[NC_LOD_MAX_LEVELS]; /* and its triangles' clusters */
     unsigned inst_id;
     RTCGeometry inst;
@@ -63,8 +70,24 @@ struct rt_body {
     int refine;                             /* a mesh anchored near the camera: nc_rt_refine_mesh16 */
     double max_edge_m[NC_LOD_MAX_LEVELS];   /* each level's longest edge, m (0: not measured yet) */
     unsigned anchor_gen;
-    /* Analytic ellipsoid in anchor-relative coordinates. */
-    double centre[3], radii[3];
+    /* Analytic ellipsoid in anchor-relative coordinates, and the same about
+     * the body's origin (ell0: its geometry ell0_geom in scene ell0_scene,
+     * what other bodies' far frames hold). */
+    struct ell ell, ell0;
+    RTCScene ell0_scene;
+    RTCGeometry ell0_geom;
+    /* Shadow rays leaving this body while the camera is farther than a
+     * bounding radius from its bounding sphere (far) are traced relative to
+     * its origin (scene axes), where float rays and geometry carry 6e-8 of
+     * the body's size rather than of the range: far_top holds every body
+     * (far_inst[k]: body k's instance, NULL for this body when it is
+     * analytic: a convex shape cannot shadow itself) and every rock tile
+     * (far_tile: 2 instances a tile, in far_top and in far_solo, the rocks
+     * alone), placed from this body's origin. */
+    int far;
+    RTCScene far_top, far_solo;
+    RTCGeometry far_inst[NC_MAX_BODIES];
+    RTCGeometry *far_tile;
     float rot[9]; /* body -> scene, row-major, for normals */
     struct nc_mat3 R;        /* body -> scene, double */
     struct nc_vec3 origin_rel; /* body origin relative to the camera, scene frame, metres */
@@ -94,6 +117,7 @@ struct nc_rt {
      * rock_binned; else through the rocks' trees) */
     struct nc__rock_bins rock_bins;
     int rock_binned;
+    size_t far_ntiles; /* every body's rock tiles (rt_body.far_tile) */
 };
 
 static int rt_check(RTCDevice dev, const char *what)
@@ -148,7 +172,7 @@ static inline struct lane lane_of(const float *ray, unsigned N, unsigned i)
 
 static void ell_bounds(const struct RTCBoundsFunctionArguments *a)
 {
-    const struct rt_body *b = a->geometryUserPtr;
+    const struct ell *b = a->geometryUserPtr;
     /* Pad by a relative 1e-6 so float rounding never clips the shape. */
     for (int k = 0; k < 3; k++) {
         double pad = 1e-6 * (fabs(b->centre[k]) + b->radii[k]);
@@ -157,23 +181,40 @@ static void ell_bounds(const struct RTCBoundsFunctionArguments *a)
     }
 }
 
-/* Nearest root of |(o + t d - c)/radii| = 1 in (tnear, tfar), or INFINITY. */
-static double ell_hit(const struct rt_body *b, const float o[3], const float d[3], double tnear, double tfar)
+/* The roots t1, t2 of |op + t dp| = 1 (an ellipsoid scaled to the unit
+ * sphere); 0 where the line misses it. The discriminant B^2 - A C is taken
+ * as A (1 - |l|^2), l the line's point nearest the centre, and C = |op|^2 -
+ * 1 as (|op| - 1)(|op| + 1): B^2 - A C cancels for an origin many radii
+ * away (a shadow ray passing 100 radii from a sphere 1e10 radii away met
+ * it), |op|^2 - 1 for one at the surface. */
+static int ell_roots(const double op[3], const double dp[3], double *t1, double *t2)
 {
-    double op[3], dp[3];
+    const double A = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2];
+    const double B = op[0] * dp[0] + op[1] * dp[1] + op[2] * dp[2];
+    if (!(A > 0))
+        return 0;
+    const double s = B / A, l[3] = {op[0] - s * dp[0], op[1] - s * dp[1], op[2] - s * dp[2]};
+    const double ln = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]), disc = A * ((1.0 - ln) * (1.0 + ln));
+    if (!(disc >= 0))
+        return 0;
+    const double on = sqrt(op[0] * op[0] + op[1] * op[1] + op[2] * op[2]), C = (on - 1.0) * (on + 1.0);
+    /* Stable roots: q = -(B + sign(B) sqrt(disc)), t = q/A and C/q. */
+    const double q = -(B + copysign(sqrt(disc), B));
+    *t1 = q / A;
+    *t2 = q != 0 ? C / q : *t1;
+    return 1;
+}
+
+/* Nearest root of |(o + t d - c)/radii| = 1 in (tnear, tfar), or INFINITY. */
+static double ell_hit(const struct ell *b, const float o[3], const float d[3], double tnear, double tfar)
+{
+    double op[3], dp[3], t1, t2;
     for (int k = 0; k < 3; k++) {
         op[k] = ((double)o[k] - b->centre[k]) / b->radii[k];
         dp[k] = (double)d[k] / b->radii[k];
     }
-    double A = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2];
-    double B = op[0] * dp[0] + op[1] * dp[1] + op[2] * dp[2];
-    double C = op[0] * op[0] + op[1] * op[1] + op[2] * op[2] - 1.0;
-    double disc = B * B - A * C;
-    if (!(disc >= 0) || A == 0)
+    if (!ell_roots(op, dp, &t1, &t2))
         return INFINITY;
-    /* Stable roots: q = -(B + sign(B) sqrt(disc)), t = q/A and C/q. */
-    double q = -(B + copysign(sqrt(disc), B));
-    double t1 = q / A, t2 = q != 0 ? C / q : t1;
     double lo = fmin(t1, t2), hi = fmax(t1, t2);
     if (lo > tnear && lo < tfar)
         return lo;
@@ -184,7 +225,7 @@ static double ell_hit(const struct rt_body *b, const float o[3], const float d[3
 
 static void ell_intersect(const struct RTCIntersectFunctionNArguments *a)
 {
-    const struct rt_body *b = a->geometryUserPtr;
+    const struct ell *b = a->geometryUserPtr;
     const float *ray = (const float *)a->rayhit;
     unsigned N = a->N;
     for (unsigned i = 0; i < N; i++) {
@@ -205,7 +246,7 @@ static void ell_intersect(const struct RTCIntersectFunctionNArguments *a)
 
 static void ell_occluded(const struct RTCOccludedFunctionNArguments *a)
 {
-    const struct rt_body *b = a->geometryUserPtr;
+    const struct ell *b = a->geometryUserPtr;
     float *ray = (float *)a->ray;
     unsigned N = a->N;
     for (unsigned i = 0; i < N; i++) {
@@ -218,6 +259,20 @@ static void ell_occluded(const struct RTCOccludedFunctionNArguments *a)
 }
 
 /* ---- setup ---------------------------------------------------------------- */
+
+/* An ellipsoid's user geometry over e, attached to a new scene *scene. */
+static RTCGeometry ell_geometry(RTCDevice dev, struct ell *e, RTCScene *scene)
+{
+    *scene = rtcNewScene(dev);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(g, 1);
+    rtcSetGeometryUserData(g, e);
+    rtcSetGeometryBoundsFunction(g, ell_bounds, NULL);
+    rtcSetGeometryIntersectFunction(g, ell_intersect);
+    rtcSetGeometryOccludedFunction(g, ell_occluded);
+    rtcAttachGeometry(*scene, g);
+    return g;
+}
 
 /* A mesh level of detail: its triangles over the body's shared vertices. */
 static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct nc_mesh_lod_level *lv)
@@ -248,10 +303,15 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
     b->closed[k] = closed;
     /* The facets' normals and clusters for the camera-ray bins. */
     const size_t ncl = (lv->nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
-    if (!(b->facet_n[k] = malloc((3 * lv->nt + 3) * sizeof *b->facet_n[k])) ||
+    if (!(b->facet[k] = aligned_alloc(16, (4 * lv->nt + 4) * sizeof *b->facet[k])) ||
         !(b->cluster[k] = malloc((ncl + 1) * sizeof *b->cluster[k])))
-        return nc_error(-ENOMEM, "out of memory for the normals of %zu facets", lv->nt);
-    nc__bins_facets(m->v, lv->tri, lv->nt, b->facet_n[k], b->cluster[k]);
+        return nc_error(-ENOMEM, "out of memory for the planes of %zu facets", lv->nt);
+    nc__bins_facets(m->v, lv->tri, lv->nt, b->facet[k], b->cluster[k]);
+    for (size_t t = 0; t < lv->nt; t++) { /* the plane through v0 with that float normal */
+        float *f = b->facet[k] + 4 * t;
+        const double *v0 = m->v + 3 * (size_t)lv->tri[3 * t];
+        f[3] = (float)((double)f[0] * v0[0] + (double)f[1] * v0[1] + (double)f[2] * v0[2]);
+    }
     return rt_check(rt->dev, "creating geometry");
 }
 
@@ -284,17 +344,13 @@ static int body_init(struct nc_rt *rt, unsigned index, const struct nc_body *src
     int rc = 0;
     if (src->shape == NC_SHAPE_SPHERE || src->shape == NC_SHAPE_ELLIPSOID) {
         b->analytic = 1;
-        b->radii[0] = src->radii_m.x;
-        b->radii[1] = src->radii_m.y;
-        b->radii[2] = src->radii_m.z;
-        b->scene[0] = rtcNewScene(rt->dev);
-        RTCGeometry g = b->geom[0] = rtcNewGeometry(rt->dev, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(g, 1);
-        rtcSetGeometryUserData(g, b);
-        rtcSetGeometryBoundsFunction(g, ell_bounds, NULL);
-        rtcSetGeometryIntersectFunction(g, ell_intersect);
-        rtcSetGeometryOccludedFunction(g, ell_occluded);
-        rtcAttachGeometry(b->scene[0], g);
+        b->ell.radii[0] = b->ell0.radii[0] = src->radii_m.x;
+        b->ell.radii[1] = b->ell0.radii[1] = src->radii_m.y;
+        b->ell.radii[2] = b->ell0.radii[2] = src->radii_m.z;
+        b->geom[0] = ell_geometry(rt->dev, &b->ell, &b->scene[0]);
+        b->ell0_geom = ell_geometry(rt->dev, &b->ell0, &b->ell0_scene);
+        rtcCommitGeometry(b->ell0_geom);
+        rtcCommitScene(b->ell0_scene);
         b->nlevels = 1;
     } else {
         const struct nc_mesh *m = &src->mesh;
@@ -343,6 +399,92 @@ static void fit_level(struct rt_body *b, int k)
     b->fitted[k] = b->anchor_gen;
 }
 
+/* Instance g placed by rotation R and translation T (float), committed. */
+static void instance_at(RTCGeometry g, const struct nc_mat3 *R, struct nc_vec3 T)
+{
+    float xfm[12];
+    for (int c = 0; c < 3; c++)
+        for (int r = 0; r < 3; r++)
+            xfm[3 * c + r] = (float)R->m[r][c];
+    xfm[9] = (float)T.x;
+    xfm[10] = (float)T.y;
+    xfm[11] = (float)T.z;
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    rtcCommitGeometry(g);
+}
+
+static RTCGeometry new_instance(RTCDevice dev, RTCScene of, RTCScene in)
+{
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_INSTANCE);
+    if (g) {
+        rtcSetGeometryInstancedScene(g, of);
+        rtcAttachGeometry(in, g);
+    }
+    return g;
+}
+
+/* Every body's far frame (rt_body.far_top): instances of the other bodies
+ * and of every body's rock tiles. */
+static int far_init(struct nc_rt *rt)
+{
+    size_t ntiles = 0;
+    for (int k = 0; k < rt->nbodies; k++)
+        ntiles += rt->body[k].rocks.ntiles;
+    rt->far_ntiles = ntiles;
+    for (int f = 0; f < rt->nbodies; f++) {
+        struct rt_body *fb = &rt->body[f];
+        fb->far_top = rtcNewScene(rt->dev);
+        rtcSetSceneBuildQuality(fb->far_top, RTC_BUILD_QUALITY_LOW);
+        if (ntiles) {
+            fb->far_solo = rtcNewScene(rt->dev);
+            rtcSetSceneBuildQuality(fb->far_solo, RTC_BUILD_QUALITY_LOW);
+            if (!(fb->far_tile = calloc(2 * ntiles, sizeof *fb->far_tile)))
+                return nc_error(-ENOMEM, "out of memory for %zu instances", 2 * ntiles);
+        }
+        RTCGeometry *tile = fb->far_tile;
+        for (int k = 0; k < rt->nbodies; k++) {
+            const struct rt_body *b = &rt->body[k];
+            if ((k != f || !b->analytic) &&
+                !(fb->far_inst[k] = new_instance(rt->dev, b->analytic ? b->ell0_scene : b->scene[0], fb->far_top)))
+                return nc_error(NC_ERENDER, "embree: cannot create an instance");
+            for (size_t t = 0; t < b->rocks.ntiles; t++, tile += 2)
+                if (!(tile[0] = new_instance(rt->dev, b->rocks.tile[t].scene, fb->far_top)) ||
+                    !(tile[1] = new_instance(rt->dev, b->rocks.tile[t].scene, fb->far_solo)))
+                    return nc_error(NC_ERENDER, "embree: cannot create a boulder tile's instance");
+        }
+    }
+    return rt_check(rt->dev, "creating the far frames");
+}
+
+/* Body f's far frame brought to the last update: every body (its level
+ * shown) and every rock tile traced, placed from f's origin. */
+static void far_place(struct nc_rt *rt, struct rt_body *fb)
+{
+    RTCGeometry *tile = fb->far_tile;
+    for (int k = 0; k < rt->nbodies; k++) {
+        const struct rt_body *b = &rt->body[k];
+        const struct nc_vec3 rel = nc_v3_sub(b->origin_rel, fb->origin_rel); /* its origin from f's */
+        if (fb->far_inst[k]) {
+            if (!b->analytic)
+                rtcSetGeometryInstancedScene(fb->far_inst[k], b->scene[b->level]);
+            instance_at(fb->far_inst[k], &b->R, b->analytic ? rel : nc_v3_add(nc_mat_mul_v(&b->R, b->anchor_m), rel));
+        }
+        for (size_t t = 0; t < b->rocks.ntiles; t++, tile += 2) {
+            const struct nc__rt_rock_tile *tl = &b->rocks.tile[t];
+            for (int q = 0; q < 2; q++) {
+                (tl->enabled ? rtcEnableGeometry : rtcDisableGeometry)(tile[q]);
+                if (tl->enabled)
+                    instance_at(tile[q], &b->R,
+                                nc_v3_add(nc_mat_mul_v(&b->R, nc_v3(tl->origin_m[0], tl->origin_m[1], tl->origin_m[2])),
+                                          rel));
+            }
+        }
+    }
+    rtcCommitScene(fb->far_top);
+    if (fb->far_solo)
+        rtcCommitScene(fb->far_solo);
+}
+
 int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
 {
     struct nc_rt *rt = calloc(1, sizeof *rt);
@@ -371,6 +513,8 @@ int nc_rt_create(const struct nc_scene *s, int threads, struct nc_rt **out)
         rc = body_init(rt, (unsigned)i, &s->body[i], s->render.lod_error_px);
         rt->nbodies = i + 1;
     }
+    if (rc == 0)
+        rc = far_init(rt);
     if (rc == 0)
         rc = nc_rt_update(rt, s);
     /* Every level's tree now, not when a frame first needs it. */
@@ -405,9 +549,9 @@ static void reanchor(struct rt_body *b, struct nc_vec3 a)
     b->anchored = 1;
     b->anchor_gen++;
     if (b->analytic) {
-        b->centre[0] = -a.x;
-        b->centre[1] = -a.y;
-        b->centre[2] = -a.z;
+        b->ell.centre[0] = -a.x;
+        b->ell.centre[1] = -a.y;
+        b->ell.centre[2] = -a.z;
     } else {
         const struct nc_mesh *m = &b->src->mesh;
         float *vb = b->verts;
@@ -524,6 +668,7 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
          * every range (above); near the camera, an edge's length can exceed
          * the range */
         b->refine = !b->analytic && (a.x != 0 || a.y != 0 || a.z != 0);
+        b->far = dmin >= src->bounding_radius_m; /* its shadow rays in its far frame */
         /* Level of detail: the coarsest whose surface error stays within
          * render.lod_error_px pixels at the nearest possible range (the
          * bounding sphere; the finest pixel axis). A function of the pose. */
@@ -536,27 +681,18 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             rtcSetGeometryInstancedScene(b->inst, b->scene[k]);
             b->level = k;
         }
-        if (b->refine && b->max_edge_m[k] == 0)
+        if (!b->analytic && (b->refine || b->far) && b->max_edge_m[k] == 0)
             b->max_edge_m[k] = longest_edge(&b->src->mesh, b->tri[k], b->nt[k]);
         rt->refine_on |= b->refine;
         rt->stats.lod_level[i] = k;
         rt->stats.lod_triangles[i] = b->nt[k];
         rt->stats.lod_error_m[i] = b->error_m[k];
-        struct nc_vec3 T = nc_v3_sub(nc_v3_add(nc_mat_mul_v(&R, b->anchor_m), src->position_m), cam);
-        float xfm[12];
-        for (int c = 0; c < 3; c++)
-            for (int r = 0; r < 3; r++)
-                xfm[3 * c + r] = (float)R.m[r][c];
-        xfm[9] = (float)T.x;
-        xfm[10] = (float)T.y;
-        xfm[11] = (float)T.z;
         for (int e = 0; e < 9; e++)
             b->rot[e] = (float)R.m[e / 3][e % 3];
         b->R = R;
         b->origin_rel = nc_v3_sub(src->position_m, cam);
         b->cull_radius_m = src->bounding_radius_m * (1 + 1e-5) + 1e-5 * nc_v3_norm(b->origin_rel);
-        rtcSetGeometryTransform(b->inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
-        rtcCommitGeometry(b->inst);
+        instance_at(b->inst, &R, nc_v3_sub(nc_v3_add(nc_mat_mul_v(&R, b->anchor_m), src->position_m), cam));
         if (b->rocks.ntiles) {
             /* Boulders: those spanning render.boulder_min_px pixels at the
              * nearest possible range (every one from inside the bounding
@@ -580,6 +716,9 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
         if ((rc = update_grid(b, s)) < 0)
             return rc;
     }
+    for (int i = 0; i < rt->nbodies; i++)
+        if (rt->body[i].far)
+            far_place(rt, &rt->body[i]);
     rtcCommitScene(rt->top);
     if (rt->solo)
         rtcCommitScene(rt->solo);
@@ -772,7 +911,7 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
         triangles += (double)b->nt[b->level];
         bd[i] = (struct nc__bins_body){.v = b->src->mesh.v,
                                        .tri = b->tri[b->level],
-                                       .ng = b->facet_n[b->level],
+                                       .ng = b->facet[b->level],
                                        .cl = b->cluster[b->level],
                                        .nv = b->src->mesh.nv,
                                        .nt = b->nt[b->level],
@@ -873,7 +1012,7 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
                 const struct rt_body *b = &rt->body[bi];
                 if (!b->vnormal && !b->src->albedo_vertex) { /* put_hit's steps for a flat, uniform facet */
                     put_surface(b, bi, t[q][i], ct->ng[0], ct->ng[1], ct->ng[2], 1.0f, h, i);
-                    if (b->refine)
+                    if (b->refine || b->far)
                         nc__bins_which(&rt->bins, slot[q][i], &h->prim[i]);
                     continue;
                 }
@@ -892,6 +1031,54 @@ void nc_rt_intersect_block(struct nc_rt *rt, int px0, int py0, const struct nc_r
 }
 
 int nc_rt_refine_on(const struct nc_rt *rt) { return rt->refine_on; }
+
+int nc_rt_far_frame(const struct nc_rt *rt, int b, double *scale_m)
+{
+    *scale_m = rt->body[b].src->bounding_radius_m;
+    return rt->body[b].far;
+}
+
+/* nc_rt_refine_far16 on a mesh, branch-free (AVX-512 or AVX2 where the CPU
+ * has it, without contraction: the same bits as plain code): each ray met
+ * against the plane of its facet in the body frame (the facet's float
+ * normal and offset, one 16-byte load: within 1.2e-7 of the body's radius
+ * of the float triangle its far frame holds). */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void
+refine_far16(const struct rt_body *b, const int *lanes, const uint32_t *prim, const struct nc_vec3 *orig,
+             const struct nc_vec3 *dir, double *t, int *done)
+{
+    const float *fp = b->facet[b->level];
+    const double edge = b->max_edge_m[b->level];
+    const struct nc_mat3 R = b->R;
+    const struct nc_vec3 rel = b->origin_rel;
+    for (int i = 0; i < NC_PACKET; i++) {
+        const int on = lanes[i] != 0;
+        const size_t p = on ? prim[i] : 0;
+        const double nx = fp[4 * p], ny = fp[4 * p + 1], nz = fp[4 * p + 2];
+        /* n . R^T x = (R n) . x: the normal into the scene frame instead */
+        const double sx = R.m[0][0] * nx + R.m[0][1] * ny + R.m[0][2] * nz,
+                     sy = R.m[1][0] * nx + R.m[1][1] * ny + R.m[1][2] * nz,
+                     sz = R.m[2][0] * nx + R.m[2][1] * ny + R.m[2][2] * nz;
+        const double ox = orig[i].x - rel.x, oy = orig[i].y - rel.y, oz = orig[i].z - rel.z;
+        const double tt =
+            (fp[4 * p + 3] - (sx * ox + sy * oy + sz * oz)) / (sx * dir[i].x + sy * dir[i].y + sz * dir[i].z);
+        /* a plane seen edge-on, or a double ray on another triangle's plane
+         * (at an edge): the float answer stands */
+        const int ok = on & (fabs(tt - t[i]) <= 1e-4 * t[i] + 1e-3 * edge) & (tt > 0);
+        t[i] = ok ? tt : t[i];
+        done[i] = ok;
+    }
+}
+
+void nc_rt_refine_far16(const struct nc_rt *rt, int b, const int *lanes, const uint32_t *prim,
+                        const struct nc_vec3 *orig, const struct nc_vec3 *dir, double *t, int *done)
+{
+    if (!rt->body[b].analytic)
+        refine_far16(&rt->body[b], lanes, prim, orig, dir, t, done);
+    else
+        for (int i = 0; i < NC_PACKET; i++)
+            done[i] = lanes[i] != 0;
+}
 
 void nc_rt_refine_mesh16(const struct nc_rt *rt, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
                          const struct nc_vec3 *dir, double *t, double *scale)
@@ -933,16 +1120,10 @@ int nc_rt_refine(const struct nc_rt *rt, int body, struct nc_vec3 origin, struct
         return 0;
     /* Body frame, body origin at zero: o = R^T (origin - origin_rel), d' = R^T d. */
     struct nc_vec3 o = nc_mat_tmul_v(&b->R, nc_v3_sub(origin, b->origin_rel)), db = nc_mat_tmul_v(&b->R, d);
-    const double *r = b->radii;
-    double op[3] = {o.x / r[0], o.y / r[1], o.z / r[2]}, dp[3] = {db.x / r[0], db.y / r[1], db.z / r[2]};
-    double A = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2];
-    double B = op[0] * dp[0] + op[1] * dp[1] + op[2] * dp[2];
-    /* C = |o'|^2 - 1 without cancellation for a camera close to the surface. */
-    double on = sqrt(op[0] * op[0] + op[1] * op[1] + op[2] * op[2]);
-    double C = (on - 1.0) * (on + 1.0), disc = B * B - A * C;
-    if (!(disc >= 0) || !(A > 0))
+    const double *r = b->ell.radii;
+    double op[3] = {o.x / r[0], o.y / r[1], o.z / r[2]}, dp[3] = {db.x / r[0], db.y / r[1], db.z / r[2]}, t1, t2;
+    if (!ell_roots(op, dp, &t1, &t2))
         return -1;
-    double q = -(B + copysign(sqrt(disc), B)), t1 = q / A, t2 = q != 0 ? C / q : t1;
     double tt = fmin(t1, t2) > 0 ? fmin(t1, t2) : fmax(t1, t2);
     if (!(tt > 0))
         return -1;
@@ -960,28 +1141,41 @@ static int ray_near_sphere(struct nc_vec3 o, struct nc_vec3 d, struct nc_vec3 c,
     return tc <= 0 ? cc <= r * r : cc - tc * tc / nc_v3_dot(d, d) <= r * r;
 }
 
+/* The grid's offsets (rt_body.grid_off) for origins in a frame at shift
+ * from the camera. */
+static void grid_offsets(const struct rt_body *b, struct nc_vec3 shift, double *off)
+{
+    for (int c = 0; c < 3; c++)
+        off[c] = b->grid_off[c] - nc_v3_dot(shift, b->grid_axis[c]);
+}
+
 /* Proof that lane i, leaving the outside of body `from`, meets nothing: its
  * own body's shadow grid (a convex analytic shape cannot shadow itself) and
- * every other body's bounding sphere, padded for float rays. dir_ok: the
- * lane's direction suits the body's grid (nc_shadow_grid_dir_ok). */
-static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct nc_ray16 *ray, int i)
+ * every other body's bounding sphere, padded for float rays; the ray's
+ * frame is at shift from the camera. dir_ok: the lane's direction suits the
+ * body's grid (nc_shadow_grid_dir_ok). */
+static int proven_lit(const struct nc_rt *rt, int from, int dir_ok, const struct nc_ray16 *ray, int i,
+                      struct nc_vec3 shift)
 {
     const struct rt_body *b = &rt->body[from];
     struct nc_vec3 o = nc_v3(ray->ox[i], ray->oy[i], ray->oz[i]), d = nc_v3(ray->dx[i], ray->dy[i], ray->dz[i]);
     if (!b->analytic) {
         if (!dir_ok)
             return 0;
-        if (!nc_shadow_grid_lit_in(b->grid, b->grid_axis, b->grid_off, o))
+        double off[3];
+        grid_offsets(b, shift, off);
+        if (!nc_shadow_grid_lit_in(b->grid, b->grid_axis, off, o))
             return 0;
     }
     for (int k = 0; k < rt->nbodies; k++)
-        if (k != from && ray_near_sphere(o, d, rt->body[k].origin_rel, rt->body[k].cull_radius_m))
+        if (k != from && ray_near_sphere(o, d, nc_v3_sub(rt->body[k].origin_rel, shift), rt->body[k].cull_radius_m))
             return 0;
     return 1;
 }
 
 /* proven_lit lane by lane: proven[i] = -1 where proven; returns how many. */
-static int proven_lanes(const struct nc_rt *rt, const struct nc_ray16 *ray, const int *from, int *proven)
+static int proven_lanes(const struct nc_rt *rt, const struct nc_ray16 *ray, const int *from, int *proven,
+                        struct nc_vec3 shift)
 {
     int culled = 0, last = -1, ok = 0; /* the direction test, redone when body or direction changes */
     float ld[3] = {0, 0, 0};
@@ -996,16 +1190,32 @@ static int proven_lanes(const struct nc_rt *rt, const struct nc_ray16 *ray, cons
                 ok = !b->analytic && b->grid_level == b->level &&
                      nc_shadow_grid_dir_ok(b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(nc_v3(ld[0], ld[1], ld[2]))));
             }
-            if (proven_lit(rt, from[i], ok, ray, i))
+            if (proven_lit(rt, from[i], ok, ray, i, shift))
                 proven[i] = -1, culled++;
         }
     }
     return culled;
 }
 
-int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked)
+/* A shadow ray frame's origin from the camera (scene frame, m) and its
+ * scenes: -1 the camera's, else that body's far frame. */
+static struct nc_vec3 frame_of(const struct nc_rt *rt, int frame, RTCScene *top, RTCScene *solo)
+{
+    if (frame < 0) {
+        *top = rt->top;
+        *solo = rt->solo;
+        return nc_v3(0, 0, 0);
+    }
+    *top = rt->body[frame].far_top;
+    *solo = rt->body[frame].far_solo;
+    return rt->body[frame].origin_rel;
+}
+
+int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked, int frame)
 {
     int culled = 0, proven[NC_PACKET] = {0};
+    RTCScene top, solo;
+    const struct nc_vec3 shift = frame_of(rt, frame, &top, &solo);
     /* One mesh body and one direction (hard shadows): proven_lit for the
      * whole packet in one grid query. */
     int want[NC_PACKET], f = -1, alike = rt->nbodies == 1;
@@ -1020,13 +1230,16 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from,
         return 0;
     const struct rt_body *b = &rt->body[from[f]];
     if (alike && !b->analytic) {
-        if (b->grid_level == b->level &&
-            nc_shadow_grid_dir_ok(b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(nc_v3(ray->dx[f], ray->dy[f], ray->dz[f])))))
-            nc_shadow_grid_lit16(b->grid, b->grid_axis, b->grid_off, ray->ox, ray->oy, ray->oz, want, proven);
+        const struct nc_vec3 d = nc_v3(ray->dx[f], ray->dy[f], ray->dz[f]);
+        if (b->grid_level == b->level && nc_shadow_grid_dir_ok(b->grid, nc_mat_tmul_v(&b->R, nc_v3_unit(d)))) {
+            double off[3];
+            grid_offsets(b, shift, off);
+            nc_shadow_grid_lit16(b->grid, b->grid_axis, off, ray->ox, ray->oy, ray->oz, want, proven);
+        }
         for (int i = 0; i < NC_PACKET; i++)
             culled -= proven[i];
     } else {
-        culled = proven_lanes(rt, ray, from, proven);
+        culled = proven_lanes(rt, ray, from, proven, shift);
     }
     if (culled && rt->rocks_on) {
         /* Clear of every mesh, but rocks may stand in the way: the proven
@@ -1037,7 +1250,7 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from,
         struct nc_ray16 pr = *ray;
         memcpy(pr.valid, proven, sizeof proven);
         load_ray(&r, &pr);
-        rtcOccluded16(proven, rt->solo, &ctx, &r);
+        rtcOccluded16(proven, solo, &ctx, &r);
         for (int i = 0; i < NC_PACKET; i++)
             if (proven[i] && r.tfar[i] == -INFINITY)
                 blocked[i] = 1, culled--;
@@ -1048,7 +1261,7 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from,
     return culled;
 }
 
-void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded)
+void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded, int frame)
 {
     int any = 0;
     for (int i = 0; i < NC_PACKET; i++)
@@ -1061,7 +1274,9 @@ void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occlude
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     load_ray(&r, ray);
-    rtcOccluded16(ray->valid, rt->top, &ctx, &r);
+    RTCScene top, solo;
+    frame_of(rt, frame, &top, &solo);
+    rtcOccluded16(ray->valid, top, &ctx, &r);
     for (int i = 0; i < NC_PACKET; i++)
         occluded[i] = ray->valid[i] && r.tfar[i] == -INFINITY;
 }
@@ -1075,7 +1290,7 @@ void nc_rt_occluded_dirs(struct nc_rt *rt, const struct nc_vec3 *dir, int n, dou
         ray.tfar[i] = (float)tfar_m;
         ray.valid[i] = -1;
     }
-    nc_rt_occluded16(rt, &ray, occluded);
+    nc_rt_occluded16(rt, &ray, occluded, -1);
 }
 
 void nc_rt_count_shadow_rays(struct nc_rt *rt, unsigned long culled, unsigned long traced)
@@ -1133,6 +1348,7 @@ size_t nc_rt_rock_mesh_triangles(const struct nc_rt *rt, int b)
 struct nc_rt_batch {
     struct RTCRayHit16 *tmpl; /* 64-byte aligned templates */
     int (*valid)[NC_PACKET];
+    int *frame; /* each packet's (nc_rt_occluded16) */
     size_t n;
     int occlusion;
 };
@@ -1145,7 +1361,7 @@ struct batch_job {
 };
 
 /* Lane k of a packet as a single ray. */
-static void lane_trace(struct nc_rt *rt, const struct RTCRayHit16 *p, int k, int occlusion,
+static void lane_trace(RTCScene scene, const struct RTCRayHit16 *p, int k, int occlusion,
                        struct RTCIntersectContext *ctx)
 {
     struct RTCRayHit r;
@@ -1164,9 +1380,9 @@ static void lane_trace(struct nc_rt *rt, const struct RTCRayHit16 *p, int k, int
     r.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     r.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     if (occlusion)
-        rtcOccluded1(rt->top, ctx, &r.ray);
+        rtcOccluded1(scene, ctx, &r.ray);
     else
-        rtcIntersect1(rt->top, ctx, &r);
+        rtcIntersect1(scene, ctx, &r);
 }
 
 static void *batch_worker(void *arg)
@@ -1185,32 +1401,35 @@ static void *batch_worker(void *arg)
             break;
         size_t end = start + chunk < b->n ? start + chunk : b->n;
         for (size_t i = start; i < end; i++) {
+            RTCScene scene = b->frame[i] < 0 ? j->rt->top : j->rt->body[b->frame[i]].far_top;
             if (j->single) {
                 for (int k = 0; k < NC_PACKET; k++)
                     if (b->valid[i][k])
-                        lane_trace(j->rt, &b->tmpl[i], k, b->occlusion, &ctx);
+                        lane_trace(scene, &b->tmpl[i], k, b->occlusion, &ctx);
                 continue;
             }
             rh = b->tmpl[i];
             if (b->occlusion)
-                rtcOccluded16(b->valid[i], j->rt->top, &ctx, &rh.ray);
+                rtcOccluded16(b->valid[i], scene, &ctx, &rh.ray);
             else
-                rtcIntersect16(b->valid[i], j->rt->top, &ctx, &rh);
+                rtcIntersect16(b->valid[i], scene, &ctx, &rh);
         }
     }
     return NULL;
 }
 
-int nc_rt_batch_create(const struct nc_ray16 *rays, size_t n, int occlusion, struct nc_rt_batch **out)
+int nc_rt_batch_create(const struct nc_ray16 *rays, const int *frames, size_t n, int occlusion,
+                       struct nc_rt_batch **out)
 {
     struct nc_rt_batch *b = calloc(1, sizeof *b);
     if (!b || !(b->tmpl = aligned_alloc(64, (n ? n : 1) * sizeof *b->tmpl)) ||
-        !(b->valid = aligned_alloc(64, (n ? n : 1) * sizeof *b->valid))) {
-        if (b)
-            free(b->tmpl);
-        free(b);
+        !(b->valid = aligned_alloc(64, (n ? n : 1) * sizeof *b->valid)) ||
+        !(b->frame = malloc((n ? n : 1) * sizeof *b->frame))) {
+        nc_rt_batch_destroy(b);
         return nc_error(-ENOMEM, "out of memory for %zu packets", n);
     }
+    for (size_t i = 0; i < n; i++)
+        b->frame[i] = frames ? frames[i] : -1;
     b->n = n;
     b->occlusion = occlusion;
     for (size_t i = 0; i < n; i++) {
@@ -1249,6 +1468,7 @@ void nc_rt_batch_destroy(struct nc_rt_batch *b)
         return;
     free(b->tmpl);
     free(b->valid);
+    free(b->frame);
     free(b);
 }
 
@@ -1260,6 +1480,21 @@ void nc_rt_destroy(struct nc_rt *rt)
         struct rt_body *b = &rt->body[i];
         if (b->inst)
             rtcReleaseGeometry(b->inst);
+        for (int k = 0; k < rt->nbodies; k++)
+            if (b->far_inst[k])
+                rtcReleaseGeometry(b->far_inst[k]);
+        for (size_t k = 0; b->far_tile && k < 2 * rt->far_ntiles; k++)
+            if (b->far_tile[k])
+                rtcReleaseGeometry(b->far_tile[k]);
+        free(b->far_tile);
+        if (b->far_top)
+            rtcReleaseScene(b->far_top);
+        if (b->far_solo)
+            rtcReleaseScene(b->far_solo);
+        if (b->ell0_geom)
+            rtcReleaseGeometry(b->ell0_geom);
+        if (b->ell0_scene)
+            rtcReleaseScene(b->ell0_scene);
         nc__rt_rocks_free(&b->rocks);
         for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
             if (b->geom[k])
@@ -1280,7 +1515,7 @@ void nc_rt_destroy(struct nc_rt *rt)
         free(rt->body[i].verts);
         free(rt->body[i].vnormal);
         for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
-            free(rt->body[i].facet_n[k]);
+            free(rt->body[i].facet[k]);
             free(rt->body[i].cluster[k]);
         }
         for (int g = 0; g < 2; g++)

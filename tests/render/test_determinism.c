@@ -16,9 +16,9 @@ static int same(const struct nc_frame *a, const struct nc_frame *b)
            !memcmp(a->coverage, b->coverage, n);
 }
 
-static void count_packet(void *user, int shadow, const struct nc_ray16 *ray)
+static void count_packet(void *user, int shadow, const struct nc_ray16 *ray, int frame)
 {
-    (void)ray;
+    (void)ray, (void)frame;
     ((long *)user)[shadow]++;
 }
 
@@ -91,8 +91,9 @@ struct spread {
     double max_rad;
 };
 
-static void packet_spread(void *user, int shadow, const struct nc_ray16 *ray)
+static void packet_spread(void *user, int shadow, const struct nc_ray16 *ray, int frame)
 {
+    (void)frame;
     struct spread *sp = user;
     if (shadow)
         return;

@@ -43,8 +43,9 @@ static void extent(const struct nc_frame *f, double thresh, int *x0, int *x1, in
             }
 }
 
-static void count_rays(void *user, int shadow, const struct nc_ray16 *ray) /* from the render threads */
+static void count_rays(void *user, int shadow, const struct nc_ray16 *ray, int frame) /* from the render threads */
 {
+    (void)frame;
     unsigned long n = 0;
     for (int i = 0; !shadow && i < NC_PACKET; i++)
         n += ray->valid[i] != 0;

@@ -1,0 +1,187 @@
+/* test_far_shadow.c - shadows of a body seen from afar through a narrow
+ * field (nc_rt_far_frame): its shadow rays go relative to its own origin,
+ * so a shadow ray starts 4e-6 of the body's size off the surface, not 4e-6
+ * of the range (which left relief lower than that without a shadow and
+ * moved every shadow edge by about 4e-6 fx / tan(e) pixels).
+ *  A: a 30 m sphere 60 m over a 1 km sphere, the Sun 60 deg from the
+ *     vertical, 10 m pixels seen from 2e5, 2e6 and 2e7 m (fx = range / 10 m):
+ *     the small sphere's shadow (the shadowed fraction of each pixel's light,
+ *     from frames with and without it) against a double-precision reference
+ *     of the two spheres (8 x 8 points a pixel). Before the far frames: 0.23,
+ *     2.2 and 13.9 px off, 0.93 and 0.34 of the area at 2e6 and 2e7 m.
+ *  B: a mesh plate with a ridge 0.5 m high and 1 m wide, seen from 2e5 m
+ *     with 0.25 m pixels (fx 8e5 px: a shadow ray started 0.8 m up), the Sun
+ *     20 deg over the plate across the ridge: the ridge's shadow on the
+ *     plate 0.874 m wide (0.5 / tan 20 deg less the ridge's half width; none
+ *     before), and the plate lit beyond it (no false self-shadowing). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "testutil.h"
+
+static const char spheres[] = "bodies:\n"
+                              "  - name: big\n"
+                              "    shape: {type: sphere, radius_m: 1000}\n"
+                              "    material: {model: lambert, A: 0.5}\n"
+                              "  - name: small\n"
+                              "    shape: {type: sphere, radius_m: 30}\n"
+                              "    position_m: [0, 0, 1090]\n"
+                              "    material: {model: lambert, A: 0.5}\n"
+                              "sun: {direction: [0.8660254037844386, 0, 0.5]}\n"
+                              "camera: {width_px: 64, height_px: 64, fx_px: 20000, fy_px: 20000,\n"
+                              "         position_m: [-160, 0, 200000], look_at_m: [-160, 0, 1000], up: [1, 0, 0]}\n"
+                              "render: {samples_per_pixel: 16}\n";
+
+/* The nearest t > 0 of ray o + t d (d unit) on the sphere (c, r), or
+ * INFINITY: from the line's point nearest the centre (no cancellation for
+ * an origin 2e7 m away). */
+static double sphere_hit(struct nc_vec3 o, struct nc_vec3 d, struct nc_vec3 c, double r)
+{
+    const struct nc_vec3 oc = nc_v3_sub(o, c);
+    const double b = nc_v3_dot(oc, d);
+    const struct nc_vec3 l = nc_v3_sub(oc, nc_v3_scale(d, b));
+    const double h2 = r * r - nc_v3_dot(l, l);
+    if (!(h2 >= 0))
+        return INFINITY;
+    const double t0 = -b - sqrt(h2), t1 = -b + sqrt(h2);
+    return t0 > 0 ? t0 : t1 > 0 ? t1 : INFINITY;
+}
+
+/* The two spheres' frame in double precision, 8 x 8 points a pixel: each
+ * point's Lambert radiance (1/sr of the irradiance) where a camera ray
+ * meets a sphere lit by the Sun unblocked; small: whether the small sphere
+ * is there. */
+static void reference(const struct nc_scene *s, int small, double *L)
+{
+    const struct nc_vec3 cb = nc_v3(0, 0, 0), cs = nc_v3(0, 0, 1090), sd = nc_v3_unit(s->sun.direction);
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            double sum = 0;
+            for (int k = 0; k < 64; k++) {
+                const double u = x - 0.4375 + 0.125 * (k % 8), v = y - 0.4375 + 0.125 * (k / 8);
+                const struct nc_vec3 d =
+                    nc_v3_unit(nc_quat_rotate(s->camera.attitude_q, nc_camera_dir(&s->camera, u, v)));
+                const double tb = sphere_hit(s->camera.position_m, d, cb, 1000);
+                const double ts = small ? sphere_hit(s->camera.position_m, d, cs, 30) : INFINITY;
+                if (!(fmin(tb, ts) < INFINITY))
+                    continue;
+                const struct nc_vec3 p = nc_v3_add(s->camera.position_m, nc_v3_scale(d, fmin(tb, ts)));
+                const struct nc_vec3 n = nc_v3_unit(nc_v3_sub(p, ts < tb ? cs : cb));
+                const double mu0 = nc_v3_dot(n, sd);
+                if (mu0 > 0 && !(ts >= tb && small && sphere_hit(p, sd, cs, 30) < INFINITY))
+                    sum += 0.5 / M_PI * mu0;
+            }
+            L[y * 64 + x] = sum / 64;
+        }
+}
+
+/* The shadowed fraction's sum (px) and centroid of "with" against "without". */
+static void shadow_of(const double *with, const double *without, double *area, double *cx, double *cy)
+{
+    double sum = 0, sx = 0, sy = 0;
+    for (int i = 0; i < 64 * 64; i++) {
+        const double f = without[i] > 0 && with[i] < without[i] ? (without[i] - with[i]) / without[i] : 0;
+        sum += f, sx += f * (i % 64), sy += f * (i / 64);
+    }
+    *area = sum, *cx = sx / sum, *cy = sy / sum;
+}
+
+/* The small sphere's shadow at range D in the render (area: px, the
+ * shadowed fraction summed over the frames with and without the small
+ * sphere; its centroid) and in the double-precision reference (ref: area,
+ * x, y). */
+static void shadow_at(double D, double *area, double *cx, double *cy, double *ref)
+{
+    char fx[64], fy[64], pos[96];
+    snprintf(fx, sizeof fx, "camera.fx_px=%.17g", D / 10);
+    snprintf(fy, sizeof fy, "camera.fy_px=%.17g", D / 10);
+    snprintf(pos, sizeof pos, "camera.position_m=[-160, 0, %.17g]", D);
+    const char *with[] = {fx, fy, pos}, *without[] = {fx, fy, pos, "bodies.1.position_m=[0, 1e6, 0]"};
+    struct nc_scene s;
+    struct nc_frame a, b;
+    nc_test_scene(spheres, without, 4, &s);
+    nc_test_render(&s, 2, &b);
+    nc_scene_free(&s);
+    nc_test_scene(spheres, with, 3, &s);
+    nc_test_render(&s, 2, &a);
+    static double la[64 * 64], lb[64 * 64];
+    for (int i = 0; i < 64 * 64; i++)
+        la[i] = a.radiance[i], lb[i] = b.radiance[i];
+    shadow_of(la, lb, area, cx, cy);
+    reference(&s, 1, la);
+    reference(&s, 0, lb);
+    shadow_of(la, lb, &ref[0], &ref[1], &ref[2]);
+    nc_frame_free(&a);
+    nc_frame_free(&b);
+    nc_scene_free(&s);
+}
+
+int main(void)
+{
+    /* A */
+    for (int k = 0; k < 3; k++) {
+        const double D = k == 0 ? 2e5 : k == 1 ? 2e6 : 2e7;
+        double a, x, y, ref[3];
+        shadow_at(D, &a, &x, &y, ref);
+        printf("%.0e m: shadow %.3f px, centroid (%.3f, %.3f); double-precision reference %.3f px at (%.3f, %.3f)\n",
+               D, a, x, y, ref[0], ref[1], ref[2]);
+        CHECK(fabs(a / ref[0] - 1) < 0.02 && hypot(x - ref[1], y - ref[2]) < 0.1,
+              "%.0e m: %.4f of the area, %.3f px off", D, a / ref[0], hypot(x - ref[1], y - ref[2]));
+    }
+
+    /* B: the plate z = 0, 40 m square, the ridge along y: x = -0.5, 0, 0.5
+     * at heights 0, 0.5, 0 (two rows of vertices, y = -20 and 20) */
+    const char *obj = nc_test_path("ridge.obj");
+    FILE *fo = fopen(obj, "w");
+    const double xs[5] = {-20, -0.5, 0, 0.5, 20}, zs[5] = {0, 0, 0.5, 0, 0};
+    for (int r = 0; r < 2; r++)
+        for (int i = 0; i < 5; i++)
+            fprintf(fo, "v %.17g %.17g %.17g\n", xs[i], r ? 20.0 : -20.0, zs[i]);
+    for (int i = 1; i <= 4; i++) /* up: +z */
+        fprintf(fo, "f %d %d %d\nf %d %d %d\n", i, i + 1, i + 6, i, i + 6, i + 5);
+    fclose(fo);
+    char shape[1200];
+    snprintf(shape, sizeof shape, "bodies.0.shape={type: mesh, file: '%s', unit: m}", obj);
+    const double e = 20 * M_PI / 180;
+    char sun[128];
+    snprintf(sun, sizeof sun, "sun.direction=[%.17g, 0, %.17g]", -cos(e), sin(e));
+    const char *sets[] = {shape, sun, "bodies.1.position_m=[0, 1e7, 0]", "camera.width_px=128",
+                          "camera.height_px=128", "camera.fx_px=8e5", "camera.fy_px=8e5",
+                          "camera.position_m=[0, 0, 2e5]", "camera.look_at_m=[0, 0, 0]", "camera.up=[0, 1, 0]"};
+    struct nc_scene s;
+    struct nc_frame f;
+    nc_test_scene(spheres, sets, 10, &s);
+    nc_test_render(&s, 2, &f);
+    /* pixel columns 0.25 m wide, edges on multiples of 0.25 m at z = 0 (a
+     * pixel's ground x from the camera's own projection of two points on the
+     * ridge's foot line); the shadowed fraction of the plate's light, rows
+     * |y| < 12 m, in whole columns from the ridge's foot to 3 m */
+    const double lit = 0.5 / M_PI * s.sun.irradiance_w_m2 * sin(e), want = 0.5 / tan(e) - 0.5;
+    double at[2];
+    for (int k = 0; k < 2; k++) {
+        const struct nc_vec3 d =
+            nc_quat_rotate(nc_quat_conj(s.camera.attitude_q), nc_v3_sub(nc_v3(k, 0, 0), s.camera.position_m));
+        double yd;
+        nc_camera_project(&s.camera, d, &at[k], &yd);
+    }
+    double cols = 0, beyond = 0;
+    int nb = 0;
+    for (int y = 16; y < 112; y++)
+        for (int x = 0; x < 128; x++) {
+            const double gx = (x - at[0]) / (at[1] - at[0]), l = f.radiance[y * 128 + x];
+            if (gx > 0.6 && gx < 2.9)
+                cols += 1 - l / lit;
+            if (gx > 1.5 && gx < 3)
+                beyond += l / lit, nb++;
+        }
+    const double rows = 96;
+    printf("the ridge's shadow on the plate: %.4f m wide (%.4f expected); the plate beyond it at %.6f of full light\n",
+           0.25 * cols / rows, want, beyond / nb);
+    CHECK(fabs(0.25 * cols / rows - want) < 0.02, "the ridge's shadow %.4f m wide, %.4f expected",
+          0.25 * cols / rows, want);
+    CHECK(nb > 0 && fabs(beyond / nb - 1) < 1e-4, "the plate beyond the shadow at %.6f of full light", beyond / nb);
+    nc_frame_free(&f);
+    nc_scene_free(&s);
+    return nc_test_end();
+}
