@@ -279,6 +279,7 @@ struct surf {
     /* The frame its shadow rays go in (nc_rt_far_frame): -1, the camera's;
      * b, body b's far frame (shadow_start) */
     int frame[NC_PACKET];
+    int rock[NC_PACKET];  /* a rock's surface (nc_hit16.rock >= 0) */
     const uint32_t *prim; /* ... and the triangles met (nc_hit16.prim), to refine a far frame's point */
     struct nc_vec3 p[NC_PACKET];    /* position relative to the camera, scene frame, m */
     struct nc_vec3 n[NC_PACKET];    /* unit normal, turned to face the ray's origin */
@@ -334,15 +335,15 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
     }
 }
 
-/* s's shadow-ray frames: a body's own surface (not its rocks) seen from
- * farther than a bounding radius off its bounding sphere in its far frame,
- * anything else in the camera's. */
+/* s's shadow-ray frames: a body seen from farther than a bounding radius
+ * off its bounding sphere in its far frame, anything else in the camera's. */
 static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, struct surf *s)
 {
     s->prim = hit->prim;
     for (int i = 0; i < NC_PACKET; i++) {
         const int b = s->body[i], k = b >= 0 ? b : 0;
-        s->frame[i] = (b >= 0) & (hit->rock[i] < 0) & j->far[k] ? b : -1;
+        s->frame[i] = (b >= 0) & j->far[k] ? b : -1;
+        s->rock[i] = hit->rock[i] >= 0;
     }
 }
 
@@ -350,16 +351,17 @@ static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, struc
  * point in its frame (*p: camera-relative, or from the body's origin in
  * its far frame), and the scale of the float errors there (returned, m: the
  * point's, or in a far frame the larger of its distance from the origin
- * and the body's bounding radius; a mesh hit is refined once a ray from it
- * is traced: occluded_in). Branch-free, for loops the compiler vectorises. */
+ * and the body's bounding radius, a mesh hit being refined once a ray from
+ * it is traced: occluded_in; a rock's hit, known to 1e-7 of the range, the
+ * range too). Branch-free, for loops the compiler vectorises. */
 static inline double shadow_start(const struct job *j, const struct surf *s, int i, struct nc_vec3 *p)
 {
     const int fr = s->frame[i], k = fr >= 0 ? fr : 0;
     const struct nc_vec3 q = s->p[i], o = j->body_rel[k];
     const double x = q.x - o.x, y = q.y - o.y, z = q.z - o.z, r = sqrt(x * x + y * y + z * z);
-    const double sc = j->far_scale[k];
+    const double sc = j->far_scale[k], far = r > sc ? r : sc, rock = s->rock[i] ? s->scale[i] : 0.0;
     *p = fr >= 0 ? nc_v3(x, y, z) : q;
-    return fr >= 0 ? (r > sc ? r : sc) : s->scale[i];
+    return fr >= 0 ? (far > rock ? far : rock) : s->scale[i];
 }
 
 /* Fill s from a packet's hits, for rays from orig along the unit dir. */
@@ -462,12 +464,14 @@ static int occluded_in(struct job *j, const struct surf *sf, struct nc_ray16 *sh
         return culled;
     if (fr >= 0) {
         double t[NC_PACKET];
-        int done[NC_PACKET];
+        int done[NC_PACKET], mesh[NC_PACKET];
         struct nc_vec3 o[NC_PACKET]; /* the rays' origins, to 1e-16 of t */
-        for (int i = 0; i < NC_PACKET; i++)
+        for (int i = 0; i < NC_PACKET; i++) {
             o[i] = nc_v3_sub(sf->p[i], nc_v3_scale(sf->d[i], sf->t[i]));
+            mesh[i] = shadow->valid[i] && !sf->rock[i];
+        }
         memcpy(t, sf->t, sizeof t);
-        nc_rt_refine_far16(j->rt, fr, shadow->valid, sf->prim, o, sf->d, t, done);
+        nc_rt_refine_far16(j->rt, fr, mesh, sf->prim, o, sf->d, t, done);
         for (int i = 0; i < NC_PACKET; i++) {
             if (!shadow->valid[i])
                 continue;
