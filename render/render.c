@@ -335,14 +335,17 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
     }
 }
 
-/* s's shadow-ray frames: a body seen from farther than a bounding radius
- * off its bounding sphere in its far frame, anything else in the camera's. */
-static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, struct surf *s)
+/* s's shadow-ray frames: a camera ray's point on a body seen from farther
+ * than a bounding radius off its bounding sphere in its far frame, anything
+ * else in the camera's (a bounce ray leaves a float origin relative to the
+ * camera: its point is known to 6e-8 of its distance from the camera, in a
+ * far frame too, and its shadow ray must start as far off as before). */
+static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, int depth, struct surf *s)
 {
     s->prim = hit->prim;
     for (int i = 0; i < NC_PACKET; i++) {
         const int b = s->body[i], k = b >= 0 ? b : 0;
-        s->frame[i] = (b >= 0) & j->far[k] ? b : -1;
+        s->frame[i] = (b >= 0) & !depth & j->far[k] ? b : -1;
         s->rock[i] = hit->rock[i] >= 0;
     }
 }
@@ -364,9 +367,10 @@ static inline double shadow_start(const struct job *j, const struct surf *s, int
     return fr >= 0 ? (far > rock ? far : rock) : s->scale[i];
 }
 
-/* Fill s from a packet's hits, for rays from orig along the unit dir. */
+/* Fill s from a packet's hits, for rays from orig along the unit dir, at
+ * path vertex depth (0: the camera rays'). */
 static void surface16(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec3 *orig,
-                      const struct nc_vec3 *dir, struct surf *s)
+                      const struct nc_vec3 *dir, int depth, struct surf *s)
 {
     const struct nc_scene *sc = j->s;
     double un[3][NC_PACKET];
@@ -377,7 +381,7 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
         nc_rt_refine_mesh16(j->rt, hit, orig, dir, s->t, s->scale);
     if (j->plain) {
         plain_lanes(j, hit, orig, dir, (const double(*)[NC_PACKET])un, s);
-        shadow_frames(j, hit, s);
+        shadow_frames(j, hit, depth, s);
         return;
     }
     for (int i = 0; i < NC_PACKET; i++) {
@@ -415,7 +419,7 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
         }
         s->factor[i] = factor;
     }
-    shadow_frames(j, hit, s);
+    shadow_frames(j, hit, depth, s);
 }
 
 /* r (1/sr) for the lanes listed, each with its own body's material, in one
@@ -758,7 +762,7 @@ static void indirect16(struct job *j, struct surf *s, int px0, int py0, int sidx
         for (int i = 0; i < NC_PACKET; i++)
             if (!ray.valid[i])
                 hit.body[i] = -1;
-        surface16(j, &hit, orig, w, s);
+        surface16(j, &hit, orig, w, k, s);
         sunlight16(j, s, px0, py0, sidx, k, r, NULL, cnt);
         for (int i = 0; i < NC_PACKET; i++) {
             if (s->body[i] < 0 || r[i] == 0)
@@ -1064,7 +1068,7 @@ static void shade_tile(struct job *j, int tile)
                             if (ray[q].valid[i])
                                 j->f->rock_id[(size_t)(y0 + by + (i >> 2)) * (size_t)W + (size_t)(x0 + bx + (i & 3))] =
                                     hit[q].body[i] >= 0 ? hit[q].rock[i] : -1;
-                    surface16(j, &hit[q], orig[q], dir[q], &sf);
+                    surface16(j, &hit[q], orig[q], dir[q], 0, &sf);
                     if (slot == 0 && j->f->geom)
                         record_geom(j, &sf, x0 + bx, y0 + by);
                     int any = 0;

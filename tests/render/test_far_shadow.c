@@ -13,7 +13,9 @@
  *     with 0.25 m pixels (fx 8e5 px: a shadow ray started 0.8 m up), the Sun
  *     20 deg over the plate across the ridge: the ridge's shadow on the
  *     plate 0.874 m wide (0.5 / tan 20 deg less the ridge's half width; none
- *     before), and the plate lit beyond it (no false self-shadowing). */
+ *     before), and the plate lit beyond it (no false self-shadowing).
+ *  C: bounce light in a valley from 2 km and from 230 km: a bounce's
+ *     shadow ray keeps the camera's frame (below). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -183,5 +185,50 @@ int main(void)
     CHECK(nb > 0 && fabs(beyond / nb - 1) < 1e-4, "the plate beyond the shadow at %.6f of full light", beyond / nb);
     nc_frame_free(&f);
     nc_scene_free(&s);
+
+    /* C: bounce light in a valley (faces 30 deg up, 1 m facets), 0.25 m
+     * pixels from 2 km and 230000.7 m (where the float points of bounces
+     * fell under the surface; at 2e5 m above it): a bounce's point comes from a ray traced
+     * from a float origin relative to the camera, known to 6e-8 of its
+     * distance from the camera, so its shadow ray keeps the camera's frame
+     * (in the far frame it started 1e-4 m off a point mm under the surface:
+     * every bounce lit point shadowed itself, the bounce light gone) */
+    const char *valley = nc_test_path("valley.obj");
+    fo = fopen(valley, "w");
+    for (int r = 0; r <= 40; r++)
+        for (int i = 0; i <= 40; i++)
+            fprintf(fo, "v %d %d %.17g\n", i - 20, r - 20, fabs(i - 20.0) * tan(M_PI / 6));
+    for (int r = 0; r < 40; r++)
+        for (int i = 1; i <= 40; i++) {
+            const int a = r * 41 + i;
+            fprintf(fo, "f %d %d %d\nf %d %d %d\n", a, a + 1, a + 42, a, a + 42, a + 41);
+        }
+    fclose(fo);
+    snprintf(shape, sizeof shape, "bodies.0.shape={type: mesh, file: '%s', unit: m}", valley);
+    double bounce[2];
+    for (int k = 0; k < 2; k++) {
+        char pos[96], fx[64], fy[64];
+        const double D = k ? 230000.7 : 2e3;
+        snprintf(pos, sizeof pos, "camera.position_m=[0, 0, %.17g]", D);
+        snprintf(fx, sizeof fx, "camera.fx_px=%.17g", D / 0.25);
+        snprintf(fy, sizeof fy, "camera.fy_px=%.17g", D / 0.25);
+        double sum[2] = {0, 0};
+        for (int b = 0; b < 2; b++) {
+            const char *vs[] = {shape,  "sun.direction=[0.3, 0.1, 1]", "bodies.1.position_m=[0, 1e7, 0]",
+                                pos,    "camera.look_at_m=[0, 0, 0]",  "camera.up=[0, 1, 0]",
+                                fx,     fy,
+                                "render.samples_per_pixel=4", b ? "render.bounces=1" : "render.bounces=0"};
+            nc_test_scene(spheres, vs, 10, &s);
+            nc_test_render(&s, 2, &f);
+            for (int i = 0; i < 64 * 64; i++)
+                sum[b] += f.radiance[i];
+            nc_frame_free(&f);
+            nc_scene_free(&s);
+        }
+        bounce[k] = (sum[1] - sum[0]) / sum[0];
+    }
+    printf("bounce light in the valley: %.4f of the direct from 2e3 m, %.4f from 230000.7 m\n", bounce[0], bounce[1]);
+    CHECK(bounce[0] > 0.03 && bounce[1] > 0.9 * bounce[0], "bounce light %.4f from 2e3 m, %.4f from 230000.7 m",
+          bounce[0], bounce[1]);
     return nc_test_end();
 }
