@@ -16,10 +16,7 @@
  * driver's ring; with exclusive_caps=1 the device loses both capabilities
  * after a plain write() producer closes, unless VIDIOC_STREAMON(OUTPUT) was
  * called once after S_FMT; Y10 is sized wrongly, so it is not offered.
- *
- * Options: device (/dev/videoN), card (label), format (auto, GREY, Y16),
- * y16_align (msb, lsb), frame_rate_hz (default: the camera's),
- * reopen_interval_s (1; 0 = never reopen), reopen_limit (0 = unlimited).
+ * Options: v4l2_params below (docs/v4l2-gpio.md).
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -60,11 +57,7 @@ struct v4l2_out {
     char path[256], card[33], driver[17];
     uint32_t caps;
     enum io_method io_opt, io;
-    struct {
-        void *mem;
-        size_t len;
-        int queued;
-    } mbuf[MMAP_BUFFERS];
+    struct { void *mem; size_t len; int queued; } mbuf[MMAP_BUFFERS]; /* mmap streaming's buffers */
     unsigned nmbuf;
     /* failures */
     int64_t next_try_ns;
@@ -155,9 +148,9 @@ static int find_device(struct v4l2_out *v)
         }
         if (fd < 0)
             return nc_error(-ENODEV, "v4l2 output: no video output device%s%s%s (seen: %s; is v4l2loopback "
-                            "loaded with that card_label? docs/setup.md)",
-                            v->want_card[0] ? " with card label '" : "", v->want_card,
-                            v->want_card[0] ? "'" : "", len ? seen : "no /dev/video* device");
+                            "loaded%s? docs/setup.md)", v->want_card[0] ? " with card label '" : "", v->want_card,
+                            v->want_card[0] ? "'" : "", len ? seen : "no /dev/video* device",
+                            v->want_card[0] ? " with that card_label" : "");
     }
     v->fd = fd;
     snprintf(v->card, sizeof v->card, "%s", (const char *)cap.card);
@@ -360,10 +353,15 @@ static int v4l2_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
         free(v->buf);
         return rc;
     }
-    char fc[5];
-    nc_log_info("output/v4l2", "%s (card '%s', driver '%s'): %dx%d %s at %g Hz through %s%s", v->path,
-            v->card, v->driver, v->width, v->height, fourcc_text(v->fourcc, fc), v->fps,
-            v->io == IO_MMAP ? "mmap streaming" : "write()", v->meta ? ", row 0 the frame's metadata" : "");
+    char fc[5], rate[96]; /* the interval the device keeps (vivid keeps its own), not the one asked for */
+    const unsigned num = v->interval.numerator, den = v->interval.denominator;
+    if (num && den)
+        snprintf(rate, sizeof rate, "frame interval %u/%u s (%g Hz)", num, den, (double)den / num);
+    else
+        snprintf(rate, sizeof rate, "no frame interval kept (%g Hz asked)", v->fps);
+    nc_log_info("output/v4l2", "%s (card '%s', driver '%s'): %dx%d %s, %s, through %s%s", v->path, v->card, v->driver,
+            v->width, v->height, fourcc_text(v->fourcc, fc), rate, v->io == IO_MMAP ? "mmap streaming" : "write()",
+            v->meta ? ", row 0 the frame's metadata" : "");
     return 0;
 }
 
