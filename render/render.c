@@ -277,10 +277,12 @@ struct surf {
     double t[NC_PACKET];      /* ray parameter, m */
     double scale[NC_PACKET];  /* the float error's scale there, m: t, or more for a refined mesh hit */
     /* The frame its shadow rays go in (nc_rt_far_frame): -1, the camera's;
-     * b, body b's far frame (shadow_start) */
+     * b, body b's far frame (shadow_frames) */
     int frame[NC_PACKET];
-    int rock[NC_PACKET];  /* a rock's surface (nc_hit16.rock >= 0) */
-    const uint32_t *prim; /* ... and the triangles met (nc_hit16.prim), to refine a far frame's point */
+    int rock[NC_PACKET];          /* a rock's surface (nc_hit16.rock >= 0) */
+    struct nc_vec3 rel[NC_PACKET]; /* the frame's origin from the camera (0 for the camera's), m */
+    double escale[NC_PACKET];     /* the float error's scale in the frame, m (shadow_frames) */
+    const uint32_t *prim;         /* the triangles met (nc_hit16.prim), to refine a far frame's point */
     struct nc_vec3 p[NC_PACKET];    /* position relative to the camera, scene frame, m */
     struct nc_vec3 n[NC_PACKET];    /* unit normal, turned to face the ray's origin */
     struct nc_vec3 d[NC_PACKET];    /* the ray's unit direction */
@@ -339,32 +341,21 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
  * than a bounding radius off its bounding sphere in its far frame, anything
  * else in the camera's (a bounce ray leaves a float origin relative to the
  * camera: its point is known to 6e-8 of its distance from the camera, in a
- * far frame too, and its shadow ray must start as far off as before). */
+ * far frame too, and its shadow ray must start as far off as before). The
+ * float error's scale: in a far frame the body's bounding radius (every
+ * coordinate of its geometry there is within it; a mesh hit is refined once
+ * a ray from it is traced: occluded_in), or for a rock's hit, known to 1e-7
+ * of the range, the range if larger; in the camera's, the point's. */
 static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, int depth, struct surf *s)
 {
     s->prim = hit->prim;
     for (int i = 0; i < NC_PACKET; i++) {
-        const int b = s->body[i], k = b >= 0 ? b : 0;
-        s->frame[i] = (b >= 0) & !depth & j->far[k] ? b : -1;
+        const int b = s->body[i], far = b >= 0 && !depth && j->far[b];
+        s->frame[i] = far ? b : -1;
         s->rock[i] = hit->rock[i] >= 0;
+        s->rel[i] = far ? j->body_rel[b] : nc_v3(0, 0, 0);
+        s->escale[i] = !far ? s->scale[i] : s->rock[i] ? fmax(j->far_scale[b], s->scale[i]) : j->far_scale[b];
     }
-}
-
-/* Where lane i's shadow ray starts, before its offset along the normal: its
- * point in its frame (*p: camera-relative, or from the body's origin in
- * its far frame), and the scale of the float errors there (returned, m: the
- * point's, or in a far frame the larger of its distance from the origin
- * and the body's bounding radius, a mesh hit being refined once a ray from
- * it is traced: occluded_in; a rock's hit, known to 1e-7 of the range, the
- * range too). Branch-free, for loops the compiler vectorises. */
-static inline double shadow_start(const struct job *j, const struct surf *s, int i, struct nc_vec3 *p)
-{
-    const int fr = s->frame[i], k = fr >= 0 ? fr : 0;
-    const struct nc_vec3 q = s->p[i], o = j->body_rel[k];
-    const double x = q.x - o.x, y = q.y - o.y, z = q.z - o.z, r = sqrt(x * x + y * y + z * z);
-    const double sc = j->far_scale[k], far = r > sc ? r : sc, rock = s->rock[i] ? s->scale[i] : 0.0;
-    *p = fr >= 0 ? nc_v3(x, y, z) : q;
-    return fr >= 0 ? (far > rock ? far : rock) : s->scale[i];
 }
 
 /* Fill s from a packet's hits, for rays from orig along the unit dir, at
@@ -457,7 +448,7 @@ struct tile_counts {
  * occluded[i] and blocked[i] set where they meet something
  * (nc_rt_shadow_cull16, nc_rt_occluded16); returns how many were proven
  * clear. In a body's far frame the rays left to trace start from their
- * points refined (nc_rt_refine_far16), 4e-6 of shadow_start's scale off. */
+ * points refined (nc_rt_refine_far16), 4e-6 of their escale off. */
 static int occluded_in(struct job *j, const struct surf *sf, struct nc_ray16 *shadow, const int *from, int fr,
                        int *occluded, int *blocked)
 {
@@ -480,9 +471,8 @@ static int occluded_in(struct job *j, const struct surf *sf, struct nc_ray16 *sh
             if (!shadow->valid[i])
                 continue;
             /* a point not refined: 1e-7 of the range off, the offset as in the camera's frame */
-            struct nc_vec3 p;
-            const double escale = shadow_start(j, sf, i, &p), eps = 4e-6 * (done[i] ? escale : fmax(escale, t[i]));
-            p = nc_v3_add(p, nc_v3_scale(sf->d[i], t[i] - sf->t[i]));
+            const double eps = 4e-6 * (done[i] ? sf->escale[i] : fmax(sf->escale[i], t[i]));
+            const struct nc_vec3 p = nc_v3_add(nc_v3_sub(sf->p[i], sf->rel[i]), nc_v3_scale(sf->d[i], t[i] - sf->t[i]));
             shadow->ox[i] = (float)(p.x + eps * sf->n[i].x);
             shadow->oy[i] = (float)(p.y + eps * sf->n[i].y);
             shadow->oz[i] = (float)(p.z + eps * sf->n[i].z);
@@ -540,15 +530,13 @@ static void unoccluded16(struct job *j, const struct surf *sf, struct nc_ray16 *
  * error's scale off the surface, in its frame, as in sunlight16. Returns
  * how many are lit. */
 __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static int
-hard_lanes(const struct job *j, const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *shadow, int *from,
-           int *lit)
+hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *shadow, int *from, int *lit)
 {
     int any = 0;
     for (int i = 0; i < NC_PACKET; i++) {
         const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i];
-        struct nc_vec3 p;
-        const double escale = shadow_start(j, s, i, &p);
-        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * escale;
+        const struct nc_vec3 p = nc_v3_sub(s->p[i], s->rel[i]); /* in its frame */
+        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->escale[i];
         const int on = (s->body[i] >= 0) & (mu0 > 0) & (mu > 0);
         geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, d), s->factor[i]};
         shadow->ox[i] = (float)(p.x + eps * nrm.x);
@@ -587,7 +575,7 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
             r_hard[i] = 0;
     }
     if (!depth && !(j->sun_tan_radius > 0) && !j->r->lane_by_lane) {
-        any = hard_lanes(j, s, geo, &shadow, from, lit);
+        any = hard_lanes(s, geo, &shadow, from, lit);
     } else {
         for (int i = 0; i < NC_PACKET; i++) {
             shadow.valid[i] = lit[i] = 0;
@@ -603,9 +591,8 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
              * coordinates in the ray's frame (the camera's: a bounce's t can be
              * far shorter than the point's distance from the camera); tnear
              * stays 0. */
-            struct nc_vec3 p;
-            const double escale = shadow_start(j, s, i, &p);
-            double eps = 4e-6 * (depth && s->frame[i] < 0 ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : escale);
+            const struct nc_vec3 p = nc_v3_sub(s->p[i], s->rel[i]);
+            double eps = 4e-6 * (depth ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : s->escale[i]);
             shadow.ox[i] = (float)(p.x + eps * nrm.x);
             shadow.oy[i] = (float)(p.y + eps * nrm.y);
             shadow.oz[i] = (float)(p.z + eps * nrm.z);

@@ -134,8 +134,9 @@ void nc_rt_refine_far16(const struct nc_rt *rt, int b, const int *lanes, const u
  * frame: -1, rays in the camera-relative scene frame; b >= 0, rays in body
  * b's far frame (nc_rt_far_frame). */
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded, int frame);
-/* Whether the shadow rays leaving body b's own surface (its mesh or shape,
- * not its rocks) go in its far frame at the last update: relative to its
+/* Whether the shadow rays leaving body b (its surface and its rocks; the
+ * renderer keeps bounce points in the camera's frame) go in its far frame
+ * at the last update: relative to its
  * origin, scene axes, where float rays and geometry carry 6e-8 of the
  * body's size instead of the range (the camera is farther than a bounding
  * radius from its bounding sphere; an analytic shape is left out of its own
