@@ -173,6 +173,13 @@ print('SUM-like rows, body moved: p95 %.4f, IoU %.4f' % (d['relative_error']['p9
 # 10 arcsec, the camera still.
 printf '064508.92 -164258.0 -000546.0-001223.100379.2 -1.4400.01A0 1            , alp CMa, Sirius\n' > stars.dat
 "$navcam" stars index stars.dat -o stars.ncs > /dev/null || fail "stars index"
+# `stars info` counts the stars brighter than each whole magnitude: V < N,
+# a star of V 2.00 not under 2 (it was counted there before session 63).
+printf '100000.00 +100000.0 +000000.0+000000.000000.0 +2.0000.00A0 1            , V two\n' > two.dat
+cat stars.dat two.dat > pair.dat
+"$navcam" stars index pair.dat -o pair.ncs > /dev/null || fail "stars index of two stars"
+"$navcam" stars info pair.ncs > info.txt || fail "stars info"
+grep -q "V <  2: 1$" info.txt && grep -q "V <  3: 2$" info.txt || fail "stars info counts: $(cat info.txt)"
 python3 - <<'PY'
 import math
 a, d = math.radians(101.287166667), math.radians(-16.716111111)
