@@ -189,6 +189,9 @@ expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" batch builtin:approach -
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
 expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 1025
 # The camera's 1e15 m limit is a distance, not a coordinate.
+# an item a --set adds to a list is blamed, not the file's line of the list
+expect 1 "--set camera.position_m.3=5: camera.position_m[3]: expected a list of 3 numbers" -- \
+  "$navcam" render -o "$tmp/long.fits" --set camera.position_m.3=5
 expect 1 "camera.position_m: 1.55885e+15 m from the scene's origin, beyond 1e+15 m" -- \
   "$navcam" render -o "$tmp/far.fits" --set 'camera.position_m=[9e14,9e14,9e14]'
 # A camera inside the body (20 m from the centre of the default asteroid) is warned of.
