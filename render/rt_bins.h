@@ -34,16 +34,15 @@ struct nc__bins_cluster {
 };
 
 /* Triangles tri[0 .. nt) of vertices v: their normals (v1 - v0) x (v2 - v0)
- * into ng[4 nt], 4 floats a triangle, the 4th left for the caller's use
- * (computed in double, as Embree's convention has it), and their clusters
- * into out[(nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER]. */
+ * into ng[3 nt] (computed in double, as Embree's convention has it) and
+ * their clusters into out[(nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER]. */
 void nc__bins_facets(const double *v, const unsigned *tri, size_t nt, float *ng, struct nc__bins_cluster *out);
 
 /* A triangle mesh as shown this pass. */
 struct nc__bins_body {
     const double *v;       /* body-frame vertices, m (x, y, z each) */
     const unsigned *tri;   /* the triangles shown: 3 vertex indices each */
-    const float *ng;       /* and their normals, body frame, 4 floats each (nc__bins_facets; copied to the hits) */
+    const float *ng;       /* and their normals in the body frame, 3 each (nc__bins_facets; copied to the hits) */
     const struct nc__bins_cluster *cl; /* their clusters (nc__bins_facets; NULL: none skipped) */
     size_t nv, nt;
     struct nc_mat3 R;      /* body -> scene */

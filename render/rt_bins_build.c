@@ -72,7 +72,7 @@ void nc__bins_facets(const double *v, const unsigned *tri, size_t nt, float *ng,
             const double len = sqrt(len2(n));
             alt = fmin(alt, len > 0 ? len / sqrt(max3(len2(e[0]), len2(e[1]), len2(e[2]))) : 0.0);
             for (int q = 0; q < 3; q++) {
-                ng[4 * (t0 + t) + q] = (float)n[q];
+                ng[3 * (t0 + t) + q] = (float)n[q];
                 a[q] += un[t][q] = len > 0 ? n[q] / len : 0.0;
             }
         }
@@ -379,7 +379,7 @@ static void triangles(struct nc__bins *b, int p)
             memcpy(ct->e, o[i].e, sizeof ct->e);
             memcpy(ct->n, o[i].n, sizeof ct->n);
             ct->nv0 = o[i].nv0;
-            memcpy(ct->ng, &bd->ng[4 * (t + (size_t)i)], sizeof ct->ng);
+            memcpy(ct->ng, &bd->ng[3 * (t + (size_t)i)], sizeof ct->ng);
             b->tri[slot] = (uint32_t)(g + (size_t)i);
             int16_t *rg = b->range[slot++];
             rg[0] = (int16_t)o[i].x0, rg[1] = (int16_t)o[i].x1, rg[2] = (int16_t)o[i].y0, rg[3] = (int16_t)o[i].y1;

@@ -42,9 +42,7 @@ struct rt_body {
     float *verts; /* anchor-relative vertices of every level, padded for Embree's 16-byte loads */
     float *vnormal; /* smooth shading: unit normals at the vertices, body frame (NULL: flat) */
     const unsigned *tri[NC_LOD_MAX_LEVELS]; /* each level's triangles (Embree's index buffer) */
-    /* each level's facets' planes, body frame (nc_rt_bin_camera, nc_rt_refine_mesh16): the normal n
-     * and n . v0, 4 floats each (nc__bins_facets) */
-    float *facet[NC_LOD_MAX_LEVELS];
+    float *facet_n[NC_LOD_MAX_LEVELS];      /* each level's facet normals, body frame (nc_rt_bin_camera) */
     struct nc__bins_cluster *cluster[NC_LOD_MAX_LEVELS]; /* and its triangles' clusters */
     unsigned inst_id;
     RTCGeometry inst;
@@ -303,15 +301,10 @@ static int level_init(struct nc_rt *rt, struct rt_body *b, int k, const struct n
     b->closed[k] = closed;
     /* The facets' normals and clusters for the camera-ray bins. */
     const size_t ncl = (lv->nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
-    if (!(b->facet[k] = aligned_alloc(16, (4 * lv->nt + 4) * sizeof *b->facet[k])) ||
+    if (!(b->facet_n[k] = malloc((3 * lv->nt + 3) * sizeof *b->facet_n[k])) ||
         !(b->cluster[k] = malloc((ncl + 1) * sizeof *b->cluster[k])))
-        return nc_error(-ENOMEM, "out of memory for the planes of %zu facets", lv->nt);
-    nc__bins_facets(m->v, lv->tri, lv->nt, b->facet[k], b->cluster[k]);
-    for (size_t t = 0; t < lv->nt; t++) { /* the plane through v0 with that float normal */
-        float *f = b->facet[k] + 4 * t;
-        const double *v0 = m->v + 3 * (size_t)lv->tri[3 * t];
-        f[3] = (float)((double)f[0] * v0[0] + (double)f[1] * v0[1] + (double)f[2] * v0[2]);
-    }
+        return nc_error(-ENOMEM, "out of memory for the normals of %zu facets", lv->nt);
+    nc__bins_facets(m->v, lv->tri, lv->nt, b->facet_n[k], b->cluster[k]);
     return rt_check(rt->dev, "creating geometry");
 }
 
@@ -668,7 +661,7 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
          * every range (above); near the camera, an edge's length can exceed
          * the range */
         b->refine = !b->analytic && (a.x != 0 || a.y != 0 || a.z != 0);
-        b->far = dmin >= src->bounding_radius_m; /* its shadow rays in its far frame */
+        b->far = dmin >= src->bounding_radius_m; /* its shadow rays in its far frame (below, where rocks are) */
         /* Level of detail: the coarsest whose surface error stays within
          * render.lod_error_px pixels at the nearest possible range (the
          * bounding sphere; the finest pixel axis). A function of the pose. */
@@ -712,6 +705,14 @@ int nc_rt_update(struct nc_rt *rt, const struct nc_scene *s)
             rt->stats.boulder_cut_cover[i] = b->rocks.cut_cover;
             rt->stats.camera_in_rock[i] = nc__rt_rocks_camera_inside(&b->rocks);
             rt->rocks_on |= b->rocks.traced > 0;
+            /* The camera's frame places the body and each rock tile by a float translation of its own, and
+             * Embree takes a ray into each instance in float: the camera sees the rocks up to about 2.4e-7 of
+             * the range off the ground they stand on, where the far frame puts them right. A ground point seen
+             * beside a rock can then lie behind it there: a shadow ray along the line of sight (near zero
+             * phase) meets it (an outside check at 2e7 m, fx 4e6 px: a black rim around every rock, 12 % of
+             * the body). So a body with rocks traced goes in its far frame only while that is under 1 % of a
+             * pixel. */
+            b->far &= !b->rocks.traced || 2.4e-7 * fmax(s->camera.fx_px, s->camera.fy_px) < 0.01;
         }
         if ((rc = update_grid(b, s)) < 0)
             return rc;
@@ -911,7 +912,7 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
         triangles += (double)b->nt[b->level];
         bd[i] = (struct nc__bins_body){.v = b->src->mesh.v,
                                        .tri = b->tri[b->level],
-                                       .ng = b->facet[b->level],
+                                       .ng = b->facet_n[b->level],
                                        .cl = b->cluster[b->level],
                                        .nv = b->src->mesh.nv,
                                        .nt = b->nt[b->level],
@@ -1038,35 +1039,35 @@ int nc_rt_far_frame(const struct nc_rt *rt, int b, double *scale_m)
     return rt->body[b].far;
 }
 
-/* nc_rt_refine_far16 on a mesh, branch-free (AVX-512 or AVX2 where the CPU
- * has it, without contraction: the same bits as plain code): each ray met
- * against the plane of its facet in the body frame (the facet's float
- * normal and offset, one 16-byte load: within 1.2e-7 of the body's radius
- * of the float triangle its far frame holds). */
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void
-refine_far16(const struct rt_body *b, const int *lanes, const uint32_t *prim, const struct nc_vec3 *orig,
-             const struct nc_vec3 *dir, double *t, int *done)
+/* nc_rt_refine_far16 on a mesh: each ray met in double precision, in the
+ * body frame, by the triangle the float ray met (its double vertices,
+ * relative to its first), and taken only where it meets it (the float hit
+ * can be on a triangle the exact ray passes by, the body placed 6e-8 of
+ * the range off in the camera's frame: refined onto that triangle's plane
+ * past a concave edge, a point lay under its neighbour and shadowed itself,
+ * found by an outside check at 2e7 m). */
+static void refine_far16(const struct rt_body *b, const int *lanes, const uint32_t *prim, const struct nc_vec3 *orig,
+                         const struct nc_vec3 *dir, double *t, int *done)
 {
-    const float *fp = b->facet[b->level];
-    const double edge = b->max_edge_m[b->level];
-    const struct nc_mat3 R = b->R;
-    const struct nc_vec3 rel = b->origin_rel;
+    const double edge = b->max_edge_m[b->level], *vs = b->src->mesh.v;
     for (int i = 0; i < NC_PACKET; i++) {
-        const int on = lanes[i] != 0;
-        const size_t p = on ? prim[i] : 0;
-        const double nx = fp[4 * p], ny = fp[4 * p + 1], nz = fp[4 * p + 2];
-        /* n . R^T x = (R n) . x: the normal into the scene frame instead */
-        const double sx = R.m[0][0] * nx + R.m[0][1] * ny + R.m[0][2] * nz,
-                     sy = R.m[1][0] * nx + R.m[1][1] * ny + R.m[1][2] * nz,
-                     sz = R.m[2][0] * nx + R.m[2][1] * ny + R.m[2][2] * nz;
-        const double ox = orig[i].x - rel.x, oy = orig[i].y - rel.y, oz = orig[i].z - rel.z;
-        const double tt =
-            (fp[4 * p + 3] - (sx * ox + sy * oy + sz * oz)) / (sx * dir[i].x + sy * dir[i].y + sz * dir[i].z);
-        /* a plane seen edge-on, or a double ray on another triangle's plane
-         * (at an edge): the float answer stands */
-        const int ok = on & (fabs(tt - t[i]) <= 1e-4 * t[i] + 1e-3 * edge) & (tt > 0);
-        t[i] = ok ? tt : t[i];
-        done[i] = ok;
+        done[i] = 0;
+        if (!lanes[i])
+            continue;
+        const unsigned *tr = b->tri[b->level] + 3 * (size_t)prim[i];
+        const double *v0 = vs + 3 * (size_t)tr[0], *v1 = vs + 3 * (size_t)tr[1], *v2 = vs + 3 * (size_t)tr[2];
+        const struct nc_vec3 o = nc_mat_tmul_v(&b->R, nc_v3_sub(orig[i], b->origin_rel)),
+                             d = nc_mat_tmul_v(&b->R, dir[i]);
+        const struct nc_vec3 e1 = nc_v3(v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]),
+                             e2 = nc_v3(v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]),
+                             w = nc_v3(o.x - v0[0], o.y - v0[1], o.z - v0[2]);
+        const struct nc_vec3 pv = nc_v3_cross(d, e2), q = nc_v3_cross(w, e1);
+        const double det = nc_v3_dot(e1, pv);
+        if (!(fabs(det) > 0))
+            continue;
+        const double u = nc_v3_dot(w, pv) / det, v = nc_v3_dot(d, q) / det, tt = nc_v3_dot(e2, q) / det;
+        if (u >= 0 && v >= 0 && u + v <= 1 && tt > 0 && fabs(tt - t[i]) <= 1e-4 * t[i] + 1e-3 * edge)
+            t[i] = tt, done[i] = 1;
     }
 }
 
@@ -1515,7 +1516,7 @@ void nc_rt_destroy(struct nc_rt *rt)
         free(rt->body[i].verts);
         free(rt->body[i].vnormal);
         for (int k = 0; k < NC_LOD_MAX_LEVELS; k++) {
-            free(rt->body[i].facet[k]);
+            free(rt->body[i].facet_n[k]);
             free(rt->body[i].cluster[k]);
         }
         for (int g = 0; g < 2; g++)

@@ -155,7 +155,7 @@ static void check_grid(void)
             else
                 t[0] = a, t[1] = c, t[2] = b, t[3] = b, t[4] = c, t[5] = d;
         }
-    float *ng = calloc(8 * n * n, sizeof *ng);
+    float *ng = calloc(6 * n * n, sizeof *ng);
     struct nc__bins_body body = {.v = v, .tri = tri, .ng = ng, .nv = (n + 1) * (n + 1), .nt = 2 * n * n,
                                  .R = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}, .origin = nc_v3(0, 0, 0), .front_only = 0};
     struct nc__bins_view view = {nc_v3(-W / 2.0 / f, -W / 2.0 / f, 1), nc_v3(1 / f, 0, 0), nc_v3(0, 1 / f, 0), W, W};
@@ -229,7 +229,7 @@ static void check_clusters(const struct nc_scene *s, double min_skip, const char
     const struct nc__bins_view view = {p.d00, p.ex, p.ey, p.width_px, p.height_px};
     const size_t ncl = (m->nt + NC_BINS_CLUSTER - 1) / NC_BINS_CLUSTER;
     struct nc__bins_cluster *cl = malloc(ncl * sizeof *cl);
-    float *ng = calloc(4 * m->nt, sizeof *ng);
+    float *ng = calloc(3 * m->nt, sizeof *ng);
     nc__bins_facets(m->v, m->tri, m->nt, ng, cl);
     struct nc__bins_body body = {.v = m->v, .tri = m->tri, .ng = ng, .nv = m->nv, .nt = m->nt,
                                  .R = nc_quat_to_mat(s->body[0].attitude_q),

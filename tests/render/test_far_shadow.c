@@ -15,7 +15,9 @@
  *     plate 0.874 m wide (0.5 / tan 20 deg less the ridge's half width; none
  *     before), and the plate lit beyond it (no false self-shadowing).
  *  C: bounce light in a valley from 2 km and from 230 km: a bounce's
- *     shadow ray keeps the camera's frame (below). */
+ *     shadow ray keeps the camera's frame (below).
+ *  D, E: what an outside check of the far frames found (below): grooves,
+ *     and rocks at zero phase. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -34,6 +36,15 @@ static const char spheres[] = "bodies:\n"
                               "camera: {width_px: 64, height_px: 64, fx_px: 20000, fy_px: 20000,\n"
                               "         position_m: [-160, 0, 200000], look_at_m: [-160, 0, 1000], up: [1, 0, 0]}\n"
                               "render: {samples_per_pixel: 16}\n";
+
+/* A mesh body (bodies.0.shape set by the test) under the Sun overhead,
+ * seen by a 256 x 256 camera. */
+static const char plate[] = "bodies:\n"
+                            "  - {shape: {type: sphere, radius_m: 1}, material: {model: lambert, A: 0.5}}\n"
+                            "sun: {direction: [0, 0, 1]}\n"
+                            "camera: {width_px: 256, height_px: 256, fx_px: 1000, fy_px: 1000,\n"
+                            "         position_m: [0, 0, 1000], look_at_m: [0, 0, 0], up: [0, 0, 1]}\n"
+                            "render: {samples_per_pixel: 4}\n";
 
 /* The nearest t > 0 of ray o + t d (d unit) on the sphere (c, r), or
  * INFINITY: from the line's point nearest the centre (no cancellation for
@@ -230,5 +241,70 @@ int main(void)
     printf("bounce light in the valley: %.4f of the direct from 2e3 m, %.4f from 230000.7 m\n", bounce[0], bounce[1]);
     CHECK(bounce[0] > 0.03 && bounce[1] > 0.9 * bounce[0], "bounce light %.4f from 2e3 m, %.4f from 230000.7 m",
           bounce[0], bounce[1]);
+
+    /* D: V grooves (faces 15 deg off the plate, 10 m facets; the body alone,
+     * its camera rays through the bins: with the analytic sphere of A beside
+     * it they go through Embree, whose hits did not show this) under the
+     * Sun overhead: every face lit alike, no shadow possible. Seen 30 deg off
+     * the vertical with 2.5 m pixels from 2e6 and 2e7 m, a float hit on one
+     * face of a groove whose exact ray meets the next, refined onto the
+     * first face's plane, lay under the second past the groove's concave
+     * edge and shadowed itself (an outside check: 4 and 371 dark pixels);
+     * refined points are taken only inside their triangle. */
+    const char *grooves = nc_test_path("grooves.obj");
+    fo = fopen(grooves, "w");
+    for (int i = 0; i <= 60; i++) /* vertex 61 i + r + 1 at x = 10 i - 300, y = 10 r - 300 */
+        for (int r = 0; r <= 60; r++)
+            fprintf(fo, "v %d %d %.17g\n", 10 * i - 300, 10 * r - 300, (i % 2) * 10 * tan(M_PI / 12));
+    for (int i = 0; i < 60; i++)
+        for (int r = 0; r < 60; r++) {
+            const int a = 61 * i + r + 1, b = a + 61;
+            fprintf(fo, "f %d %d %d\nf %d %d %d\n", a, b, b + 1, a, b + 1, a + 1);
+        }
+    fclose(fo);
+    snprintf(shape, sizeof shape, "bodies.0.shape={type: mesh, file: '%s', unit: m}", grooves);
+    for (int k = 0; k < 2; k++) {
+        const double D = k ? 2e7 : 2e6;
+        char pos[128], fx[64], fy[64];
+        snprintf(pos, sizeof pos, "camera.position_m=[0, %.17g, %.17g]", -D / 2, D * sqrt(0.75));
+        snprintf(fx, sizeof fx, "camera.fx_px=%.17g", D / 2.5);
+        snprintf(fy, sizeof fy, "camera.fy_px=%.17g", D / 2.5);
+        const char *gs[] = {shape, pos, fx, fy};
+        nc_test_scene(plate, gs, 4, &s);
+        nc_test_render(&s, 2, &f);
+        const double L = 0.5 / M_PI * s.sun.irradiance_w_m2 * cos(M_PI / 12);
+        int dark = 0; /* the middle 128 x 128 pixels, on the plate */
+        for (int y = 64; y < 192; y++)
+            for (int x = 64; x < 192; x++)
+                dark += f.radiance[256 * y + x] < 0.99 * L;
+        printf("grooves under the Sun overhead, from %.0e m: %d of 16384 pixels darker than their faces' light\n", D,
+               dark);
+        CHECK(dark == 0, "grooves from %.0e m: %d dark pixels", D, dark);
+        nc_frame_free(&f);
+        nc_scene_free(&s);
+    }
+
+    /* E: rocks at zero phase, 5 m pixels from 2e7 m: the camera's frame
+     * places the body and each rock tile by float translations of their own,
+     * so it sees the rocks some 2.4e-7 of the range (0.96 px here) off the
+     * ground they stand on; in the far frame a ground point seen beside a
+     * rock lay behind it, and every shadow ray along the line of sight met
+     * it (a black rim around every rock, 12 % of the body in an outside
+     * check). Such a body keeps the camera's frame. */
+    const char *rocks[] = {"bodies.0.boulders={preset: bennu}", "render.boulder_min_px=0",
+                           "sun.direction=[0, -1, 0]", "camera.position_m=[0, -2e7, 0]", "camera.focal_length_m=4.0",
+                           "camera.pixel_pitch_m=1e-6", "camera.width_px=128", "camera.height_px=128",
+                           "render.samples_per_pixel=1"};
+    nc_test_scene(nc_test_asteroid_yaml, rocks, 9, &s);
+    nc_test_render(&s, 2, &f);
+    int body = 0, black = 0;
+    for (int i = 0; i < 128 * 128; i++) {
+        body += f.range_m[i] > 0;
+        black += f.range_m[i] > 0 && !(f.radiance[i] > 0);
+    }
+    printf("rocks at zero phase from 2e7 m: %d of %d body pixels black\n", black, body);
+    CHECK(body > 1000 && black < body / 100, "rocks at zero phase: %d of %d body pixels black", black, body);
+    nc_frame_free(&f);
+    nc_scene_free(&s);
     return nc_test_end();
 }
