@@ -123,11 +123,12 @@ void nc_rt_refine_mesh16(const struct nc_rt *rt, const struct nc_hit16 *hit, con
 /* For body b's own triangles prim[i] met by the lanes of nonzero lanes[i]
  * (rays orig[i] + t[i] dir[i], dir unit, camera-relative scene frame), when
  * its shadow rays go in its far frame (nc_rt_far_frame): t[i] recomputed in
- * double precision, so that the point is known to 1.2e-7 of the body's
- * radius instead of 1e-7 of the range, and done[i] set (0 where the double
- * ray meets the triangle's plane edge-on or far from t[i]: at an edge,
- * another triangle's; t[i] then stands). Analytic shapes' hits are refined
- * already (nc_rt_refine): left as they are, done. */
+ * double precision from its double vertices, so that the point is known to
+ * 1e-16 of the range instead of 1e-7, and done[i] set (0 where the double
+ * ray misses that triangle: near an edge the float ray, the body placed
+ * 6e-8 of the range off, can meet one the exact ray passes by; t[i] then
+ * stands). Analytic shapes' hits are refined already (nc_rt_refine): left
+ * as they are, done. */
 void nc_rt_refine_far16(const struct nc_rt *rt, int b, const int *lanes, const uint32_t *prim,
                         const struct nc_vec3 *orig, const struct nc_vec3 *dir, double *t, int *done);
 /* Occlusion: on return occluded[i] is nonzero for blocked active rays.
@@ -136,17 +137,18 @@ void nc_rt_refine_far16(const struct nc_rt *rt, int b, const int *lanes, const u
 void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occluded, int frame);
 /* Whether the shadow rays leaving body b (its surface and its rocks; the
  * renderer keeps bounce points in the camera's frame) go in its far frame
- * at the last update: relative to its
- * origin, scene axes, where float rays and geometry carry 6e-8 of the
- * body's size instead of the range (the camera is farther than a bounding
- * radius from its bounding sphere; an analytic shape is left out of its own
- * far frame: a convex shape cannot shadow itself). The frame's origin is
- * the body's, at s->body[b].position_m - s->camera.position_m from the
- * camera; *scale_m: the scale of its float coordinates there (its bounding
- * radius). Hits on its mesh are known to 1e-7 of the range along the ray:
- * enough for nc_rt_shadow_cull16's proof, which takes no ray within the
- * grid's margin of the mesh, and refined by nc_rt_refine_far16 before a
- * ray is traced from there. */
+ * at the last update: relative to its origin, scene axes, where float rays
+ * and geometry carry 6e-8 of the body's size instead of the range (the
+ * camera is farther than a bounding radius from its bounding sphere, and
+ * where its rocks are traced, 2.4e-7 of the range is under 1 % of a pixel:
+ * docs/validation.md; an analytic shape is left out of its own far frame:
+ * a convex shape cannot shadow itself). The frame's origin is the body's,
+ * at s->body[b].position_m - s->camera.position_m from the camera;
+ * *scale_m: the scale of its float coordinates there (its bounding radius).
+ * Hits on its mesh are known to 1e-7 of the range along the ray: enough
+ * for nc_rt_shadow_cull16's proof, which takes no ray within the grid's
+ * margin of the mesh, and refined by nc_rt_refine_far16 before a ray is
+ * traced from there. */
 int nc_rt_far_frame(const struct nc_rt *rt, int b, double *scale_m);
 /* The same for n (at most NC_PACKET) rays from the camera along the unit
  * scene-frame directions dir, each to distance tfar_m (INFINITY: the whole
