@@ -33,8 +33,10 @@ test:
 	cd $(TESTBUILD) && ctest --output-on-failure -j $(JOBS) --timeout 600
 
 bench: build
+	@scripts/install-deps.sh --stars
 	bench/startup.sh $(BUILD)
 	$(BUILD)/bench_render
+	$(BUILD)/bench_render --subdivisions 7 --spp 4
 	$(BUILD)/bench_lod
 	$(BUILD)/bench_stars
 	$(BUILD)/bench_rubble

@@ -57,6 +57,9 @@ struct nc_rt_stats {
     /* Since creation, as the renderer reports them (nc_rt_count_shadow_rays):
      * shadow rays proven unoccluded (nc_rt_shadow_cull16), and traced. */
     unsigned long shadow_rays_culled, shadow_rays_traced;
+    /* Whether the last pass's camera rays went through the bins
+     * (nc_rt_bin_camera served it). */
+    int camera_bins;
     /* ... and camera-ray samples that met a surface, and those of them that
      * met its back, inner side (a camera inside a body sees little else). */
     unsigned long camera_hits, camera_back_hits;

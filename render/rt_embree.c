@@ -893,7 +893,7 @@ void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_h
 
 int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct nc_pool *pool, int threads)
 {
-    rt->rock_binned = 0;
+    rt->rock_binned = rt->stats.camera_bins = 0;
     if (!cam)
         return 0;
     struct nc__bins_body bd[NC_MAX_BODIES];
@@ -927,6 +927,7 @@ int nc_rt_bin_camera(struct nc_rt *rt, const struct nc_rt_pinhole *cam, struct n
      * serve, the camera model of the frame before runs beside the render)
      * leaves its share of the build to the others. */
     int rc = nc__bins_build(&rt->bins, &v, bd, rt->nbodies, pool, 4 * threads);
+    rt->stats.camera_bins = rc > 0;
     if (rc > 0 && rt->rocks_on) {
         struct nc__rock_bins_body rb[NC_MAX_BODIES];
         for (int i = 0; i < rt->nbodies; i++)
