@@ -337,11 +337,14 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
     }
 }
 
-/* s's shadow-ray frames: a camera ray's point on a body seen from farther
- * than a bounding radius off its bounding sphere in its far frame, anything
- * else in the camera's (a bounce ray leaves a float origin relative to the
- * camera: its point is known to 6e-8 of its distance from the camera, in a
- * far frame too, and its shadow ray must start as far off as before). The
+/* s's shadow-ray frames: a camera ray's point on the outer side of a body
+ * seen from farther than a bounding radius off its bounding sphere in its
+ * far frame, anything else in the camera's (a bounce ray leaves a float
+ * origin relative to the camera: its point is known to 6e-8 of its
+ * distance from the camera, in a far frame too, and its shadow ray must
+ * start as far off as before; a camera ray on a surface's inner side is a
+ * float ray that slipped through the body's near side, in the far frame
+ * shut in by it: black pixels at zero phase, found by a review). The
  * float error's scale: in a far frame the body's bounding radius (every
  * coordinate of its geometry there is within it; a mesh hit is refined once
  * a ray from it is traced: occluded_in), or for a rock's hit, known to 1e-7
@@ -350,7 +353,7 @@ static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, int d
 {
     s->prim = hit->prim;
     for (int i = 0; i < NC_PACKET; i++) {
-        const int b = s->body[i], far = b >= 0 && !depth && j->far[b];
+        const int b = s->body[i], far = b >= 0 && !depth && s->outside[i] && j->far[b];
         s->frame[i] = far ? b : -1;
         s->rock[i] = hit->rock[i] >= 0;
         s->rel[i] = far ? j->body_rel[b] : nc_v3(0, 0, 0);
