@@ -183,9 +183,9 @@ int nc_cfg_doubles(struct nc_cfg_node *parent, const char *key, double *out, siz
     if (!s)
         return 0;
     if (s->kind != NC_CFG_SEQ || s->nchild != n) {
-        /* an item another layer added (--set KEY.3=...) is where the length went wrong */
+        /* an item past the length another layer added (--set KEY.3=...) is where the length went wrong */
         const struct nc_cfg_node *at = s;
-        for (size_t i = 0; s->kind == NC_CFG_SEQ && i < s->nchild; i++)
+        for (size_t i = n; s->kind == NC_CFG_SEQ && i < s->nchild; i++)
             at = s->child[i]->origin != s->origin ? s->child[i] : at;
         return nc_cfg_error(at, "expected a list of %zu numbers, got %s", n,
                             s->kind == NC_CFG_SEQ ? "a list of another length" : kind_name(s->kind));

@@ -189,9 +189,13 @@ expect 2 "rock_id needs FITS, TIFF or EXR" -- "$navcam" batch builtin:approach -
 expect 2 "unknown quantity 'flux'" -- "$navcam" render -o "$tmp/x.exr" --quantity flux
 expect 2 "--threads expects" -- "$navcam" render -o "$tmp/x.exr" --threads 1025
 # The camera's 1e15 m limit is a distance, not a coordinate.
-# an item a --set adds to a list is blamed, not the file's line of the list
+# an item a --set adds to a list is blamed, not the file's line of the list;
+# a --set that replaces an item of a list too short in its file is not
 expect 1 "--set camera.position_m.3=5: camera.position_m[3]: expected a list of 3 numbers" -- \
   "$navcam" render -o "$tmp/long.fits" --set camera.position_m.3=5
+printf 'base: builtin:default\ncamera:\n  position_m: [0, -6000]\n' > "$tmp/short.yaml"
+expect 1 "short.yaml:3: camera.position_m: expected a list of 3 numbers" -- \
+  "$navcam" render "$tmp/short.yaml" -o "$tmp/short.fits" --set camera.position_m.1=-5000
 expect 1 "camera.position_m: 1.55885e+15 m from the scene's origin, beyond 1e+15 m" -- \
   "$navcam" render -o "$tmp/far.fits" --set 'camera.position_m=[9e14,9e14,9e14]'
 # A camera inside the body (20 m from the centre of the default asteroid) is warned of.
