@@ -36,7 +36,7 @@ static const char expose_help[] =
     "      --first-frame K    frame number of the first frame (keys the noise; default 0)\n"
     "  -d, --dark             dark frames: no light (radiance 0)\n"
     "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N), 16-bit unsigned (8-bit\n"
-    "                         for an ADC of 8 bits or fewer);\n"
+    "                         for an 8-bit ADC);\n"
     "                         .png/.tif/.exr: numbered files OUT_0000.ext, OUT_0001.ext, ...\n"
     "      --fits-rows ORDER  .fits only: top_down (default: row 1 is the top image\n"
     "                         row) or bottom_up (row 1 at the bottom, as FITS viewers\n"
