@@ -212,6 +212,7 @@ struct job {
     int bins; /* camera rays through nc_rt_intersect_block (a pinhole at rest over meshes) */
     int plain; /* meshes only, no albedo maps, the Sun at infinity: surface16's lanes without exceptions */
     int far[NC_MAX_BODIES];        /* shadow rays leaving the body in its far frame (nc_rt_far_frame) */
+    int any_far;                   /* ... for any body */
     double far_scale[NC_MAX_BODIES]; /* ... and the scale of its float coordinates there, m */
 };
 
@@ -276,19 +277,23 @@ struct surf {
     int outside[NC_PACKET];   /* the ray came from the outer side of the surface */
     double t[NC_PACKET];      /* ray parameter, m */
     double scale[NC_PACKET];  /* the float error's scale there, m: t, or more for a refined mesh hit */
-    /* The frame its shadow rays go in (nc_rt_far_frame): -1, the camera's;
-     * b, body b's far frame (shadow_frames) */
-    int frame[NC_PACKET];
-    int rock[NC_PACKET];          /* a rock's surface (nc_hit16.rock >= 0) */
-    struct nc_vec3 rel[NC_PACKET]; /* the frame's origin from the camera (0 for the camera's), m */
-    double escale[NC_PACKET];     /* the float error's scale in the frame, m (shadow_frames) */
-    const uint32_t *prim;         /* the triangles met (nc_hit16.prim), to refine a far frame's point */
     struct nc_vec3 p[NC_PACKET];    /* position relative to the camera, scene frame, m */
     struct nc_vec3 n[NC_PACKET];    /* unit normal, turned to face the ray's origin */
     struct nc_vec3 d[NC_PACKET];    /* the ray's unit direction */
     struct nc_vec3 sdir[NC_PACKET]; /* unit direction to the Sun's centre */
     double irr[NC_PACKET];    /* solar irradiance there, W m^-2 */
     double factor[NC_PACKET]; /* on the albedo: variation and map */
+    /* The frame its shadow rays go in (shadow_frames; after the arrays
+     * above, which keep their 64-byte alignment): frame -1, the camera's; b,
+     * body b's far frame (nc_rt_far_frame), where the point is p - rel and
+     * the float error's scale escale; far: some lane is in a far frame (else
+     * rel and escale are not set). */
+    int frame[NC_PACKET];
+    int rock[NC_PACKET]; /* a rock's surface (nc_hit16.rock >= 0) */
+    struct nc_vec3 rel[NC_PACKET];
+    double escale[NC_PACKET];
+    const uint32_t *prim; /* the triangles met (nc_hit16.prim), to refine a far frame's point */
+    int far;
 };
 
 /* (x, y, z) / |(x, y, z)| into lane i of u, as nc_v3_unit does it (the
@@ -352,8 +357,13 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
 static void shadow_frames(const struct job *j, const struct nc_hit16 *hit, int depth, struct surf *s)
 {
     s->prim = hit->prim;
+    s->far = j->any_far && !depth;
+    if (!s->far) { /* every lane in the camera's frame */
+        memset(s->frame, 0xff, sizeof s->frame); /* -1 */
+        return;
+    }
     for (int i = 0; i < NC_PACKET; i++) {
-        const int b = s->body[i], far = b >= 0 && !depth && s->outside[i] && j->far[b];
+        const int b = s->body[i], far = b >= 0 && s->outside[i] && j->far[b];
         s->frame[i] = far ? b : -1;
         s->rock[i] = hit->rock[i] >= 0;
         s->rel[i] = far ? j->body_rel[b] : nc_v3(0, 0, 0);
@@ -529,17 +539,15 @@ static void unoccluded16(struct job *j, const struct surf *sf, struct nc_ray16 *
  * branch-free loop (AVX-512 or AVX2 where the CPU has it, without
  * contraction: the same bits as the loop lane by lane): a lane with no
  * point, or facing away from the Sun or the camera, gets lit 0 and an
- * invalid ray (its other fields unused); a ray starts 4e-6 of its float
- * error's scale off the surface, in its frame, as in sunlight16. Returns
- * how many are lit. */
+ * invalid ray (its other fields unused); a ray starts 4e-6 t off the
+ * surface, as in sunlight16. Returns how many are lit. */
 __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static int
 hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *shadow, int *from, int *lit)
 {
     int any = 0;
     for (int i = 0; i < NC_PACKET; i++) {
-        const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i];
-        const struct nc_vec3 p = nc_v3_sub(s->p[i], s->rel[i]); /* in its frame */
-        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->escale[i];
+        const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i], p = s->p[i];
+        const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->scale[i];
         const int on = (s->body[i] >= 0) & (mu0 > 0) & (mu > 0);
         geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, d), s->factor[i]};
         shadow->ox[i] = (float)(p.x + eps * nrm.x);
@@ -556,6 +564,21 @@ hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *sha
         any += on;
     }
     return any;
+}
+
+/* The shadow rays of s's lanes in far frames (shadow_frames) start there:
+ * from p - rel, 4e-6 escale off along the normal (a lane in the camera's
+ * frame gets the bits it had: rel 0, escale its scale); branch-free. */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void far_origins(const struct surf *s,
+                                                                                            struct nc_ray16 *ray)
+{
+    for (int i = 0; i < NC_PACKET; i++) {
+        const struct nc_vec3 p = nc_v3_sub(s->p[i], s->rel[i]), nrm = s->n[i];
+        const double eps = 4e-6 * s->escale[i];
+        ray->ox[i] = (float)(p.x + eps * nrm.x);
+        ray->oy[i] = (float)(p.y + eps * nrm.y);
+        ray->oz[i] = (float)(p.z + eps * nrm.z);
+    }
 }
 
 /* Direct sunlight at the surface points of s seen along their rays: r[i]
@@ -591,11 +614,11 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
                 continue;
             geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, s->d[i]), s->factor[i]};
             /* Offset the origin off the surface by a few float ulps of the
-             * coordinates in the ray's frame (the camera's: a bounce's t can be
-             * far shorter than the point's distance from the camera); tnear
-             * stays 0. */
-            const struct nc_vec3 p = nc_v3_sub(s->p[i], s->rel[i]);
-            double eps = 4e-6 * (depth ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : s->escale[i]);
+             * camera-relative coordinates (a bounce's t can be far shorter than
+             * the point's distance from the camera; a lane in a far frame is
+             * moved there below: far_origins); tnear stays 0. */
+            double eps = 4e-6 * (depth ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : s->scale[i]);
+            struct nc_vec3 p = s->p[i];
             shadow.ox[i] = (float)(p.x + eps * nrm.x);
             shadow.oy[i] = (float)(p.y + eps * nrm.y);
             shadow.oz[i] = (float)(p.z + eps * nrm.z);
@@ -637,6 +660,11 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
     }
     if (!any)
         return;
+    if (s->far) { /* the lanes in far frames start there */
+        far_origins(s, &shadow);
+        if (twin)
+            far_origins(s, &centre);
+    }
     int lit_hard[NC_PACKET], from_hard[NC_PACKET];
     if (twin) { /* the soft shadows' grid serves every ray into the disk, its centre too */
         for (int i = 0; i < NC_PACKET; i++) {
@@ -1206,6 +1234,7 @@ static int render_rows(struct nc_renderer *r, const struct nc_scene *s, struct n
         j.body_rel[b] = nc_v3_sub(s->body[b].position_m, c->position_m);
         j.mat[b] = s->body[b].material;
         j.far[b] = nc_rt_far_frame(r->rt, b, &j.far_scale[b]);
+        j.any_far |= j.far[b];
         r->fold_theta_bar_deg[b] = -1;
         if (s->render.boulder_fold && st.boulder_cut_cover[b] > 0)
             r->fold_theta_bar_deg[b] = nc_material_fold_rocks(&s->body[b].material, st.boulder_cut_cover[b], &j.mat[b]);
