@@ -286,8 +286,10 @@ struct surf {
     /* The frame its shadow rays go in (shadow_frames; after the arrays
      * above, which keep their 64-byte alignment): frame -1, the camera's; b,
      * body b's far frame (nc_rt_far_frame), where the point is p - rel and
-     * the float error's scale escale; far: some lane is in a far frame (else
-     * rel and escale are not set). */
+     * the float error's scale escale; far: the frames of a camera ray's
+     * points while some body is in a far frame (the lanes in the camera's
+     * frame then have rel 0 and escale their scale), else 0, every lane in
+     * the camera's frame, and rock, rel and escale not set. */
     int frame[NC_PACKET];
     int rock[NC_PACKET]; /* a rock's surface (nc_hit16.rock >= 0) */
     struct nc_vec3 rel[NC_PACKET];
@@ -1020,7 +1022,7 @@ static void shade_tile(struct job *j, int tile)
     int g_lane[SLOT_GROUP][NC_PACKET];
     struct nc_hit16 hit[SLOT_GROUP];
     struct surf sf;
-    memset(&sf, 0, sizeof sf); /* hard_lanes reads every lane, hit or not */
+    memset(&sf, 0, sizeof sf); /* hard_lanes and far_origins read every lane, hit or not */
     struct tile_counts cnt = {0, 0, 0, 0};
     double r[NC_PACKET];
 

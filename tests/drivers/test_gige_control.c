@@ -352,8 +352,8 @@ static void test_slow_poll(void)
  * pixel so that a frame is being made at many of them: no frame exposed
  * before the start arrives well after it (its first packet received more
  * than 15 ms after the call: a frame sent before the Stop can be taken
- * late by a client's thread on a loaded machine, 4.5 ms seen), and every
- * frame exposed after it has exposure X. Before,
+ * late by a client's thread on a loaded machine, 4.5 ms seen), and the
+ * first frame exposed after it has exposure X. Before,
  * the device saw no restart (its acquisition register read 1 before and
  * after) and sent frames exposed up to 20 ms before the start 12-37 ms
  * after it (an outside check: 8 of 45 restarts). */
