@@ -459,6 +459,16 @@ struct tile_counts {
     unsigned long shadow_culled, shadow_traced, hits, back_hits;
 };
 
+/* Lane i of ray starts eps off point p (in the ray's frame) along the unit
+ * normal n, rounded to float. */
+static inline __attribute__((always_inline)) void start_off(struct nc_ray16 *ray, int i, struct nc_vec3 p, double eps,
+                                                           struct nc_vec3 n)
+{
+    ray->ox[i] = (float)(p.x + eps * n.x);
+    ray->oy[i] = (float)(p.y + eps * n.y);
+    ray->oz[i] = (float)(p.z + eps * n.z);
+}
+
 /* The valid lanes of shadow, rays from the points of sf, all in frame fr:
  * occluded[i] and blocked[i] set where they meet something
  * (nc_rt_shadow_cull16, nc_rt_occluded16); returns how many were proven
@@ -487,10 +497,8 @@ static int occluded_in(struct job *j, const struct surf *sf, struct nc_ray16 *sh
                 continue;
             /* a point not refined: 1e-7 of the range off, the offset as in the camera's frame */
             const double eps = 4e-6 * (done[i] ? sf->escale[i] : fmax(sf->escale[i], t[i]));
-            const struct nc_vec3 p = nc_v3_add(nc_v3_sub(sf->p[i], sf->rel[i]), nc_v3_scale(sf->d[i], t[i] - sf->t[i]));
-            shadow->ox[i] = (float)(p.x + eps * sf->n[i].x);
-            shadow->oy[i] = (float)(p.y + eps * sf->n[i].y);
-            shadow->oz[i] = (float)(p.z + eps * sf->n[i].z);
+            start_off(shadow, i, nc_v3_add(nc_v3_sub(sf->p[i], sf->rel[i]), nc_v3_scale(sf->d[i], t[i] - sf->t[i])),
+                      eps, sf->n[i]);
         }
     }
     int occ[NC_PACKET];
@@ -574,13 +582,8 @@ hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *sha
 __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) static void far_origins(const struct surf *s,
                                                                                             struct nc_ray16 *ray)
 {
-    for (int i = 0; i < NC_PACKET; i++) {
-        const struct nc_vec3 p = nc_v3_sub(s->p[i], s->rel[i]), nrm = s->n[i];
-        const double eps = 4e-6 * s->escale[i];
-        ray->ox[i] = (float)(p.x + eps * nrm.x);
-        ray->oy[i] = (float)(p.y + eps * nrm.y);
-        ray->oz[i] = (float)(p.z + eps * nrm.z);
-    }
+    for (int i = 0; i < NC_PACKET; i++)
+        start_off(ray, i, nc_v3_sub(s->p[i], s->rel[i]), 4e-6 * s->escale[i], s->n[i]);
 }
 
 /* Direct sunlight at the surface points of s seen along their rays: r[i]
@@ -619,11 +622,8 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
              * camera-relative coordinates (a bounce's t can be far shorter than
              * the point's distance from the camera; a lane in a far frame is
              * moved there below: far_origins); tnear stays 0. */
-            double eps = 4e-6 * (depth ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : s->scale[i]);
-            struct nc_vec3 p = s->p[i];
-            shadow.ox[i] = (float)(p.x + eps * nrm.x);
-            shadow.oy[i] = (float)(p.y + eps * nrm.y);
-            shadow.oz[i] = (float)(p.z + eps * nrm.z);
+            start_off(&shadow, i, s->p[i], 4e-6 * (depth ? fmax(s->scale[i], nc_v3_norm(s->p[i])) : s->scale[i]),
+                      nrm);
             struct nc_vec3 sray = sdir;
             if (twin) {
                 centre.ox[i] = shadow.ox[i];

@@ -1199,25 +1199,25 @@ static int proven_lanes(const struct nc_rt *rt, const struct nc_ray16 *ray, cons
     return culled;
 }
 
-/* A shadow ray frame's origin from the camera (scene frame, m) and its
- * scenes: -1 the camera's, else that body's far frame. */
-static struct nc_vec3 frame_of(const struct nc_rt *rt, int frame, RTCScene *top, RTCScene *solo)
+/* A shadow ray frame's origin from the camera (scene frame, m): -1 the
+ * camera's, else that body's far frame. */
+static struct nc_vec3 frame_shift(const struct nc_rt *rt, int frame)
 {
-    if (frame < 0) {
-        *top = rt->top;
-        *solo = rt->solo;
-        return nc_v3(0, 0, 0);
-    }
-    *top = rt->body[frame].far_top;
-    *solo = rt->body[frame].far_solo;
-    return rt->body[frame].origin_rel;
+    return frame < 0 ? nc_v3(0, 0, 0) : rt->body[frame].origin_rel;
+}
+
+/* ... and its scene: everything, or with solo the rocks alone. */
+static RTCScene frame_scene(const struct nc_rt *rt, int frame, int solo)
+{
+    if (frame < 0)
+        return solo ? rt->solo : rt->top;
+    return solo ? rt->body[frame].far_solo : rt->body[frame].far_top;
 }
 
 int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from, int *blocked, int frame)
 {
     int culled = 0, proven[NC_PACKET] = {0};
-    RTCScene top, solo;
-    const struct nc_vec3 shift = frame_of(rt, frame, &top, &solo);
+    const struct nc_vec3 shift = frame_shift(rt, frame);
     /* One mesh body and one direction (hard shadows): proven_lit for the
      * whole packet in one grid query. */
     int want[NC_PACKET], f = -1, alike = rt->nbodies == 1;
@@ -1252,7 +1252,7 @@ int nc_rt_shadow_cull16(struct nc_rt *rt, struct nc_ray16 *ray, const int *from,
         struct nc_ray16 pr = *ray;
         memcpy(pr.valid, proven, sizeof proven);
         load_ray(&r, &pr);
-        rtcOccluded16(proven, solo, &ctx, &r);
+        rtcOccluded16(proven, frame_scene(rt, frame, 1), &ctx, &r);
         for (int i = 0; i < NC_PACKET; i++)
             if (proven[i] && r.tfar[i] == -INFINITY)
                 blocked[i] = 1, culled--;
@@ -1276,9 +1276,7 @@ void nc_rt_occluded16(struct nc_rt *rt, const struct nc_ray16 *ray, int *occlude
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     load_ray(&r, ray);
-    RTCScene top, solo;
-    frame_of(rt, frame, &top, &solo);
-    rtcOccluded16(ray->valid, top, &ctx, &r);
+    rtcOccluded16(ray->valid, frame_scene(rt, frame, 0), &ctx, &r);
     for (int i = 0; i < NC_PACKET; i++)
         occluded[i] = ray->valid[i] && r.tfar[i] == -INFINITY;
 }
