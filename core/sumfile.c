@@ -30,14 +30,16 @@ static void trim(char *s)
         s[--n] = 0;
 }
 
-/* Where label starts as a word of line (at its start or after a blank or
- * a comma, and followed by neither a letter, a digit nor '_'), or NULL. */
+/* Where label starts as a word of line (at its start or after a blank, a
+ * comma or a digit: a label glued to the line's last number, `0.5D+00CX`,
+ * as fixed-width Fortran output can print it; and followed by neither a
+ * letter, a digit nor '_'), or NULL. */
 static const char *label_at(const char *line, const char *label)
 {
     const size_t n = strlen(label);
     for (const char *p = strstr(line, label); p; p = strstr(p + 1, label))
-        if ((p == line || isspace((unsigned char)p[-1]) || p[-1] == ',') && !isalnum((unsigned char)p[n]) &&
-            p[n] != '_')
+        if ((p == line || isspace((unsigned char)p[-1]) || p[-1] == ',' || isdigit((unsigned char)p[-1])) &&
+            !isalnum((unsigned char)p[n]) && p[n] != '_')
             return p;
     return NULL;
 }

@@ -366,6 +366,15 @@ int main(void)
           "D notation: %s", nc_errmsg());
 
     char bad[2048];
+    /* labels glued to the last number, as fixed-width Fortran output can print them (an outside check found
+     * such a line reported missing) */
+    replaced(bad, sizeof bad, good, "   -0.9759000729D+00  CY", "   -0.9759000729D+00CY");
+    char glued[2048];
+    replaced(glued, sizeof glued, bad, "   0.00000  K-MATRIX", "   0.00000K-MATRIX");
+    nc_test_write(nc_test_path("glued.SUM"), glued);
+    CHECK(nc_sumfile_read(nc_test_path("glued.SUM"), &sum) == 0 && fabs(sum.cy[2] + 0.9759000729) < 1e-15 &&
+              sum.k[4] == 117.647 && sum.k[5] == 0,
+          "labels glued to their numbers: %s", nc_errmsg());
     /* a NUL byte after a label: the rest of the line would be lost unseen */
     const size_t glen = strlen(good), at = (size_t)(strstr(good, "SCOBJ\n") - good) + 5;
     memcpy(bad, good, glen);
