@@ -60,16 +60,42 @@ void nc_frame_flip(struct nc_frame *f, int rows, int cols)
  * direction R (u, v, 1); the standard coordinates east and north of the
  * boresight b are u R_x . e + v R_y . e (e east) and the same with north:
  * linear in (u, v), so the CD matrix is exact. */
-int nc_shot_detail_attrs(double lod_error_m, double boulder_min_m, double boulder_mesh_px, char (*val)[40],
+void nc_shot_detail_of(const struct nc_renderer *r, int nbodies, struct nc_shot_detail *d)
+{
+    d->lod_error_m = nc_rt_lod_error_m(r->rt);
+    d->boulder_min_m = nc_rt_boulder_min_m(r->rt);
+    d->boulder_mesh_px = nc_rt_boulder_mesh_px(r->rt);
+    for (int i = 0; i < NC_MAX_BODIES; i++)
+        d->fold_theta_bar_deg[i] = i < nbodies ? r->fold_theta_bar_deg[i] : -1;
+}
+
+int nc_shot_detail_attrs(const struct nc_scene *scene, const struct nc_shot_detail *d, struct nc_shot_detail_text *t,
                          struct nc_image_attr *out)
 {
     static const char *const names[3] = {"navcam:lod_error_m", "navcam:boulder_min_m", "navcam:boulder_mesh_px"};
-    const double v[3] = {lod_error_m, boulder_min_m, boulder_mesh_px};
+    const double v[3] = {d->lod_error_m, d->boulder_min_m, d->boulder_mesh_px};
+    int n = 0;
     for (int k = 0; k < 3; k++) {
-        snprintf(val[k], sizeof val[k], "%.17g", v[k]);
-        out[k] = (struct nc_image_attr){names[k], val[k]};
+        snprintf(t->num[k], sizeof t->num[k], "%.17g", v[k]);
+        out[n++] = (struct nc_image_attr){names[k], t->num[k]};
     }
-    return 3;
+    /* how each mesh is shaded (name=flat or name=smooth), and the roughness each body's rocks not traced were
+     * folded into (name=deg), comma-separated */
+    t->normals[0] = t->fold[0] = 0;
+    for (int i = 0, o = 0, p = 0; i < scene->nbodies; i++) {
+        const struct nc_body *b = &scene->body[i];
+        if (nc_body_is_mesh(b))
+            o += snprintf(t->normals + o, sizeof t->normals - (size_t)o, "%s%s=%s", o ? "," : "", b->name,
+                          b->smooth_normals ? "smooth" : "flat");
+        if (d->fold_theta_bar_deg[i] >= 0)
+            p += snprintf(t->fold + p, sizeof t->fold - (size_t)p, "%s%s=%.6g", p ? "," : "", b->name,
+                          d->fold_theta_bar_deg[i]);
+    }
+    if (t->normals[0])
+        out[n++] = (struct nc_image_attr){"navcam:normals", t->normals};
+    if (t->fold[0])
+        out[n++] = (struct nc_image_attr){"navcam:rock_fold_theta_bar_deg", t->fold};
+    return n;
 }
 
 int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out)
@@ -206,32 +232,17 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     info->stars_ms = t2 - ts0;
     if (q <= NC_Q_ROCK_ID) /* the sensor's quantities are mirrored after the optics (write_sensor_frame) */
         nc_frame_flip(&f, scene->camera.flip_rows, scene->camera.flip_cols);
-    char detail[3][40];
-    /* How each mesh is shaded: name=flat or name=smooth, comma-separated. */
-    char normals[NC_MAX_BODIES * 72] = "";
-    for (int i = 0, o = 0; i < scene->nbodies; i++)
-        if (nc_body_is_mesh(&scene->body[i]))
-            o += snprintf(normals + o, sizeof normals - (size_t)o, "%s%s=%s", o ? "," : "", scene->body[i].name,
-                          scene->body[i].smooth_normals ? "smooth" : "flat");
-    /* The roughness each body's rocks not traced were folded into. */
-    char fold[NC_MAX_BODIES * 80] = "";
-    for (int i = 0, o = 0; i < scene->nbodies; i++)
-        if (r->fold_theta_bar_deg[i] >= 0)
-            o += snprintf(fold + o, sizeof fold - (size_t)o, "%s%s=%.6g", o ? "," : "", scene->body[i].name,
-                          r->fold_theta_bar_deg[i]);
     char flip[40];
     snprintf(flip, sizeof flip, "rows=%d columns=%d", scene->camera.flip_rows, scene->camera.flip_cols);
     struct nc_image_attr extra[48];
-    int nextra = nc_shot_detail_attrs(nc_rt_lod_error_m(r->rt), nc_rt_boulder_min_m(r->rt),
-                                      nc_rt_boulder_mesh_px(r->rt), detail, extra);
+    struct nc_shot_detail detail;
+    struct nc_shot_detail_text detail_text;
+    nc_shot_detail_of(r, scene->nbodies, &detail);
+    int nextra = nc_shot_detail_attrs(scene, &detail, &detail_text, extra);
     if (suninfo[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:sun_view", suninfo};
     if (starinfo[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:stars", starinfo};
-    if (normals[0])
-        extra[nextra++] = (struct nc_image_attr){"navcam:normals", normals};
-    if (fold[0])
-        extra[nextra++] = (struct nc_image_attr){"navcam:rock_fold_theta_bar_deg", fold};
     if (scene->camera.flip_rows || scene->camera.flip_cols)
         extra[nextra++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
     if (scene->camera.from_sumfile)

@@ -48,10 +48,24 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
  * attributes ("fits:CTYPE1", ...) into out[14], their numbers' text in
  * val; 0 (none) for a distorted camera. Returns how many. */
 int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out);
-/* The detail a frame was rendered with (levels of detail's error, m; the
- * boulder cut, m, 0: every rock; the detailed surfaces' threshold, px) as
- * attributes into out[3], their text in val. Returns 3. */
-int nc_shot_detail_attrs(double lod_error_m, double boulder_min_m, double boulder_mesh_px, char (*val)[40],
+/* The detail a frame was rendered with, read off its renderer after the
+ * render (the levels of detail's error bound, m; the boulder cut, m, 0:
+ * every rock; the detailed surfaces' threshold, px; the roughness each
+ * body's rocks not traced were folded into, deg, -1: none). */
+struct nc_shot_detail {
+    double lod_error_m, boulder_min_m, boulder_mesh_px;
+    double fold_theta_bar_deg[NC_MAX_BODIES];
+};
+/* The text of its attributes. */
+struct nc_shot_detail_text {
+    char num[3][40], normals[NC_MAX_BODIES * 72], fold[NC_MAX_BODIES * 80];
+};
+void nc_shot_detail_of(const struct nc_renderer *r, int nbodies, struct nc_shot_detail *d);
+/* d and how scene shades its meshes as attributes into out[5]
+ * (navcam:lod_error_m, boulder_min_m, boulder_mesh_px; navcam:normals
+ * when a body is a mesh, navcam:rock_fold_theta_bar_deg when rocks were
+ * folded), their text in t. Returns how many. */
+int nc_shot_detail_attrs(const struct nc_scene *scene, const struct nc_shot_detail *d, struct nc_shot_detail_text *t,
                          struct nc_image_attr *out);
 /* The geometry planes (render.h, enum nc_geom_plane) of scene at pixel
  * centres: one sample a pixel, direct light only, no time samples; then

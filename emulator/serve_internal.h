@@ -19,6 +19,7 @@
 #include <stdio.h>
 
 #include "camera/camsys.h"
+#include "camera/shot.h"
 #include "camera/sky.h"
 #include "emulator/output.h"
 #include "emulator/serve.h"
@@ -84,11 +85,12 @@ static inline void nc__job_exposure(const struct nc__job *j, int64_t *start_sim,
 
 /* A finished job on its way to the outputs: a frame, or (lock-step) a drop
  * that must be answered in request order. */
-#define NC__SLOT_ATTRS 48
+#define NC__SLOT_ATTRS 52
 struct nc__slot {
     struct nc_frame_record rec;
     struct nc_image_attr attrs[NC__SLOT_ATTRS]; /* rec.attrs, and their values */
-    char attr_text[30][200], attr_detail[3][40], attr_wcs[8][32];
+    char attr_text[30][200], attr_wcs[8][32];
+    struct nc_shot_detail_text attr_detail;
     struct nc__job job;
     uint16_t *dn;
     int64_t render_start_mono_ns; /* the job left the queue and its pose was there: the render began */

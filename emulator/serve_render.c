@@ -153,7 +153,8 @@ struct staged {
     unsigned long hits, back_hits; /* camera samples that met a surface, and its back side */
     long in_rock;                  /* the rock the camera is inside (of body in_rock_body), -1: none */
     int in_rock_body;
-    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg;
+    struct nc_shot_detail detail;   /* the levels of detail, the boulder cut, the fold */
+    double rock_fold_theta_bar_deg; /* the largest fold (-1: none) */
     struct nc_sky_stats stars;
     struct nc_sun_view sun;
     struct nc_render_settings used; /* render.quality: auto's choice, or the scene's */
@@ -211,7 +212,7 @@ static int frame_attrs(const struct nc__emu *e, const struct staged *x, const st
     at.render = x->used;
     int n = nc_frame_meta(&at, NC_Q_DN, sl->attrs, sl->attr_text, 24);
     n += nc_camsys_meta(cs, x->j.exposure_s, frame, sl->attrs + n, sl->attr_text + 24, 6);
-    n += nc_shot_detail_attrs(x->lod_error_m, x->boulder_min_m, x->boulder_mesh_px, sl->attr_detail, sl->attrs + n);
+    n += nc_shot_detail_attrs(&at, &x->detail, &sl->attr_detail, sl->attrs + n);
     at.camera.flip_rows = at.camera.flip_cols = 0; /* the emulator's frames are the view, unmirrored */
     if (e->sky.on)
         n += nc_shot_wcs_attrs(&at.camera, sl->attr_wcs, sl->attrs + n);
@@ -263,8 +264,8 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .exposure_end_sim_ns = start_sim + exp_ns, .trigger_mono_ns = j->trigger_mono_ns,
         .exposure_start_mono_ns = start_mono, .exposure_end_mono_ns = start_mono + exp_ns, .pose = x->pose,
         .pose_quality = x->q, .pose_gap_ns = x->gap, .exposure_s = j->exposure_s, .gain_db = j->gain_db,
-        .time_samples = x->ts, .lod_error_m = x->lod_error_m, .boulder_min_m = x->boulder_min_m,
-        .boulder_mesh_px = x->boulder_mesh_px,
+        .time_samples = x->ts, .lod_error_m = x->detail.lod_error_m, .boulder_min_m = x->detail.boulder_min_m,
+        .boulder_mesh_px = x->detail.boulder_mesh_px,
         .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .samples_per_pixel = x->used.samples_per_pixel,
         .bounces = x->used.bounces, .soft_shadows = x->used.soft_shadows, .quality_auto = x->used.quality_auto,
         .stars_on = e->sky.on, .star_limit_mag = x->stars.limit_mag, .stars_drawn = x->stars.drawn,
@@ -380,9 +381,7 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
         if (x.rc >= 0) /* the Sun drawn if its disk reaches the frame; in the record if in or near it */
             x.rc = nc_render_sun(&e->renderer, &at, NC_SUN_NEAR_DEG, f, &x.sun);
         x.t1 = nc_mono_ns();
-        x.lod_error_m = nc_rt_lod_error_m(e->renderer.rt);
-        x.boulder_min_m = nc_rt_boulder_min_m(e->renderer.rt);
-        x.boulder_mesh_px = nc_rt_boulder_mesh_px(e->renderer.rt);
+        nc_shot_detail_of(&e->renderer, at.nbodies, &x.detail);
         x.rock_fold_theta_bar_deg = nc_render_fold_theta_bar_deg(&e->renderer, at.nbodies);
         if (overlap) {
             atomic_store(&e->readout_end_ns, 0); /* the next exposure may start rendering */

@@ -64,29 +64,6 @@ cmp -s <(strip "$tmp/lock1/frames/frames.jsonl") <(strip "$tmp/lock2/frames/fram
   || bad "lock-step metadata differs: $(diff <(strip "$tmp/lock1/frames/frames.jsonl") <(strip "$tmp/lock2/frames/frames.jsonl") | head -3)"
 [ "$(wc -l < "$tmp/lock1/frames/frames.jsonl")" -eq 8 ] && ok || bad "sidecar lines"
 [ "$(json "$tmp/lock1/stats.json" "d['frames_delivered']")" = 8 ] && ok || bad "stats: frames_delivered"
-# Each file carries navcam render's metadata of a dn frame (docs/config.md), at the frame's own pose.
-python3 - "$tmp/lock1/frames" <<'PY' && ok || bad "file output metadata"
-import json, struct, sys, zlib
-d = open(sys.argv[1] + "/frame_000003.png", "rb").read()
-i, meta = 8, {}
-while i < len(d):  # the PNG's text chunks
-    n, = struct.unpack(">I", d[i:i + 4]); t, c = d[i + 4:i + 8], d[i + 8:i + 8 + n]; i += 12 + n
-    if t == b"tEXt":
-        k, v = c.split(b"\0", 1); meta[k.decode()] = v.decode("latin1")
-    elif t in (b"zTXt", b"iTXt"):
-        k, r = c.split(b"\0", 1)
-        if t == b"zTXt":
-            meta[k.decode()] = zlib.decompress(r[1:]).decode("latin1")
-        else:
-            comp, r = r[0], r[2:]; r = r.split(b"\0", 2)[2]; meta[k.decode()] = (zlib.decompress(r) if comp else r).decode()
-rec = [json.loads(l) for l in open(sys.argv[1] + "/frames.jsonl")][3]
-need = ["navcam:exposure_s", "navcam:gain_e_per_dn", "navcam:bias_dn", "navcam:intrinsics_fx_fy_cx_cy_px",
-        "navcam:sun_direction_scene", "navcam:light", "navcam:frame"]
-assert all(k in meta for k in need), sorted(meta)
-pos = json.loads(meta["navcam:camera_position_m"])
-assert max(abs(a - b) for a, b in zip(pos, rec["pose"]["camera_position_m"])) < 1e-6, (pos, rec["pose"])
-assert float(meta["navcam:exposure_s"]) == rec["exposure_s"] and meta["navcam:frame"] == "3", meta
-PY
 
 # A sidecar that cannot be written (a full disk: /dev/full) fails the file
 # output's submit, frame by frame, with the reason; the frames go on to the
@@ -119,7 +96,8 @@ stop
 rocks="bodies.0.boulders={preset: bennu, min_diameter_m: 4}"
 "$navcam" population "${small[@]}" --set "$rocks" -b "$tmp/rocks.csv" > /dev/null 2>&1 || bad "population"
 awk -F, 'NR == 3 { printf "0,%s,%s,%s,1,0,0,0,0,-1,0\n", $3, $4, $5 }' "$tmp/rocks.csv" > "$tmp/in_rock.csv"
-printf '1,0,-3000,0,0.70710678,-0.70710678,0,0,1,0,0\n' >> "$tmp/in_rock.csv" # then outside: the log says it ended
+# then outside, 30 km off (the rocks under 6.5 m folded): the log says it ended
+printf '1,0,-30000,0,0.70710678,-0.70710678,0,0,1,0,0\n' >> "$tmp/in_rock.csv"
 start in_rock 16 --set serve.mode=lockstep --set "$rocks"
 "$navcam" replay "$tmp/in_rock.csv" --lockstep --port "$tcp" > "$tmp/in_rock/replay.out" 2>&1 && ok \
   || bad "replay in_rock.csv: $(cat "$tmp/in_rock/replay.out")"
@@ -129,6 +107,40 @@ grep -q '"inside": {"warning": "camera inside a boulder", "body": 0, "boulder": 
   && [ "$(grep -c 'nor is the camera inside a boulder' "$tmp/in_rock/serve.log")" = 1 ] \
   && [ "$(sed -n 2p "$tmp/in_rock/frames/frames.jsonl" | grep -c inside)" = 0 ] && ok \
   || bad "in_rock: $(cut -c1-300 "$tmp/in_rock/frames/frames.jsonl") $(cat "$tmp/in_rock/serve.log")"
+
+# Each file carries navcam render's metadata of a dn frame (docs/config.md), at the frame's own pose, with the
+# detail it was rendered with (an outside check found NORMALS and ROCKFOLD missing).
+python3 - "$tmp/lock1/frames" "$tmp/in_rock/frames" <<'PY' && ok || bad "file output metadata"
+import json, struct, sys, zlib
+def png_meta(path):
+    d = open(path, "rb").read()
+    i, meta = 8, {}
+    while i < len(d):  # the PNG's text chunks
+        n, = struct.unpack(">I", d[i:i + 4]); t, c = d[i + 4:i + 8], d[i + 8:i + 8 + n]; i += 12 + n
+        if t == b"tEXt":
+            k, v = c.split(b"\0", 1); meta[k.decode()] = v.decode("latin1")
+        elif t in (b"zTXt", b"iTXt"):
+            k, r = c.split(b"\0", 1)
+            if t == b"zTXt":
+                meta[k.decode()] = zlib.decompress(r[1:]).decode("latin1")
+            else:
+                comp, r = r[0], r[2:]; r = r.split(b"\0", 2)[2]; meta[k.decode()] = (zlib.decompress(r) if comp else r).decode()
+    return meta
+meta = png_meta(sys.argv[1] + "/frame_000003.png")
+rec = [json.loads(l) for l in open(sys.argv[1] + "/frames.jsonl")][3]
+need = ["navcam:exposure_s", "navcam:gain_e_per_dn", "navcam:bias_dn", "navcam:intrinsics_fx_fy_cx_cy_px",
+        "navcam:sun_direction_scene", "navcam:light", "navcam:frame"]
+assert all(k in meta for k in need), sorted(meta)
+pos = json.loads(meta["navcam:camera_position_m"])
+assert max(abs(a - b) for a, b in zip(pos, rec["pose"]["camera_position_m"])) < 1e-6, (pos, rec["pose"])
+assert float(meta["navcam:exposure_s"]) == rec["exposure_s"] and meta["navcam:frame"] == "3", meta
+# the detail it was rendered with, as navcam render writes it: how the mesh is shaded, the rocks' cut and fold
+assert meta["navcam:normals"] == "asteroid=flat" and "navcam:rock_fold_theta_bar_deg" not in meta, meta
+meta = png_meta(sys.argv[2] + "/frame_000001.png")
+rec = [json.loads(l) for l in open(sys.argv[2] + "/frames.jsonl")][1]
+assert rec["rock_fold_theta_bar_deg"] > 0 and float(meta["navcam:boulder_min_m"]) == rec["boulder_min_m"] > 0, rec
+assert meta["navcam:rock_fold_theta_bar_deg"] == "asteroid=%.6g" % rec["rock_fold_theta_bar_deg"], meta
+PY
 
 # 2. Every rejection reason, sent on purpose over UDP, is counted; serving goes on.
 start reject 2 --set serve.mode=lockstep
