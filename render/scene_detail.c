@@ -166,8 +166,9 @@ static int boulders_from_config(struct nc_cfg_node *item, struct nc_body *b, int
         return rc;
     if (rc) {
         if (!(burial[0] >= 0 && burial[1] >= burial[0] && burial[1] <= 1))
-            return nc_cfg_key_error(map, "burial", "expected [min, max] buried fractions of the extent along the normal, "
-                                                   "0 <= min <= max <= 1");
+            return nc_cfg_key_error(map, "burial",
+                                    "expected [min, max] buried fractions of the extent along the normal, "
+                                    "0 <= min <= max <= 1");
         p.burial_min = burial[0], p.burial_max = burial[1];
     }
     if ((rc = nc_cfg_int(map, "shapes", 1, NC_ROCK_SHAPES_MAX, &v)) < 0)

@@ -124,7 +124,8 @@ def png_meta(path):
             if t == b"zTXt":
                 meta[k.decode()] = zlib.decompress(r[1:]).decode("latin1")
             else:
-                comp, r = r[0], r[2:]; r = r.split(b"\0", 2)[2]; meta[k.decode()] = (zlib.decompress(r) if comp else r).decode()
+                comp, r = r[0], r[2:]; r = r.split(b"\0", 2)[2]
+                meta[k.decode()] = (zlib.decompress(r) if comp else r).decode()
     return meta
 meta = png_meta(sys.argv[1] + "/frame_000003.png")
 rec = [json.loads(l) for l in open(sys.argv[1] + "/frames.jsonl")][3]
