@@ -185,6 +185,7 @@ void nc__serve_lockstep(struct nc__emu *e, const struct nc_pose_msg *m, int clie
                         .ready_mono_ns = mono, .sequence = m->sequence, .client = client, .client_gen = gen,
                         .source = "lockstep", .exposure_s = a.exposure_s, .gain_db = a.gain_db, .has_pose = 1};
     nc_pose_from_msg(m, &j.pose);
+    nc_scene_pose_body(&e->scene, &j.pose);
     if (m->flags & NC_MSG_EXPOSURE)
         j.exposure_s = m->exposure_s;
     if (m->flags & NC_MSG_GAIN)

@@ -68,6 +68,7 @@ static void handle_message(struct nc__emu *e, const uint8_t *buf, size_t len, in
     if (m.type == NC_MSG_POSE) {
         struct nc_pose p;
         nc_pose_from_msg(&m, &p);
+        nc_scene_pose_body(&e->scene, &p);
         pthread_mutex_lock(&e->tl_lock);
         r = nc_timeline_push(&e->tl, &p);
         if (r == NC_REJECT_NONE) {

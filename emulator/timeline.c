@@ -166,6 +166,6 @@ enum nc_pose_quality nc_timeline_at(const struct nc_timeline *tl, int64_t t, str
     out->body_angular_velocity_rad_s = lerp(a->body_angular_velocity_rad_s, b->body_angular_velocity_rad_s, s);
     if (a->sun_is_position == b->sun_is_position)
         out->sun = a->sun_is_position ? lerp(a->sun, b->sun, s) : dir_slerp(a->sun, b->sun, s);
-    out->has_body = a->has_body && b->has_body;
+    out->has_body = a->has_body || b->has_body; /* the body as configured where a pose gave none */
     return NC_POSE_INTERPOLATED;
 }

@@ -158,5 +158,9 @@ void nc_scene_sun_at(const struct nc_scene *s, struct nc_vec3 p, struct nc_vec3 
  * (scene_pose.c). A pose's Sun position keeps the configured irradiance law. */
 void nc_scene_pose(const struct nc_scene *s, int64_t t_ns, struct nc_pose *p);
 void nc_scene_apply_pose(struct nc_scene *s, const struct nc_pose *p);
+/* A pose that carries no body pose (has_body 0: a message without
+ * BODY_POSE) given bodies[0]'s configured position and attitude, so that
+ * it interpolates with and records the pose the frame uses. */
+void nc_scene_pose_body(const struct nc_scene *s, struct nc_pose *p);
 
 #endif

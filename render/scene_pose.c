@@ -19,6 +19,14 @@ void nc_scene_pose(const struct nc_scene *s, int64_t t_ns, struct nc_pose *p)
                           .body_angular_velocity_rad_s = s->body[0].angular_velocity_rad_s};
 }
 
+void nc_scene_pose_body(const struct nc_scene *s, struct nc_pose *p)
+{
+    if (!p->has_body) {
+        p->body_position_m = s->body[0].position_m;
+        p->body_attitude_q = s->body[0].attitude_q;
+    }
+}
+
 void nc_scene_apply_pose(struct nc_scene *s, const struct nc_pose *p)
 {
     s->camera.position_m = p->cam_position_m;

@@ -81,13 +81,18 @@ stop
 # records say so, and the log warns once when it begins and once when it ends.
 printf '0,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n1,0,-20,0,0.70710678,-0.70710678,0,0,1,0,0\n' > "$tmp/inside.csv"
 printf '2,0,-3000,0,0.70710678,-0.70710678,0,0,1,0,0\n' >> "$tmp/inside.csv"
-start inside 14 --set serve.mode=lockstep
+start inside 14 --set serve.mode=lockstep --set 'bodies.0.position_m=[0, 0, 5]'
 "$navcam" replay "$tmp/inside.csv" --lockstep --port "$tcp" > "$tmp/inside/replay.out" 2>&1 && ok \
   || bad "replay inside.csv: $(cat "$tmp/inside/replay.out")"
 stop
 [ "$(grep -c '"inside": {"warning": "camera inside a body?"' "$tmp/inside/frames/frames.jsonl")" = 2 ] \
   && [ "$(sed -n 3p "$tmp/inside/frames/frames.jsonl" | grep -c inside)" = 0 ] && ok \
   || bad "inside: frame records: $(cut -c1-300 "$tmp/inside/frames/frames.jsonl")"
+# replay sends no BODY_POSE: each record gives the body pose the frame used, the configured one (an outside
+# client found [0, 0, 0] recorded)
+[ "$(grep -c '"body": false, "body_position_m": \[0, 0, 5\], "body_attitude_q": \[1, 0, 0, 0\]' \
+     "$tmp/inside/frames/frames.jsonl")" = 3 ] && ok \
+  || bad "inside: body pose: $(head -c 600 "$tmp/inside/frames/frames.jsonl")"
 [ "$(grep -c 'met its back, inner side' "$tmp/inside/serve.log")" = 1 ] \
   && [ "$(grep -c 'no longer meet back sides' "$tmp/inside/serve.log")" = 1 ] && ok \
   || bad "inside: log: $(cat "$tmp/inside/serve.log")"

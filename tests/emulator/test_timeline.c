@@ -107,5 +107,27 @@ int main(void)
     }
     CHECK(worst_s < 1e-12, "Sun directions of unequal lengths: worst error %.3g rad", worst_s);
     nc_timeline_free(&tl);
+    /* A pose without BODY_POSE stands for the configured body pose (nc_scene_pose_body): between a pose with
+     * the body 3 km off and one without, the body moves from there to the configured place, and the result
+     * says a body pose took part (an outside client found the record interpolated toward [0, 0, 0] while the
+     * configured pose was rendered) */
+    struct nc_scene sc = {.nbodies = 1};
+    sc.body[0].position_m = nc_v3(100, 0, 0), sc.body[0].attitude_q = (struct nc_quat){0, 0, 0, 1};
+    nc_timeline_init(&tl, 4, 0);
+    struct nc_pose b0 = truth(0), b1 = truth(1);
+    b0.has_body = 1, b0.body_position_m = nc_v3(3000, 0, 0), b0.body_attitude_q = (struct nc_quat){1, 0, 0, 0};
+    nc_scene_pose_body(&sc, &b0);
+    nc_scene_pose_body(&sc, &b1);
+    CHECK(b0.body_position_m.x == 3000 && b1.body_position_m.x == 100 && b1.body_attitude_q.z == 1 && !b1.has_body,
+          "the configured body pose filled in only where none was sent");
+    nc_timeline_push(&tl, &b0);
+    nc_timeline_push(&tl, &b1);
+    nc_timeline_at(&tl, 500000000, &out, NULL);
+    CHECK(out.has_body && out.body_position_m.x == 1550 && fabs(qdiff(out.body_attitude_q, (struct nc_quat){
+                                                                    cos(M_PI / 4), 0, 0, sin(M_PI / 4)})) < 1e-12,
+          "half way to the configured body pose: %g m, has_body %d", out.body_position_m.x, out.has_body);
+    nc_timeline_at(&tl, 1000000000, &out, NULL);
+    CHECK(!out.has_body && out.body_position_m.x == 100, "at the pose without a body: the configured one");
+    nc_timeline_free(&tl);
     return nc_test_end();
 }
