@@ -71,12 +71,41 @@ static inline float poisson_inversion(double lambda, double p0, double u)
     return (float)k;
 }
 
+/* Charge q along the segment from (x, y) (pixel units, pixel (i, j) the
+ * square [i, i + 1) x [j, j + 1)) at angle a, len long, into the pixels of
+ * the W x H image e in proportion to the length inside each (all of it in
+ * the first pixel if len is 0); what runs off the image is lost. The
+ * pixels crossed in turn, each boundary where the segment meets it. */
+static void track(double x, double y, double a, double len, double q, int W, int H, double *e)
+{
+    const double dx = cos(a), dy = sin(a);
+    int i = (int)floor(x), j = (int)floor(y);
+    const int si = dx > 0 ? 1 : -1, sj = dy > 0 ? 1 : -1;
+    /* distances along the track to the next column and row boundary, and between boundaries */
+    const double di = dx != 0 ? 1 / fabs(dx) : INFINITY, dj = dy != 0 ? 1 / fabs(dy) : INFINITY;
+    double ti = dx != 0 ? ((dx > 0 ? i + 1 - x : x - i) * di) : INFINITY,
+           tj = dy != 0 ? ((dy > 0 ? j + 1 - y : y - j) * dj) : INFINITY, t = 0;
+    for (int n = 0; n < 1 << 20; n++) {
+        const double next = fmin(fmin(ti, tj), len);
+        const double share = len > 0 ? q * (next - t) / len : q;
+        if (i >= 0 && i < W && j >= 0 && j < H)
+            e[(size_t)j * W + i] += share;
+        if (!(next < len))
+            break;
+        t = next;
+        if (ti <= tj)
+            i += si, ti += di;
+        else
+            j += sj, tj += dj;
+    }
+}
+
 /* Cosmic-ray charge for this frame, added into e (keyed by seed and frame). */
 static void cosmic_rays(const struct nc_camsys *cs, double exposure_s, uint64_t frame, double *e)
 {
     const struct nc_sensor *s = &cs->sensor;
     const int W = cs->width_px, H = cs->height_px;
-    double area_cm2 = W * H * s->pixel_pitch_m * s->pixel_pitch_m * 1e4;
+    double area_cm2 = W * H * cs->pixel_area_m2 * 1e4;
     double mean = s->cosmic_rate_cm2_s * area_cm2 * exposure_s, u[4];
     nc_rng4(s->seed, NC_RNG_COSMIC, frame, 0xffffffffu, 0, u);
     /* Number of hits: Poisson by inversion in blocks of uniforms. */
@@ -97,17 +126,11 @@ static void cosmic_rays(const struct nc_camsys *cs, double exposure_s, uint64_t 
     }
     for (long h = 0; h < hits; h++) {
         nc_rng4(s->seed, NC_RNG_COSMIC, frame, (uint32_t)h, 1, u);
-        double x = u[0] * W, y = u[1] * H, a = 2 * M_PI * u[2], len = -s->cosmic_track_px * log(u[3]);
-        /* Charge per pixel of projected track; a track shorter than a pixel
-         * (near-normal incidence) still crosses the whole depth of one. */
-        int steps = (int)ceil(len / 0.5) + 1;
-        double q = s->cosmic_e_per_px * (len > 1.0 ? len : 1.0) / steps;
-        for (int k = 0; k < steps; k++) {
-            double t = steps > 1 ? (double)k / (steps - 1) : 0.0;
-            int px = (int)floor(x + t * len * cos(a)), py = (int)floor(y + t * len * sin(a));
-            if (px >= 0 && px < W && py >= 0 && py < H)
-                e[(size_t)py * W + px] += q;
-        }
+        const double len = -s->cosmic_track_px * log(u[3]);
+        /* e_per_px per pixel of projected track (a track shorter than a
+         * pixel, near-normal incidence, still crosses the whole depth of
+         * one), each pixel's share the length of track inside it */
+        track(u[0] * W, u[1] * H, 2 * M_PI * u[2], len, s->cosmic_e_per_px * (len > 1.0 ? len : 1.0), W, H, e);
     }
 }
 

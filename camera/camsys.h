@@ -77,6 +77,7 @@ struct nc_camsys {
     struct nc_optics optics;
     struct nc_sensor sensor;
     int width_px, height_px;     /* the sensor */
+    double pixel_area_m2;        /* a pixel's area on the sensor: pitch^2 fx / fy (f / fy tall) */
     /* The radiance image the renderer draws for it: margin_px (the PSF's half
      * width) more on every side, so light from just outside the field
      * reaches the edge pixels as through a real lens. */

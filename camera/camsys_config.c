@@ -181,7 +181,7 @@ static int optics_from_config(struct nc_cfg_node *m, double focal_length_m, stru
             return nc_cfg_error(vig, "expected none, cos4, or a table [[field_angle_deg, factor], ...]");
         o->vignetting = k == 0 ? NC_VIGNETTING_NONE : NC_VIGNETTING_COS4;
     } else if (vig) {
-        if (vig->kind != NC_CFG_SEQ || vig->nchild < 2)
+        if (vig->kind != NC_CFG_SEQ || vig->nchild < 1) /* one row: a constant factor */
             return nc_cfg_error(vig, "expected none, cos4, or a table [[field_angle_deg, factor], ...]");
         o->vignetting = NC_VIGNETTING_TABLE;
         o->nvig = (int)vig->nchild;
@@ -428,9 +428,9 @@ int nc_camsys_from_config(struct nc_cfg_node *root, const struct nc_camera *geom
     /* Camera equation for an object at infinity: focal-plane irradiance
      * E = L tau pi / (4 N^2) V(theta); electrons/s = QE E A_pix lambda/(h c).
      * The pitch is along x (f / fx); a pixel is f / fy tall: A_pix = pitch^2 fx / fy. */
+    cs->pixel_area_m2 = s->pixel_pitch_m * s->pixel_pitch_m * (geom->fx_px / geom->fy_px);
     double k = s->qe * o->band_fraction * o->transmission * M_PI / (4.0 * o->f_number * o->f_number) *
-               s->pixel_pitch_m * s->pixel_pitch_m * (geom->fx_px / geom->fy_px) * o->wavelength_m /
-               (NC_PLANCK_J_S * NC_LIGHT_M_S);
+               cs->pixel_area_m2 * o->wavelength_m / (NC_PLANCK_J_S * NC_LIGHT_M_S);
     /* Dark current doubles every dark_doubling_k: the mean, the per-pixel
      * non-uniformity and the hot pixels alike (the pattern is the sensor's,
      * its scale the temperature's). DSNU is a log-normal factor of mean 1 and
