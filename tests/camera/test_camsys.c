@@ -455,8 +455,8 @@ static void cosmic_ray_tracks(void)
     }
     printf("cosmic-ray tracks: %ld pixels hit, %.1f %% under 300 e-, %.2f %% over 1415 e-\n", lit,
            100.0 * low / fmax(1, lit), 100.0 * high / fmax(1, lit));
-    CHECK(lit > 5000 && low > 0.05 * lit && high < 0.005 * lit, "charge by length: %ld hit, %ld under 300, %ld over 1415",
-          lit, low, high);
+    CHECK(lit > 5000 && low > 0.05 * lit && high < 0.005 * lit,
+          "charge by length: %ld hit, %ld under 300, %ld over 1415", lit, low, high);
     nc_camsys_free(&cs);
 }
 
