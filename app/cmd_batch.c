@@ -488,6 +488,7 @@ int main(int argc, char **argv)
             skipped++;
             continue;
         }
+        nc_fs_drop_temporaries(dir, stem); /* what a crash left of the row, some with its process's id */
         rc = batch_row(&r, &base, &cs, &sky, &rows[i], i, dir, stem, ext, q, exposure, geometry, geom, rock);
         unlock_row(lock, fd, rc >= 0);
         if (rc < 0) { /* named, and the other rows go on: ten failures in a row stop the shard */

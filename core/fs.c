@@ -1,6 +1,7 @@
 /* fs.c - directories and files that must survive a crash (fs.h). */
 #include "core/fs.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -70,4 +71,23 @@ int nc_commit_file(const char *tmp, const char *path)
     else
         *slash = '\0';
     return sync_path(dir);
+}
+
+int nc_fs_drop_temporaries(const char *dir, const char *stem)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0;
+    const size_t n = strlen(stem);
+    int dropped = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        const char *name = e->d_name, *p = name + (name[0] == '.') + (name[0] == '.' && name[1] == '.');
+        if (p == name || strncmp(p, stem, n) || (p[n] != '.' && p[n] != '_') || !strstr(p + n, ".tmp"))
+            continue;
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s", dir, name);
+        dropped += unlink(path) == 0;
+    }
+    closedir(d);
+    return dropped;
 }

@@ -20,4 +20,10 @@ int nc_fs_replaceable(const char *path);
  * -errno with a message naming the file. */
 int nc_commit_file(const char *tmp, const char *path);
 
+/* Remove the temporaries a crash may have left of the files named stem in
+ * dir: a hidden name (one dot or two: a temporary's own temporary) made of
+ * stem, then '.' or '_', holding ".tmp" ("DIR/.frame_000005.tmp.fits",
+ * "DIR/..frame_000005.tmp.4242.tmp.fits"). How many; errors are ignored. */
+int nc_fs_drop_temporaries(const char *dir, const char *stem);
+
 #endif

@@ -467,8 +467,18 @@ double nc_scene_boulder_min_px(const struct nc_scene *s, int b)
     return s->render.boulder_fold && nc_material_roughness_param(&s->body[b].material) >= 0 ? 1.0 : 0.0;
 }
 
+static double sun_radius(double d) { return d > NC_SUN_RADIUS_M ? asin(NC_SUN_RADIUS_M / d) : M_PI / 2; }
+
 double nc_scene_sun_radius_rad(const struct nc_scene *s)
 {
-    double d = s->sun.has_position ? nc_v3_norm(s->sun.position_m) : s->sun.distance_m;
-    return d > NC_SUN_RADIUS_M ? asin(NC_SUN_RADIUS_M / d) : M_PI / 2;
+    return sun_radius(s->sun.has_position ? nc_v3_norm(s->sun.position_m) : s->sun.distance_m);
+}
+
+double nc_scene_sun_radius_from(const struct nc_scene *s, struct nc_vec3 p)
+{
+    if (!s->sun.has_position)
+        return sun_radius(s->sun.distance_m);
+    const struct nc_body *b0 = &s->body[0]; /* the position is in its frame, from its origin */
+    const struct nc_vec3 sun = nc_v3_add(nc_quat_rotate(b0->attitude_q, s->sun.position_m), b0->position_m);
+    return sun_radius(nc_v3_norm(nc_v3_sub(sun, p)));
 }

@@ -136,8 +136,11 @@ int nc__scene_error_at(const struct nc_cfg_node *n);
  * dry: their keys alone, no image read. */
 int nc__scene_dem_from_config(struct nc_cfg_node *shape, int globe, struct nc_body *b, int dry);
 
-/* The Sun's angular radius seen from bodies[0], radians. */
+/* The Sun's angular radius seen from bodies[0] (the penumbrae on the
+ * bodies), and from scene point p, radians (sun.distance_m away for a Sun
+ * given by its direction). */
 double nc_scene_sun_radius_rad(const struct nc_scene *s);
+double nc_scene_sun_radius_from(const struct nc_scene *s, struct nc_vec3 p);
 
 /* The boulder cut of body b in pixels (render.boulder_min_px resolved). */
 double nc_scene_boulder_min_px(const struct nc_scene *s, int b);

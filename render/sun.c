@@ -80,7 +80,7 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
     struct nc_vec3 sun;
     double irr;
     nc_scene_sun_at(s, c->position_m, &sun, &irr);
-    const double theta = nc_scene_sun_radius_rad(s);
+    const double theta = nc_scene_sun_radius_from(s, c->position_m); /* seen from the camera */
     const struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(c->attitude_q), sun); /* camera frame */
     const double off = acos(fmax(-1, fmin(1, d.z)));
     v->off_axis_deg = off * 180 / M_PI;

@@ -476,5 +476,37 @@ int main(void)
         nc_renderer_free(&rs);
         nc_scene_free(&sc);
     }
+    /* A Sun given by its position (from bodies[0], in its frame: 1.8e9 m away) 0.02 au from the camera: its
+     * disk as seen from the camera (13.4 deg in radius; it was sized from bodies[0], 22.7 deg, and too dim, as
+     * an outside check found) */
+    {
+        const char *sets[] = {"sun={position_m: [-1e9, 0, 1.495978707e9]}", "camera.position_m=[0, 0, -1.495978707e9]",
+                              "bodies.0.position_m=[1e9, 0, 0]", "camera.fx_px=100", "camera.fy_px=100"};
+        struct nc_scene sc;
+        nc_test_scene("bodies:\n  - shape: {type: sphere, radius_m: 200}\n    material: {model: lambert, A: 0.1}\n"
+                      "sun: {direction: [0, 0, 1]}\n"
+                      "camera: {width_px: 128, height_px: 128, fx_px: 2000, fy_px: 2000, position_m: [0, 0, 0],\n"
+                      "         attitude_q: [1, 0, 0, 0]}\n",
+                      sets, 5, &sc);
+        struct nc_renderer rs;
+        struct nc_frame fs;
+        struct nc_sun_view sv;
+        nc_renderer_init(&rs, &sc, 2);
+        nc_frame_alloc(&fs, 128, 128);
+        memset(fs.radiance, 0, 128 * 128 * sizeof *fs.radiance);
+        CHECK(nc_render_sun(&rs, &sc, NC_SUN_NEAR_DEG, &fs, &sv) == 0, "sun: %s", nc_errmsg());
+        struct nc_vec3 sd;
+        double irr;
+        nc_scene_sun_at(&sc, sc.camera.position_m, &sd, &irr);
+        const double th = asin(6.957e8 / 2.991957414e9), disk = irr / (M_PI * sin(th) * sin(th));
+        const double centre = fs.radiance[64 * 128 + 64];
+        printf("a Sun 0.02 au from the camera, given by its position: radiance %.6g (E / (pi sin^2 theta) %.6g, "
+               "theta %.4f deg), drawn %.5f of its irradiance\n", centre, disk, th * 180 / M_PI, sv.drawn_w_m2 / irr);
+        CHECK(fabs(centre / disk - 1) < 1e-6 && fabs(sv.drawn_w_m2 / irr - 1) < 0.005,
+              "a Sun given by its position: radiance %.6g, want %.6g", centre, disk);
+        nc_frame_free(&fs);
+        nc_renderer_free(&rs);
+        nc_scene_free(&sc);
+    }
     return nc_test_end();
 }

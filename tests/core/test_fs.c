@@ -55,5 +55,26 @@ int main(void)
     nc_test_write(tmp, "again");
     CHECK(nc_commit_file(tmp, a) == -EEXIST && stat(tmp, &st) == 0 && is_dir(a), "commit over a directory: %s",
           nc_errmsg());
+
+    /* a row's temporaries dropped, and nothing else: its files, its lock, other rows' */
+    static const char *const drop[] = {".frame_000005.tmp.fits", "..frame_000005.tmp.4242.tmp.fits",
+                                       ".frame_000005_geometry.tmp.fits", ".frame_000005.json.tmp"};
+    static const char *const keep[] = {"frame_000005.fits", ".frame_000005.lock", ".frame_0000050.tmp.fits",
+                                       ".frame_000006.tmp.fits", "frame_000005.tmp.fits"};
+    char d[600], p[700];
+    snprintf(d, sizeof d, "%s/rows", nc_test_tmp());
+    CHECK(nc_mkdirs(d) == 0, "mkdirs %s", d);
+    for (int i = 0; i < 9; i++) {
+        snprintf(p, sizeof p, "%s/%s", d, i < 4 ? drop[i] : keep[i - 4]);
+        nc_test_write(p, "x");
+    }
+    const int n = nc_fs_drop_temporaries(d, "frame_000005");
+    int kept = 0, gone = 0;
+    for (int i = 0; i < 9; i++) {
+        snprintf(p, sizeof p, "%s/%s", d, i < 4 ? drop[i] : keep[i - 4]);
+        *(i < 4 ? &gone : &kept) += (stat(p, &st) == 0) == (i >= 4);
+    }
+    CHECK(n == 4 && gone == 4 && kept == 5, "a row's temporaries: %d dropped, %d of 4 gone, %d of 5 kept", n, gone,
+          kept);
     return nc_test_end();
 }
