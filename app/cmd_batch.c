@@ -9,8 +9,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <fcntl.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include "app/cli.h"
@@ -65,32 +63,6 @@ static const char batch_help[] =
     "  -j, --threads N       render threads, 0..1024 (default: render.threads, else all\n"
     "                        cores; 0: all cores)\n"
     "  -h, --help            this help\n";
-
-/* Row stem's lock (DIR/.STEM.lock, flock; its path into lock): held while
- * the row is rendered, so that two processes given the same rows (a shard
- * submitted again while it still runs) never write the same temporary
- * files; the other skips the row. 1 with *fd held, 0 if another process
- * holds it, < 0 on error. */
-static int lock_row(const char *dir, const char *stem, char *lock, size_t len, int *fd)
-{
-    snprintf(lock, len, "%s/.%s.lock", dir, stem);
-    if ((*fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0666)) < 0)
-        return nc_error(-errno, "%s: %s", lock, strerror(errno));
-    if (flock(*fd, LOCK_EX | LOCK_NB) == 0)
-        return 1;
-    const int err = errno;
-    close(*fd);
-    return err == EWOULDBLOCK ? 0 : nc_error(-err, "%s: flock: %s", lock, strerror(err));
-}
-
-/* Released; the file removed once the row is done (its JSON in place:
- * nobody renders it again). */
-static void unlock_row(const char *lock, int fd, int done)
-{
-    if (done)
-        unlink(lock);
-    close(fd);
-}
 
 /* A text file DIR/NAME: opened as DIR/.NAME.tmp (tmp holds that path) ... */
 static int begin(const char *dir, const char *name, char *tmp, size_t len, FILE **f)
@@ -477,20 +449,24 @@ int main(int argc, char **argv)
             skipped++;
             continue;
         }
-        if ((rc = lock_row(dir, stem, lock, sizeof lock, &fd)) <= 0) {
+        /* held while the row is rendered (DIR/.STEM.lock), so that two processes given the same rows (a shard
+         * submitted again while it still runs) never write the same temporary files; the other skips the row */
+        snprintf(lock, sizeof lock, "%s/.%s.lock", dir, stem);
+        if ((rc = nc_fs_lock(lock, &fd)) <= 0) {
             busy += rc == 0;
             if (rc < 0)
                 break;
             continue;
         }
         if (access(path, F_OK) == 0) { /* finished by another process while we took the lock: done */
-            unlock_row(lock, fd, 1);
+            nc_fs_unlock(lock, fd, 1);
             skipped++;
             continue;
         }
-        nc_fs_drop_temporaries(dir, stem); /* what a crash left of the row, some with its process's id */
+        if (rc == 2) /* what a crash or a failure left of the row, some named by its process's id */
+            nc_fs_drop_temporaries(dir, stem);
         rc = batch_row(&r, &base, &cs, &sky, &rows[i], i, dir, stem, ext, q, exposure, geometry, geom, rock);
-        unlock_row(lock, fd, rc >= 0);
+        nc_fs_unlock(lock, fd, rc >= 0); /* the file removed once the row is done: nobody renders it again */
         if (rc < 0) { /* named, and the other rows go on: ten failures in a row stop the shard */
             fprintf(stderr, "navcam batch: row %ld (line %d): %s\n", i, rows[i].line, nc_errmsg());
             rc = ++failed_run < 10 ? 0 : nc_error(rc, "stopped: ten rows in a row failed");

@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -90,4 +91,24 @@ int nc_fs_drop_temporaries(const char *dir, const char *stem)
     }
     closedir(d);
     return dropped;
+}
+
+int nc_fs_lock(const char *path, int *fd)
+{
+    struct stat st;
+    const int stale = stat(path, &st) == 0;
+    if ((*fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666)) < 0)
+        return nc_error(-errno, "%s: %s", path, strerror(errno));
+    if (flock(*fd, LOCK_EX | LOCK_NB) == 0)
+        return 1 + stale;
+    const int err = errno;
+    close(*fd);
+    return err == EWOULDBLOCK ? 0 : nc_error(-err, "%s: flock: %s", path, strerror(err));
+}
+
+void nc_fs_unlock(const char *path, int fd, int done)
+{
+    if (done)
+        unlink(path);
+    close(fd);
 }

@@ -20,6 +20,14 @@ int nc_fs_replaceable(const char *path);
  * -errno with a message naming the file. */
 int nc_commit_file(const char *tmp, const char *path);
 
+/* An exclusive lock (flock) on the file path, made if missing: 1 with *fd
+ * holding it, 2 the same where the file was there already (a holder that
+ * crashed, or one that let it go without removing it: what it was doing is
+ * unfinished), 0 if another process holds it, < 0 on error. Released by
+ * nc_fs_unlock, which removes the file if done (the work is finished). */
+int nc_fs_lock(const char *path, int *fd);
+void nc_fs_unlock(const char *path, int fd, int done);
+
 /* Remove the temporaries a crash may have left of the files named stem in
  * dir: a hidden name (one dot or two: a temporary's own temporary) made of
  * stem, then '.' or '_', holding ".tmp" ("DIR/.frame_000005.tmp.fits",

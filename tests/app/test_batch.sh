@@ -81,11 +81,12 @@ PY
 for k in 2 0 1; do "$navcam" batch traj.csv -o shards "${scene[@]}" --shard $k/3 -j 1 > /dev/null 2>&1 || fail "shard $k"; done
 diff -r ref shards > /dev/null || fail "3 shards in the order 2, 0, 1 differ from one process: $(diff -rq ref shards | head -3)"
 
-# A crash: frame 5's truth and image gone, half-written temporaries left, the image writer's own named by the
-# crashed process's id (an outside check found those left for good): the rerun gives the reference's bytes
-# and files, nothing more.
+# A crash: frame 5's truth and image gone, its lock file and half-written temporaries left, the image writer's
+# own named by the crashed process's id (an outside check found those left for good): the rerun gives the
+# reference's bytes and files, nothing more.
 cp -r ref crashed
 rm crashed/frame_000005.json crashed/frame_000005.fits
+: > crashed/.frame_000005.lock
 head -c 1000 ref/frame_000005.fits > crashed/.frame_000005.tmp.fits
 head -c 1000 ref/frame_000005.fits > crashed/..frame_000005.tmp.4242.tmp.fits
 echo '{' > crashed/.frame_000005.json.tmp

@@ -76,5 +76,16 @@ int main(void)
     }
     CHECK(n == 4 && gone == 4 && kept == 5, "a row's temporaries: %d dropped, %d of 4 gone, %d of 5 kept", n, gone,
           kept);
+
+    /* a lock: 1 when made, 2 when its file was left by a holder that did not finish, 0 while held */
+    snprintf(p, sizeof p, "%s/.row.lock", d);
+    int fd, fd2;
+    CHECK(nc_fs_lock(p, &fd) == 1, "a new lock");
+    CHECK(nc_fs_lock(p, &fd2) == 0, "a lock held elsewhere");
+    nc_fs_unlock(p, fd, 0); /* unfinished: the file stays */
+    CHECK(nc_fs_lock(p, &fd) == 2, "a lock left unfinished");
+    nc_fs_unlock(p, fd, 1);
+    CHECK(stat(p, &st) < 0 && nc_fs_lock(p, &fd) == 1, "a lock removed when done, then new again");
+    nc_fs_unlock(p, fd, 1);
     return nc_test_end();
 }
