@@ -203,8 +203,11 @@ int main(int argc, char **argv)
         rc = nc_error(-ENOMEM, "out of memory");
         goto done;
     }
-    for (size_t i = 0; i < n; i++)
-        fg[i] = isfinite(real[i]) && real[i] > res.threshold_real && real[i] > 0 && isfinite(moved[i]);
+    for (size_t i = 0; i < n; i++) { /* a pixel missing in either is missing in both (their FAST circles too) */
+        if (!isfinite(real[i]) || !isfinite(moved[i]))
+            real[i] = moved[i] = NAN;
+        fg[i] = isfinite(real[i]) && real[i] >= res.threshold_real && real[i] > 0; /* the error's foreground */
+    }
     struct nc_texture_opts to;
     nc_texture_defaults(&to);
     to.mask = fg;

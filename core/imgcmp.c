@@ -215,6 +215,10 @@ static double pct(const double *v, size_t n, double p)
     return v[k ? k - 1 : 0];
 }
 
+/* The median of sorted v[0..n), n > 0: the middle value, or the mean of
+ * the two middle ones. */
+static double median(const double *v, size_t n) { return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]); }
+
 int nc_imgcmp(const float *real, const float *render, int w, int h, enum nc_imgcmp_fit fit,
               struct nc_imgcmp_result *out, float *rel)
 {
@@ -311,7 +315,7 @@ int nc_imgcmp(const float *real, const float *render, int w, int h, enum nc_imgc
     out->rel_mean = sum / (double)m;
     out->rel_rms = sqrt(sum2 / (double)m);
     out->rel_bias = bias / (double)m;
-    out->rel_median = pct(err, m, 0.5);
+    out->rel_median = median(err, m);
     out->rel_p95 = pct(err, m, 0.95);
     for (int k = 0; k < 5; k++)
         out->ncc[k] = nc_imgcmp_ncc(real, fit_px, fg, w, h, nc_imgcmp_blocks[k]);

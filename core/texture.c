@@ -208,10 +208,10 @@ int nc_texture_measure(const float *img, int w, int h, const struct nc_texture_o
         out->hi = sorted[(size_t)(0.995 * (double)(m - 1) + 0.5)];
     }
     /* LO = HI (99.5 % of the region one value: a star field, a point): LO and below 0, above it 255 */
-    const double k = out->hi > out->lo ? 255.0 / (out->hi - out->lo) : 0.0;
+    const double span = out->hi - out->lo; /* round(255 (v - LO) / (HI - LO)) in that order: halves up */
     for (size_t i = 0; i < n; i++) {
         const double v = !isfinite(img[i]) ? 0.0
-                         : k > 0            ? floor((img[i] - out->lo) * k + 0.5)
+                         : span > 0         ? floor(255.0 * (img[i] - out->lo) / span + 0.5)
                          : img[i] > out->lo ? 255
                                             : 0;
         u8[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);

@@ -432,6 +432,27 @@ assert a['flip_real'] == 'xy' and a['relative_error']['p95'] == 0 and a['limb_io
 assert b['flip_real'] == 'y' and b['relative_error']['p95'] > 0.01, b" "$tmp/flip.json" "$tmp/flip_y.json" &&
   ok || bad "navcam compare --flip-real: $(cat "$tmp/flip.json" "$tmp/flip_y.json")"
 expect 2 "--flip-real expects none, x, y or xy" -- "$navcam" compare a b --flip-real z
+# A pixel missing in one image is missing in both, for the texture too: the render with a block of NaN
+# against itself whole, either way round, gives both images the same texture (an outside check found REAL's
+# pixels read on the FAST circle where RENDER's were missing: 300 corners against 275).
+python3 - "$tmp/real.fits" "$tmp/holed.fits" <<'PY'
+import sys
+d = bytearray(open(sys.argv[1], "rb").read())
+end = next(i for i in range(0, len(d), 80) if d[i:i + 8] == b"END     ")
+start = (end // 2880 + 1) * 2880
+for y in range(30, 60):
+    for x in range(20, 70):
+        o = start + 4 * (96 * y + x)
+        d[o:o + 4] = b"\x7f\xc0\x00\x00"
+open(sys.argv[2], "wb").write(bytes(d))
+PY
+"$navcam" compare "$tmp/real.fits" "$tmp/holed.fits" --fit none > "$tmp/hole1.json" &&
+  "$navcam" compare "$tmp/holed.fits" "$tmp/real.fits" --fit none > "$tmp/hole2.json" &&
+  python3 -c "
+import json, sys; a, b = (json.load(open(f))['texture'] for f in sys.argv[1:])
+t = [a['real'], a['render'], b['real'], b['render']]
+assert len({(x['corners'], x['region_px']) for x in t}) == 1, t" "$tmp/hole1.json" "$tmp/hole2.json" &&
+  ok || bad "navcam compare with missing pixels: $(cat "$tmp/hole1.json" "$tmp/hole2.json")"
 expect 1 "no.SUM: No such file or directory" -- "$navcam" render -o "$tmp/s.fits" --sumfile "$tmp/no.SUM" \
   --set sun.distance_au=1
 # navcam texture: two renders at once (JSON fields, the region, --gsd), and

@@ -80,6 +80,19 @@ int main(void)
     CHECK(fabs(r.rel_bias + 0.63) < 1e-6 && fabs(r.rel_median - 0.63) < 1e-6, "unfitted: bias %g median %g (-0.63)",
           r.rel_bias, r.rel_median);
 
+    /* 40 foreground pixels of errors 0.01 .. 0.40 on black: the median is the mean of the two middle ones,
+     * 0.205 (it was the lower, 0.20: an outside check) */
+    {
+        static float a[16 * 16], b[16 * 16], e[16 * 16];
+        memset(a, 0, sizeof a), memset(b, 0, sizeof b);
+        for (int i = 1; i <= 40; i++)
+            a[i + 60] = 1, b[i + 60] = 1 + 0.01f * (float)i;
+        struct nc_imgcmp_result m;
+        CHECK(nc_imgcmp(a, b, 16, 16, NC_FIT_NONE, &m, e) == 0 && m.foreground_px == 40 &&
+                  fabs(m.rel_median - 0.205) < 1e-6,
+              "an even count's median: %g over %zu pixels, want 0.205", m.rel_median, m.foreground_px);
+    }
+
     /* A real image with 2 % multiplicative noise: e = 1/(1 + 0.02 n) - 1,
      * so E|e| ~ 0.02 sqrt(2/pi) = 0.01596 and p95 |e| ~ 1.96 x 0.02. */
     uint64_t st = 42;
