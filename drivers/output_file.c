@@ -48,18 +48,17 @@ static int pattern_ok(const char *pattern)
     return width <= 2 && !strncmp(p + width, "llu", 3);
 }
 
-static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
+/* The pattern must format exactly one unsigned long long, into a name a
+ * directory can hold for every frame number, of a format this build
+ * writes (its library loaded now, not at the first frame); the FITS row
+ * order only with FITS. Before the scene is built (nc_output_check). */
+static int file_check(struct nc_cfg_node *opts)
 {
-    struct file_out *f = priv;
-    const char *dir = NULL, *pattern = NULL, *sidecar = NULL;
-    int rc;
-    if ((rc = nc_param_string(opts, file_params, "directory", &dir)) < 0 ||
-        (rc = nc_param_string(opts, file_params, "pattern", &pattern)) < 0 ||
-        (rc = nc_param_string(opts, file_params, "sidecar", &sidecar)) < 0 ||
-        (rc = nc_param_enum(opts, file_params, "fits_row_order", &f->bottom_up)) < 0)
+    const char *pattern = NULL;
+    int rc, bottom_up = 0;
+    if ((rc = nc_param_string(opts, file_params, "pattern", &pattern)) < 0 ||
+        (rc = nc_param_enum(opts, file_params, "fits_row_order", &bottom_up)) < 0)
         return rc;
-    /* The pattern must format exactly one unsigned long long, into a name
-     * a directory can hold for every frame number. */
     if (!pattern_ok(pattern) || strchr(pattern, '/'))
         return nc_cfg_key_error(opts, "pattern",
                                 "expected a file name with one %%llu conversion (flags - or 0, a width of at most 99), "
@@ -70,14 +69,28 @@ static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_outpu
     snprintf(probe, sizeof probe, pattern, 0ULL);
     if (!nc_image_format_ok(probe, NULL))
         return nc_cfg_key_error(opts, "pattern", "unsupported image format (use .png, .tif, .fits or .exr)");
-    if (f->bottom_up && !nc_image_is_fits(probe))
+    if (bottom_up && !nc_image_is_fits(probe))
         return nc_cfg_key_error(opts, "fits_row_order", "applies to .fits patterns only (the pattern writes %s)",
                                 probe);
-    if (nc_image_prepare(probe) < 0) { /* now, not at the first frame */
+    if (nc_image_prepare(probe) < 0) {
         char why[4096];
         snprintf(why, sizeof why, "%s", nc_errmsg());
         return nc_cfg_key_error(opts, "pattern", "%s", why);
     }
+    return 0;
+}
+
+/* Its values checked by file_check (nc_output_open). */
+static int file_open(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx)
+{
+    struct file_out *f = priv;
+    const char *dir = NULL, *pattern = NULL, *sidecar = NULL;
+    int rc;
+    if ((rc = nc_param_string(opts, file_params, "directory", &dir)) < 0 ||
+        (rc = nc_param_string(opts, file_params, "pattern", &pattern)) < 0 ||
+        (rc = nc_param_string(opts, file_params, "sidecar", &sidecar)) < 0 ||
+        (rc = nc_param_enum(opts, file_params, "fits_row_order", &f->bottom_up)) < 0)
+        return rc;
     snprintf(f->dir, sizeof f->dir, "%s", dir);
     snprintf(f->pattern, sizeof f->pattern, "%s", pattern);
     if (nc_mkdirs(f->dir) < 0) { /* with every missing parent, as mkdir -p */
@@ -150,6 +163,7 @@ const struct nc_output_driver nc_output_file = {
     .caps = NC_OUTPUT_CAP_DN16,
     .priv_size = sizeof(struct file_out),
     .params = file_params,
+    .check = file_check,
     .open = file_open,
     .submit = file_submit,
     .control = file_control,

@@ -34,21 +34,38 @@ static const struct nc_param timer_params[] = {
     NC_P_END,
 };
 
+/* The period and pulse width of opts (NULL: the defaults): 0, or < 0 if
+ * the pulse is not shorter than the period. Before the scene is built
+ * (nc_trigger_check), and at open. */
+static int timer_times(struct nc_cfg_node *opts, double *rate_hz, int64_t *period_ns, int64_t *width_ns)
+{
+    double width_s = -1;
+    int rc;
+    if ((rc = nc_param_double(opts, timer_params, "rate_hz", rate_hz)) < 0 ||
+        (rc = nc_param_double(opts, timer_params, "pulse_width_s", &width_s)) < 0)
+        return rc;
+    *period_ns = llround(1e9 / *rate_hz);
+    *width_ns = width_s > 0 ? llround(width_s * 1e9) : default_width(*period_ns);
+    if (*width_ns >= *period_ns)
+        return nc_cfg_key_error(opts, "pulse_width_s", "pulse_width_s must be shorter than the period 1/rate_hz = %g s",
+                                *period_ns * 1e-9);
+    return 0;
+}
+
+static int timer_check(struct nc_cfg_node *opts)
+{
+    double rate_hz;
+    int64_t period_ns, width_ns;
+    return timer_times(opts, &rate_hz, &period_ns, &width_ns);
+}
+
 static int timer_open(void *priv, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx)
 {
     struct timer *t = priv;
-    double rate_hz = 0, width_s = -1;
-    int rc;
-    if ((rc = nc_param_double(opts, timer_params, "rate_hz", &rate_hz)) < 0 ||
-        (rc = nc_param_double(opts, timer_params, "pulse_width_s", &width_s)) < 0)
+    int rc = timer_times(opts, &t->rate_hz, &t->period_ns, &t->width_ns);
+    if (rc < 0)
         return rc;
     t->ctx = *ctx;
-    t->rate_hz = rate_hz;
-    t->period_ns = llround(1e9 / rate_hz);
-    t->width_ns = width_s > 0 ? llround(width_s * 1e9) : default_width(t->period_ns);
-    if (t->width_ns >= t->period_ns)
-        return nc_cfg_key_error(opts, "pulse_width_s", "pulse_width_s must be shorter than the period 1/rate_hz = %g s",
-                                t->period_ns * 1e-9);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
@@ -151,6 +168,7 @@ const struct nc_trigger_driver nc_trigger_timer = {
     .caps = NC_TRIGGER_CAP_LINE,
     .priv_size = sizeof(struct timer),
     .params = timer_params,
+    .check = timer_check,
     .open = timer_open,
     .start = timer_start,
     .stop = timer_stop,

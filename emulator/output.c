@@ -22,7 +22,9 @@ int nc_output_check(const struct nc_output_driver *drv, struct nc_cfg_node *opts
     snprintf(what, sizeof what, "output driver '%s'", drv->name);
     const struct nc_param *const tables[] = {common_params, drv->params};
     int rc = nc_params_check(opts, tables, 2, what);
-    return rc < 0 ? rc : nc_params_values(opts, tables, 2);
+    if (rc >= 0)
+        rc = nc_params_values(opts, tables, 2);
+    return rc < 0 || !drv->check ? rc : drv->check(opts);
 }
 
 int nc_output_open(struct nc_output *o, const struct nc_output_driver *drv, struct nc_cfg_node *opts,

@@ -100,6 +100,10 @@ struct nc_output_driver {
     unsigned caps;
     size_t priv_size;
     const struct nc_param *params; /* the keys of the driver's map in `outputs:` (besides `driver`) */
+    /* The driver's checks of its values that need no device (a file name's
+     * form, keys that must agree), run with the tables' before the scene is
+     * built (nc_output_check) and again at open; NULL: none. */
+    int (*check)(struct nc_cfg_node *opts);
     /* Options come from the driver's map in `outputs:`, checked against params. */
     int (*open)(void *priv, struct nc_cfg_node *opts, const struct nc_output_ctx *ctx);
     int (*submit)(void *priv, const struct nc_frame_record *r);

@@ -58,7 +58,9 @@ int nc_trigger_check(const struct nc_trigger_driver *drv, struct nc_cfg_node *op
     snprintf(what, sizeof what, "trigger driver '%s'", drv->name);
     const struct nc_param *const tables[] = {nc_trigger_common_params, drv->params};
     int rc = nc_params_check(opts, tables, 2, what);
-    return rc < 0 ? rc : nc_params_values(opts, tables, 2);
+    if (rc >= 0)
+        rc = nc_params_values(opts, tables, 2);
+    return rc < 0 || !drv->check ? rc : drv->check(opts);
 }
 
 int nc_trigger_open(struct nc_trigger *t, const struct nc_trigger_driver *drv, struct nc_cfg_node *opts,

@@ -52,6 +52,10 @@ struct nc_trigger_driver {
     unsigned caps;
     size_t priv_size;
     const struct nc_param *params; /* the driver's own keys in `serve.trigger` */
+    /* Its checks of values that need no device (keys that must agree), run
+     * with the tables' before the scene is built (nc_trigger_check) and
+     * again at open; opts may be NULL; NULL: none. */
+    int (*check)(struct nc_cfg_node *opts);
     /* opts may be NULL (every option at its default). */
     int (*open)(void *priv, struct nc_cfg_node *opts, const struct nc_trigger_ctx *ctx);
     int (*start)(void *priv);

@@ -104,6 +104,16 @@ for s in "camera.widht_px=64" "render.samples=4" "optics.f_numbr=4" "sensor.read
   done
 done
 expect 1 "base is a scene file's key" -- "$navcam" render -o "$tmp/early.fits" --set base=builtin:default
+# An output's or a trigger's values that need no device are checked before the scene too (an outside check
+# found a file pattern and a pulse width reported after the scene was built).
+for s in "outputs=[{driver: file, pattern: 'f_%d.png'}]" "outputs=[{driver: file, pattern: 'f_%llu.jpg'}]" \
+         "outputs=[{driver: file, pattern: 'f_%llu.png', fits_row_order: bottom_up}]" \
+         "serve.trigger={driver: timer, rate_hz: 10, pulse_width_s: 0.2}"; do
+  out=$("$navcam" serve --set serve.mode=trigger --set "$s" 2>&1)
+  case "$out" in *"scene: body"*) bad "serve --set $s built the scene before its error: $out" ;;
+    *"outputs[0].pattern: "* | *"outputs[0].fits_row_order: "* | *"serve.trigger.pulse_width_s: "*) ok ;;
+    *) bad "serve --set $s: $out" ;; esac
+done
 expect 1 "serve.trigger does not apply to lock-step mode" -- "$navcam" serve --set serve.mode=lockstep --set "serve.trigger={driver: timer}"
 expect 1 "serve.trigger.activation" -- "$navcam" serve --set serve.mode=trigger \
   --set "serve.trigger={driver: timer, activation: sideways}"
