@@ -100,13 +100,16 @@ static int fold_time_samples(int k0, int S)
 /* Global shutter: one band of all rows. Rolling: bands of 16 rows; the
  * camera of each row is at that row's own time, the bodies at the band's
  * mid-time (within 8 line times of every row in it): band b's mid-time tc
- * and each row's offset from it, row_dt. */
-static double band_times(const struct nc_exposure *ex, int b, int H, double *row_dt)
+ * and each row's offset from it, row_dt. The rows are read out in the
+ * stored image's order: for a view whose stored image is mirrored top to
+ * bottom (flip_rows, a SUM camera's K22 < 0), from the view's last row up. */
+static double band_times(const struct nc_exposure *ex, int b, int H, int flip_rows, double *row_dt)
 {
+    const double line_s = flip_rows ? -ex->line_time_s : ex->line_time_s;
     int y0 = NC_TILE * b, y1 = NC_TILE * (b + 1) < H ? NC_TILE * (b + 1) : H;
-    double tc = ex->rolling ? (0.5 * (y0 + y1 - 1) - 0.5 * (H - 1)) * ex->line_time_s : 0.0;
+    double tc = ex->rolling ? (0.5 * (y0 + y1 - 1) - 0.5 * (H - 1)) * line_s : 0.0;
     for (int y = 0; y < H; y++)
-        row_dt[y] = ex->rolling ? (y - 0.5 * (H - 1)) * ex->line_time_s - tc : 0.0;
+        row_dt[y] = ex->rolling ? (y - 0.5 * (H - 1)) * line_s - tc : 0.0;
     return tc;
 }
 
@@ -122,7 +125,7 @@ static int rolling_into(struct nc_renderer *r, const struct nc_scene *s, const s
     int rc = 0;
     for (int b = 0; b < bands && rc >= 0; b++) {
         struct nc_scene at;
-        nc_scene_propagate(s, band_times(ex, b, H, row_dt), &at);
+        nc_scene_propagate(s, band_times(ex, b, H, s->camera.flip_rows, row_dt), &at);
         rc = nc_render_rows_timed(r, &at, f, b, b + 1, row_dt, NULL);
     }
     free(row_dt);
@@ -161,7 +164,7 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
     for (int b = 0; b < nb && rc >= 0; b++) {
         int r0 = ex->rolling ? b : 0, r1 = ex->rolling ? b + 1 : bands;
         int y0 = NC_TILE * r0, y1 = NC_TILE * r1 < H ? NC_TILE * r1 : H;
-        double tc = band_times(ex, b, H, row_dt);
+        double tc = band_times(ex, b, H, s->camera.flip_rows, row_dt);
         for (int k = 0; k < K && rc >= 0; k++) {
             struct nc_scene at;
             nc_scene_propagate(s, tc + T * ((k + 0.5) / K - 0.5), &at);

@@ -51,7 +51,9 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
     const double turn_px = nc_v3_norm(c->angular_velocity_rad_s) * exposure_s * fmax(c->fx_px, c->fy_px);
     const int K = turn_px > 0 ? (int)fmin(4096, ceil(turn_px / 0.1)) : 1;
     /* A rolling shutter exposes row y (y - (H - 1) / 2) line_time_s after
-     * the middle row: the camera has turned by then, by up to roll_px. */
+     * the middle row (y of the stored image: the view's rows counted from
+     * its last for a view mirrored top to bottom): the camera has turned by
+     * then, by up to roll_px. */
     const double mid_row = 0.5 * (c->height_px - 1),
                  roll_px = nc_v3_norm(c->angular_velocity_rad_s) * line_time_s * mid_row * fmax(c->fx_px, c->fy_px);
     /* Only the stars the frame can show: projected at mid-exposure within
@@ -93,7 +95,7 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                 const struct nc_quat a = nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, t_row);
                 if (nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), q->dir), &x, &y) < 0)
                     break;
-                t_row = (y - mid_row) * line_time_s;
+                t_row = (y - mid_row) * (c->flip_rows ? -line_time_s : line_time_s); /* the stored image's rows */
             }
             int shown = 0;
             for (int k = 0; k < K; k++) {

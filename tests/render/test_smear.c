@@ -61,6 +61,28 @@ static void render(const struct nc_scene *s, const struct nc_exposure *ex, struc
     nc_renderer_free(&r);
 }
 
+/* The least-squares slope over the rows of each 96-px row's centroid of
+ * signal in f, relative to still's (which cancels the sampling pattern
+ * common to both), px per row. */
+static double shear_px(const struct nc_frame *f, const struct nc_frame *still)
+{
+    double cx[64];
+    for (int y = 0; y < 64; y++) {
+        double m = 0, mx = 0, m0 = 0, mx0 = 0;
+        for (int x = 0; x < 96; x++) {
+            m += f->radiance[y * 96 + x];
+            mx += x * f->radiance[y * 96 + x];
+            m0 += still->radiance[y * 96 + x];
+            mx0 += x * still->radiance[y * 96 + x];
+        }
+        cx[y] = m > 0 && m0 > 0 ? mx / m - mx0 / m0 : NAN;
+    }
+    double sy = 0, sc = 0, syy = 0, syc = 0;
+    for (int y = 0; y < 64; y++)
+        sy += y, sc += cx[y], syy += (double)y * y, syc += y * cx[y];
+    return (64 * syc - sy * sc) / (64 * syy - sy * sy);
+}
+
 int main(void)
 {
     struct nc_scene s;
@@ -145,26 +167,20 @@ int main(void)
     nc_frame_free(&fr);
     s.camera.angular_velocity_rad_s = nc_v3(0, 1.0, 0);
     render(&s, &rs, &fr, &k);
-    /* Centroid of each row's signal, relative to the still bar's (which
-     * cancels the sampling pattern common to both). */
-    double cx[64];
-    for (int y = 0; y < 64; y++) {
-        double m = 0, mx = 0, m0 = 0, mx0 = 0;
-        for (int x = 0; x < 96; x++) {
-            m += fr.radiance[y * 96 + x];
-            mx += x * fr.radiance[y * 96 + x];
-            m0 += fg.radiance[y * 96 + x];
-            mx0 += x * fg.radiance[y * 96 + x];
-        }
-        cx[y] = m > 0 && m0 > 0 ? mx / m - mx0 / m0 : NAN;
-    }
-    /* Least-squares slope of the centroid over all rows. */
-    double sy = 0, sc = 0, syy = 0, syc = 0;
-    for (int y = 0; y < 64; y++)
-        sy += y, sc += cx[y], syy += (double)y * y, syc += y * cx[y];
-    double shear = (64 * syc - sy * sc) / (64 * syy - sy * sy), expect = -1.0 * 1e-4 * 1000;
+    double shear = shear_px(&fr, &fg), expect = -1.0 * 1e-4 * 1000;
     printf("rolling shutter: bar centroid moves %.4f px per row (expected %.4f)\n", shear, expect);
     CHECK(fabs(shear - expect) < 0.02 * fabs(expect), "rolling-shutter shear %.4f px/row, expected %.4f", shear, expect);
+    /* A view whose stored image is mirrored top to bottom (a SUM camera's K22 < 0) is read out in the stored
+     * image's order, from the view's last row: the view shears the other way (it was timed by the view's rows,
+     * as an outside check found) */
+    nc_frame_free(&fr);
+    s.camera.flip_rows = 1;
+    render(&s, &rs, &fr, &k);
+    shear = shear_px(&fr, &fg);
+    printf("rolling shutter, the stored image mirrored: the view's bar moves %.4f px per row (expected %.4f)\n",
+           shear, -expect);
+    CHECK(fabs(shear + expect) < 0.02 * fabs(expect), "mirrored rows' shear %.4f px/row, expected %.4f", shear,
+          -expect);
     nc_frame_free(&fg);
     nc_frame_free(&fr);
     nc_scene_free(&s);
