@@ -151,9 +151,10 @@ static void metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_BY
     nc_le_put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
     nc_le_put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
     const struct nc_pose *p = &r->pose;
+    const struct nc_vec3 sun = p->sun_is_position ? p->sun : nc_v3_unit(p->sun); /* as the JSON record has it */
     const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
-                          p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, p->sun.x,
-                          p->sun.y,            p->sun.z};
+                          p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, sun.x,
+                          sun.y,               sun.z};
     for (int i = 0; i < 10; i++)
         nc_le_put_f64(m + 72 + 8 * i, v[i]);
     m[152] = (uint8_t)p->sun_is_position;

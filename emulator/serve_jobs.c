@@ -279,7 +279,8 @@ static int control_set(void *emu, const struct nc_acquisition *a)
     int rc = 0;
     if (e->mode == NC__MODE_LOCKSTEP &&
         (a->triggered != old.triggered || a->source != old.source || a->frame_rate_hz != old.frame_rate_hz))
-        rc = nc_error(NC_EUNSUPPORTED, "lock-step mode: frames follow the poses; only exposure and gain can change");
+        rc = nc_error(NC_EUNSUPPORTED, "lock-step mode: frames follow the poses; the trigger mode, source and frame "
+                                       "rate cannot change (exposure, gain, trigger activation and delay can)");
     if (rc >= 0 && a->frame_rate_hz != old.frame_rate_hz && e->have_freerun)
         rc = nc_trigger_control(&e->freerun, "rate_hz", (void *)&a->frame_rate_hz);
     if (rc >= 0) {

@@ -7,9 +7,11 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "core/le.h"
+#include "emulator/output.h"
+#include "emulator/timeline.h"
 #include "render/scene.h"
 #include "testutil.h"
-#include "emulator/timeline.h"
 
 static const struct nc_vec3 V = {12.5, -3.0, 0.75}, W_AXIS = {0.267261241912424, 0.534522483824849, 0.801783725737273};
 static const double OMEGA = 0.3; /* rad/s */
@@ -129,5 +131,16 @@ int main(void)
     nc_timeline_at(&tl, 1000000000, &out, NULL);
     CHECK(!out.has_body && out.body_position_m.x == 100, "at the pose without a body: the configured one");
     nc_timeline_free(&tl);
+    /* The metadata row (GigE, V4L2) gives the Sun as the record does: a direction made a unit vector, a
+     * position as it is (the row held the vector as sent, (3, -4, 0), as an outside check found) */
+    for (int pos = 0; pos < 2; pos++) {
+        struct nc_frame_record rec = {.pose = truth(0)};
+        rec.pose.sun = nc_v3(3, -4, 0), rec.pose.sun_is_position = pos;
+        uint8_t row[NC_FRAME_META_BYTES];
+        nc_frame_metadata_row(&rec, row, sizeof row);
+        const double sx = nc_le_get_f64(row + 128), sy = nc_le_get_f64(row + 136);
+        CHECK(pos ? sx == 3 && sy == -4 : fabs(sx - 0.6) < 1e-15 && fabs(sy + 0.8) < 1e-15,
+              "the metadata row's Sun %s: (%g, %g)", pos ? "position" : "direction", sx, sy);
+    }
     return nc_test_end();
 }
