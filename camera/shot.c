@@ -224,8 +224,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     struct nc_sun_view *sv = &info->sun;
     if (rc >= 0 && (rc = nc_render_sun(r, &drawn, NC_SUN_NEAR_DEG, &f, sv)) >= 0) {
         nc_sun_view_warning(sv, info->sun_warning, sizeof info->sun_warning);
-        snprintf(suninfo, sizeof suninfo, "off_axis_deg=%.4f edge_deg=%.4f in_field=%d hidden=%d%s%s", sv->off_axis_deg,
-                 sv->edge_deg, sv->in_field, sv->hidden, info->sun_warning[0] ? " warning=" : "", info->sun_warning);
+        nc_sun_view_text(sv, suninfo, sizeof suninfo); /* "" when the Sun is neither in nor near the field */
     }
     double t2 = now_ms();
     info->render_ms = ts0 - t1;

@@ -89,7 +89,7 @@ static inline void nc__job_exposure(const struct nc__job *j, int64_t *start_sim,
 struct nc__slot {
     struct nc_frame_record rec;
     struct nc_image_attr attrs[NC__SLOT_ATTRS]; /* rec.attrs, and their values */
-    char attr_text[30][200], attr_wcs[8][32];
+    char attr_text[30][200], attr_wcs[8][32], attr_sun[200];
     struct nc_shot_detail_text attr_detail;
     struct nc__job job;
     uint16_t *dn;

@@ -213,6 +213,9 @@ static int frame_attrs(const struct nc__emu *e, const struct staged *x, const st
     int n = nc_frame_meta(&at, NC_Q_DN, sl->attrs, sl->attr_text, 24);
     n += nc_camsys_meta(cs, x->j.exposure_s, frame, sl->attrs + n, sl->attr_text + 24, 6);
     n += nc_shot_detail_attrs(&at, &x->detail, &sl->attr_detail, sl->attrs + n);
+    nc_sun_view_text(&x->sun, sl->attr_sun, sizeof sl->attr_sun); /* in or near the field */
+    if (sl->attr_sun[0])
+        sl->attrs[n++] = (struct nc_image_attr){"navcam:sun_view", sl->attr_sun};
     at.camera.flip_rows = at.camera.flip_cols = 0; /* the emulator's frames are the view, unmirrored */
     if (e->sky.on)
         n += nc_shot_wcs_attrs(&at.camera, sl->attr_wcs, sl->attrs + n);

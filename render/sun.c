@@ -167,3 +167,16 @@ void nc_sun_view_warning(const struct nc_sun_view *v, char *buf, size_t len)
     else if (len)
         buf[0] = 0;
 }
+
+void nc_sun_view_text(const struct nc_sun_view *v, char *buf, size_t len)
+{
+    char warning[80];
+    nc_sun_view_warning(v, warning, sizeof warning);
+    if (!warning[0]) {
+        if (len)
+            buf[0] = 0;
+        return;
+    }
+    snprintf(buf, len, "off_axis_deg=%.4f edge_deg=%.4f in_field=%d hidden=%d warning=%s", v->off_axis_deg,
+             v->edge_deg, v->in_field, v->hidden, warning);
+}

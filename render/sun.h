@@ -32,5 +32,9 @@ int nc_render_sun(struct nc_renderer *r, const struct nc_scene *s, double near_d
 /* "sun in field", "sun in field, hidden by a body", "sun 4.2 deg from the
  * field" or "" (far from it), into buf. */
 void nc_sun_view_warning(const struct nc_sun_view *v, char *buf, size_t len);
+/* The frame's metadata of it (navcam:sun_view, FITS SUNVIEW) into buf:
+ * "off_axis_deg=... edge_deg=... in_field=... hidden=..." and the warning,
+ * when the Sun is in or near the field; "" otherwise. */
+void nc_sun_view_text(const struct nc_sun_view *v, char *buf, size_t len);
 
 #endif
