@@ -77,7 +77,8 @@ int nc_param_int(struct nc_cfg_node *map, const struct nc_param *table, const ch
 int nc_param_double(struct nc_cfg_node *map, const struct nc_param *table, const char *key, double *out);
 int nc_param_string(struct nc_cfg_node *map, const struct nc_param *table, const char *key, const char **out);
 int nc_param_enum(struct nc_cfg_node *map, const struct nc_param *table, const char *key, int *out);
-/* A MAP entry: *out is the node (NULL when absent) and *sub its table. */
+/* A MAP entry: *out is the node (NULL when absent; a map has no default);
+ * its keys are read with the entry's own table (struct nc_param.sub). */
 int nc_param_map(struct nc_cfg_node *map, const struct nc_param *table, const char *key, struct nc_cfg_node **out);
 
 /* The table as help text: one line a key, "  key  [default] range unit: doc",
