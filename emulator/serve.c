@@ -65,6 +65,8 @@ static int setup(struct nc__emu *e, const struct nc_serve_options *opt, int *hav
                     "unmirrored, +X along CX and +Y along CY (docs/sumfiles.md)",
                     e->scene.camera.flip_rows ? (e->scene.camera.flip_cols ? "K11 < 0 and K22 < 0" : "K22 < 0")
                                               : "K11 < 0");
+    /* the frames are the view: nothing mirrored, a rolling shutter reading the view's rows from the top */
+    e->scene.camera.flip_rows = e->scene.camera.flip_cols = 0;
     if (rc >= 0)
         rc = nc_sky_prepare(&e->sky, &e->cs, &e->scene.camera);
     if (rc >= 0)

@@ -216,7 +216,6 @@ static int frame_attrs(const struct nc__emu *e, const struct staged *x, const st
     nc_sun_view_text(&x->sun, sl->attr_sun, sizeof sl->attr_sun); /* in or near the field */
     if (sl->attr_sun[0])
         sl->attrs[n++] = (struct nc_image_attr){"navcam:sun_view", sl->attr_sun};
-    at.camera.flip_rows = at.camera.flip_cols = 0; /* the emulator's frames are the view, unmirrored */
     if (e->sky.on)
         n += nc_shot_wcs_attrs(&at.camera, sl->attr_wcs, sl->attrs + n);
     return n;

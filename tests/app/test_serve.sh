@@ -148,6 +148,37 @@ assert rec["rock_fold_theta_bar_deg"] > 0 and float(meta["navcam:boulder_min_m"]
 assert meta["navcam:rock_fold_theta_bar_deg"] == "asteroid=%.6g" % rec["rock_fold_theta_bar_deg"], meta
 PY
 
+# A SUM camera mirrored top to bottom (K22 < 0): serve delivers the view, so a rolling shutter on a turning
+# camera gives the frame of the same camera with K22 > 0, bit for bit (a review found the rows read from the
+# view's bottom, the shear reversed, though the frame is not mirrored).
+for k in 20 -20; do
+  printf '%s\n' SERVE '2020 JAN 15 12:00:00.000' '    96    64    10 65535   NPX, NLN, THRSH' \
+    '    0.1000000000D+03    0.4850000000D+02    0.3250000000D+02  MMFL, CTR' \
+    '    0.0000000000D+00    0.6000000000D+01    0.0000000000D+00  SCOBJ' \
+    '    0.1000000000D+01    0.0000000000D+00    0.0000000000D+00  CX' \
+    '    0.0000000000D+00    0.0000000000D+00   -0.1000000000D+01  CY' \
+    '    0.0000000000D+00    0.1000000000D+01    0.0000000000D+00  CZ' \
+    '    0.1000000000D+01    0.0000000000D+00    0.0000000000D+00  SZ' \
+    "   20.00000   0.00000   0.00000   0.00000 $k.00000   0.00000  K-MATRIX" > "$tmp/k$k.SUM"
+  mkdir -p "$tmp/sum$k"
+  (cd "$tmp/sum$k" && "$navcam" serve --set "camera={sumfile: '$tmp/k$k.SUM'}" --set sun.direction=null \
+     --set sun.distance_au=1 --set bodies.0.shape.subdivisions=4 --set render.samples_per_pixel=1 \
+     --set serve.udp_port=0 --set serve.tcp_port=0 --set serve.stats_interval_s=0 --set sensor.shutter=rolling \
+     --set sensor.line_time_s=0.001 --set exposure.time_s=0.001 --set 'camera.angular_velocity_rad_s=[0, 0.05, 0]' \
+     --set "outputs=[{driver: file, directory: frames, pattern: 'f_%06llu.fits'}]" -n 1 > stats.json 2> serve.log) \
+    || bad "serve with k$k.SUM: $(cat "$tmp/sum$k/serve.log")"
+done
+grep -q "delivers the view unmirrored" "$tmp/sum-20/serve.log" && python3 - "$tmp/sum20/frames/f_000000.fits" \
+  "$tmp/sum-20/frames/f_000000.fits" <<'PY' && ok || bad "a mirrored SUM camera's rolling frame differs from the unmirrored one's"
+import sys
+def data(path):  # the pixels after the header (whose FRAMEREC has free-run's wall-clock times)
+    d = open(path, "rb").read()
+    end = next(i for i in range(0, len(d), 80) if d[i:i + 8] == b"END     ")
+    return d[(end // 2880 + 1) * 2880:]
+a, b = data(sys.argv[1]), data(sys.argv[2])
+assert len(a) == 96 * 64 * 2 + 2880 - 96 * 64 * 2 % 2880 and a == b
+PY
+
 # 2. Every rejection reason, sent on purpose over UDP, is counted; serving goes on.
 start reject 2 --set serve.mode=lockstep
 python3 - "$src/examples" "$udp" <<'PY'
