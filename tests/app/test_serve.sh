@@ -168,8 +168,9 @@ for k in 20 -20; do
      --set "outputs=[{driver: file, directory: frames, pattern: 'f_%06llu.fits'}]" -n 1 > stats.json 2> serve.log) \
     || bad "serve with k$k.SUM: $(cat "$tmp/sum$k/serve.log")"
 done
-grep -q "delivers the view unmirrored" "$tmp/sum-20/serve.log" && python3 - "$tmp/sum20/frames/f_000000.fits" \
-  "$tmp/sum-20/frames/f_000000.fits" <<'PY' && ok || bad "a mirrored SUM camera's rolling frame differs from the other's"
+grep -q "delivers the view unmirrored" "$tmp/sum-20/serve.log" &&
+  python3 - "$tmp/sum20/frames/f_000000.fits" "$tmp/sum-20/frames/f_000000.fits" <<'PY' && ok \
+  || bad "a mirrored SUM camera's rolling frame differs from the other's"
 import sys
 def data(path):  # the pixels after the header (whose FRAMEREC has free-run's wall-clock times)
     d = open(path, "rb").read()
