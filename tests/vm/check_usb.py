@@ -19,6 +19,10 @@ C: unplugged and plugged again: reported, counted, reopened; the edges
 D: the adapter's IN endpoint stalled (still plugged in): the session's end
    is reported and counted as a session error, not an unplug; the adapter is
    opened again by itself; the edges before and after gave frames.
+E: a host sending a full OUT packet of requests in one transfer (as the
+   protocol allows; a full packet is ended by no short packet) gets every
+   reply within 0.5 s (the reference adapter read 1024 bytes at a time and
+   kept such a packet until another transfer came, until session 65).
 """
 import json
 import os
@@ -151,6 +155,11 @@ check(ud["session_errors"] == 1 and ud["unplugged"] == 0 and ud["reopened"] == 1
 check("the session ended on a transfer error (a stall; 1 so far); opened again" in dlog
       and "reopened after" in dlog, "D: the stall and the reopening are reported")
 check(len(drecs) == m1 + m2, f"D: {m1} edges before and {m2} after the stall -> {len(drecs)} frames")
+
+# ---- E ----------------------------------------------------------------------
+burst = open(os.path.join(out, "e/burst.log")).read().strip()
+check(open(os.path.join(out, "e/status")).read().strip() == "0",
+      f"E: a full packet of requests in one transfer answered within 0.5 s: {burst}")
 
 print(f"{len(failures)} checks failed" if failures else "all checks passed")
 if lat:

@@ -14,7 +14,7 @@ out=$1 navcam=$2 helpers=$3 src=$4 adapter=$5
 edges=${6:-12}
 mods=/run/vm/root
 cd "$out"
-rm -rf a b c d && mkdir -p a b c d
+rm -rf a b c d e && mkdir -p a b c d e
 
 . "$(dirname "$0")/guest_lib.sh"
 trap 'echo "guest_usb.sh: line $LINENO: $BASH_COMMAND failed"' ERR
@@ -186,6 +186,11 @@ sleep 1
 taskset -c 0 "$helpers/gpio_sim" edges "$sim/sim_gpio0/pull" 4 300 d/edges2.csv
 sleep 0.5
 stop_serve d
+
+# ---- E: a full packet of requests in one transfer --------------------------------
+step "E: a full OUT packet of TIME requests in one transfer (no navcam serve): every reply at once"
+"$helpers/usb_burst" 0.5 >e/burst.log 2>&1 && echo 0 >e/status || echo $? >e/status
+cat e/burst.log
 
 kill -INT "$adapter_pid"
 wait "$adapter_pid" || true
