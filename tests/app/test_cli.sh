@@ -344,8 +344,7 @@ expect 0 "photon transfer" -- "$navcam" expose --help
 # The shading choice is recorded in the file.
 "$navcam" render "${small[@]}" --set bodies.0.shape.normals=smooth -o "$tmp/smooth.fits" >/dev/null 2>&1
 head -c 28800 "$tmp/smooth.fits" | grep -aq "NORMALS = 'asteroid=smooth'" && ok || bad "smooth.fits lacks NORMALS = 'asteroid=smooth'"
-# SUNVIEW only with the Sun in or near the field (it was in every file; the default scene's Sun is 140 deg
-# off the boresight)
+# SUNVIEW only with the Sun in or near the field (it was in every file; the default scene's is 140 deg off)
 head -c 28800 "$tmp/smooth.fits" | grep -aq "SUNVIEW" && bad "smooth.fits has SUNVIEW with the Sun far off" || ok
 "$navcam" render "${small[@]}" --set "sun.direction=[0.001, 1, 0]" -o "$tmp/sunview.fits" >/dev/null 2>&1
 head -c 28800 "$tmp/sunview.fits" | grep -aq "SUNVIEW = 'off_axis_deg=0.0573 .* in_field=1 " && ok \
