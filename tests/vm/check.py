@@ -214,9 +214,10 @@ for g in got:
     same = r is not None and g[row:] == b"".join((v << 4).to_bytes(2, "little") for v in dn)
     if magic == b"NCMD" and (version, length) == (1, 160) and crc_ok and same and exposure_s == r["exposure_s"]:
         matched.append(number)
-check(len(matched) == len(got) == 5 and matched == sorted(set(matched)),
+# the first two may be the ring's stale frames, in either order (seen once: frames 2, 1, then 2 again)
+check(len(matched) == len(got) == 5 and matched[2:] == sorted(set(matched[2:])) and max(matched[:2]) <= matched[2],
       f"D: each frame v4l2-ctl read names its frame in row 0 (frames {matched}) and is that file-output frame, "
-      f"in order")
+      f"in order after the ring's stale ones")
 
 # ---- E ----------------------------------------------------------------------
 elog = open(os.path.join(out, "e/serve.log")).read()
