@@ -17,6 +17,16 @@
 
 #include "proto/usb_trigger.h"
 
+/* A bulk IN transfer of up to len bytes within timeout_ms: the bytes that
+ * came, also when the call timed out as they came (libusb then reports the
+ * timeout with the data in *got). */
+static int read_in(libusb_device_handle *h, unsigned char ep, uint8_t *buf, int len, unsigned timeout_ms)
+{
+    int got = 0;
+    const int rc = libusb_bulk_transfer(h, ep, buf, len, &got, timeout_ms);
+    return rc == 0 || rc == LIBUSB_ERROR_TIMEOUT ? got : 0;
+}
+
 static double now_s(void)
 {
     struct timespec ts;
@@ -76,12 +86,13 @@ int main(int argc, char **argv)
     int done = 0, got = 0;
     libusb_bulk_transfer(h, ep_out, msg, sizeof msg, &done, 1000);
     const double t_hello = now_s();
-    for (int info = 0; !info && now_s() - t_hello < 2;)
-        if (libusb_bulk_transfer(h, ep_in, in, pkt, &got, 200) == 0)
-            for (int o = 0; o + NC_UT_MSG_BYTES <= got; o += NC_UT_MSG_BYTES) {
-                struct nc_ut_msg m;
-                info |= nc_ut_decode(in + o, &m) == 0 && m.type == NC_UT_INFO && m.tag == 7;
-            }
+    for (int info = 0; !info && now_s() - t_hello < 2;) {
+        got = read_in(h, ep_in, in, pkt, 200);
+        for (int o = 0; o + NC_UT_MSG_BYTES <= got; o += NC_UT_MSG_BYTES) {
+            struct nc_ut_msg m;
+            info |= nc_ut_decode(in + o, &m) == 0 && m.type == NC_UT_INFO && m.tag == 7;
+        }
+    }
     /* one full packet of requests, tags 100.. */
     const int k = pkt / NC_UT_MSG_BYTES < (int)(sizeof out / NC_UT_MSG_BYTES) ? pkt / NC_UT_MSG_BYTES
                                                                                 : (int)(sizeof out / NC_UT_MSG_BYTES);
@@ -93,14 +104,15 @@ int main(int argc, char **argv)
     int replies = 0;
     unsigned seen = 0;
     double t_last = t0;
-    while (replies < k && now_s() - t0 < timeout_s)
-        if (libusb_bulk_transfer(h, ep_in, in, pkt, &got, 50) == 0)
-            for (int o = 0; o + NC_UT_MSG_BYTES <= got; o += NC_UT_MSG_BYTES) {
-                struct nc_ut_msg m;
-                if (nc_ut_decode(in + o, &m) == 0 && m.type == NC_UT_TIME && m.tag >= 100 && m.tag < 100u + k &&
-                    !(seen >> (m.tag - 100) & 1u))
-                    seen |= 1u << (m.tag - 100), replies++, t_last = now_s();
-            }
+    while (replies < k && now_s() - t0 < timeout_s) {
+        got = read_in(h, ep_in, in, pkt, 50);
+        for (int o = 0; o + NC_UT_MSG_BYTES <= got; o += NC_UT_MSG_BYTES) {
+            struct nc_ut_msg m;
+            if (nc_ut_decode(in + o, &m) == 0 && m.type == NC_UT_TIME && m.tag >= 100 && m.tag < 100u + k &&
+                !(seen >> (m.tag - 100) & 1u))
+                seen |= 1u << (m.tag - 100), replies++, t_last = now_s();
+        }
+    }
     printf("burst: %d requests in one %d-byte transfer, %d replies in %.1f ms\n", k, k * NC_UT_MSG_BYTES, replies,
            1e3 * (t_last - t0));
     libusb_release_interface(h, ifnum);
