@@ -14,17 +14,28 @@
 
 #include "core/error.h"
 
+/* A FRAME answer read and not yet returned: nc_client_wait_frame passes
+ * over answers to other requests and keeps them for the calls after it. */
+struct answer {
+    uint32_t sequence, status;
+    uint64_t frame;
+};
+
 struct nc_client {
     int fd, tcp;
     uint32_t next_sequence;
     uint8_t buf[4 + NC_PROTO_MAX_BYTES];
     size_t have;
+    struct answer *held; /* in the order NavCam sent them */
+    size_t nheld, held_cap;
 };
 
 int nc_client_connect(const char *host, int port, int tcp, struct nc_client **out)
 {
+    if (port < 1 || port > 65535)
+        return nc_error(-EINVAL, "port %d: expected 1 to 65535", port);
     struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
-    if (inet_pton(AF_INET, host, &a.sin_addr) != 1)
+    if (!host || inet_pton(AF_INET, host, &a.sin_addr) != 1)
         return nc_error(-EINVAL, "'%s' is not a numeric IPv4 address", host);
     struct nc_client *c = calloc(1, sizeof *c);
     if (!c)
@@ -48,11 +59,15 @@ int nc_client_connect(const char *host, int port, int tcp, struct nc_client **ou
 long nc_client_send(struct nc_client *c, struct nc_pose_msg *m)
 {
     uint8_t buf[4 + NC_PROTO_MAX_BYTES];
-    m->sequence = c->next_sequence++;
+    if (m->type != NC_MSG_POSE && m->type != NC_MSG_TRIGGER) /* FRAME goes the other way */
+        return nc_error(-EINVAL, "message type %d: a simulator sends POSE (%d) or TRIGGER (%d)", (int)m->type,
+                        (int)NC_MSG_POSE, (int)NC_MSG_TRIGGER);
+    m->sequence = c->next_sequence;
     size_t n = nc_msg_encode(m, buf + 4, NC_PROTO_MAX_BYTES);
     if (!n)
         return nc_error(-EINVAL, "message not encodable: flags 0x%x are not those of message type %d "
                                  "(docs/protocol.md)", m->flags, (int)m->type);
+    c->next_sequence++; /* used only by a message that goes out */
     for (int i = 0; i < 4; i++)
         buf[i] = (uint8_t)(n >> (8 * i));
     const uint8_t *p = c->tcp ? buf : buf + 4;
@@ -74,7 +89,8 @@ long nc_client_send(struct nc_client *c, struct nc_pose_msg *m)
     return (long)m->sequence;
 }
 
-int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence, uint64_t *frame, uint32_t *status)
+/* The next FRAME answer from the connection (not from those held). */
+static int read_answer(struct nc_client *c, int timeout_ms, uint32_t *sequence, uint64_t *frame, uint32_t *status)
 {
     if (!c->tcp)
         return nc_error(-EOPNOTSUPP, "frames are answered over TCP only");
@@ -119,19 +135,49 @@ int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence
     }
 }
 
+/* Held answer i out, removed. */
+static void take_held(struct nc_client *c, size_t i, uint32_t *sequence, uint64_t *frame, uint32_t *status)
+{
+    *sequence = c->held[i].sequence, *frame = c->held[i].frame, *status = c->held[i].status;
+    memmove(c->held + i, c->held + i + 1, (c->nheld - i - 1) * sizeof *c->held);
+    c->nheld--;
+}
+
+int nc_client_next_frame(struct nc_client *c, int timeout_ms, uint32_t *sequence, uint64_t *frame, uint32_t *status)
+{
+    if (c->nheld) {
+        take_held(c, 0, sequence, frame, status);
+        return 0;
+    }
+    return read_answer(c, timeout_ms, sequence, frame, status);
+}
+
 int nc_client_wait_frame(struct nc_client *c, uint32_t sequence, int timeout_ms, uint64_t *frame, uint32_t *status)
 {
+    uint32_t seq;
+    for (size_t i = 0; i < c->nheld; i++)
+        if (c->held[i].sequence == sequence) {
+            take_held(c, i, &seq, frame, status);
+            return 0;
+        }
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     for (;;) {
         clock_gettime(CLOCK_MONOTONIC, &t1);
         long left = timeout_ms - ((t1.tv_sec - t0.tv_sec) * 1000 + (t1.tv_nsec - t0.tv_nsec) / 1000000);
-        uint32_t seq;
-        int rc = nc_client_next_frame(c, timeout_ms < 0 ? -1 : left > 0 ? (int)left : 0, &seq, frame, status);
+        int rc = read_answer(c, timeout_ms < 0 ? -1 : left > 0 ? (int)left : 0, &seq, frame, status);
         if (rc == -ETIMEDOUT)
             return nc_error(rc, "no frame for request %u within %d ms", sequence, timeout_ms);
         if (rc < 0 || seq == sequence)
             return rc;
+        if (c->nheld == c->held_cap) { /* another request's answer: kept for the calls after this one */
+            size_t cap = c->held_cap ? 2 * c->held_cap : 16;
+            struct answer *h = realloc(c->held, cap * sizeof *h);
+            if (!h)
+                return nc_error(-ENOMEM, "out of memory for the answers to other requests");
+            c->held = h, c->held_cap = cap;
+        }
+        c->held[c->nheld++] = (struct answer){seq, *status, *frame};
     }
 }
 
@@ -140,6 +186,7 @@ void nc_client_close(struct nc_client *c)
     if (!c)
         return;
     close(c->fd);
+    free(c->held);
     free(c);
 }
 

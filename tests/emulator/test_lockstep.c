@@ -172,6 +172,15 @@ static void twenty_back_to_back(void)
     CHECK(order && st[0] == NC_FRAME_DELIVERED && st[1] == NC_FRAME_DELIVERED && st[2] == NC_FRAME_DROPPED &&
               st[3] == NC_FRAME_DELIVERED,
           "a TRIGGER among captures: in order %d, statuses %u %u %u %u", order, st[0], st[1], st[2], st[3]);
+    /* Waiting for the last of three answers keeps the two before it: a later wait finds its own at once, and
+     * the next answer read is the other (an outside client found them thrown away). */
+    capture(c, 4.0), capture(c, 4.1);
+    const long third = capture(c, 4.2);
+    uint64_t f3 = 0, f1 = 0;
+    int kept = third > 0 && nc_client_wait_frame(c, (uint32_t)third, 60000, &f3, &status) == 0;
+    kept &= nc_client_wait_frame(c, (uint32_t)third - 2, 0, &f1, &status) == 0 && f1 + 2 == f3;
+    kept &= nc_client_next_frame(c, 0, &seq, &frame, &status) == 0 && seq == (uint32_t)third - 1 && frame == f3 - 1;
+    CHECK(kept, "answers passed over by nc_client_wait_frame: kept for later calls (%s)", nc_client_errmsg());
     nc_client_close(c);
     CHECK(finish(pid) == 0, "serve did not exit cleanly");
 }
@@ -424,7 +433,13 @@ static void udp_to_nothing(void)
         usleep(20000);
     }
     CHECK(last == 5, "UDP to a port with no listener: the 5th send returned %ld (%s)", last, nc_client_errmsg());
+    /* A FRAME (NavCam's answer) is not sent, and a message not sent uses no sequence (both were, as an outside
+     * client found); a port beyond 65535 is refused, not wrapped */
+    struct nc_pose_msg fr = {.type = NC_MSG_FRAME};
+    CHECK(c && nc_client_send(c, &fr) == -EINVAL && capture(c, 6) == 6, "a FRAME sent: %s", nc_client_errmsg());
     nc_client_close(c);
+    struct nc_client *w = NULL;
+    CHECK(nc_client_connect("127.0.0.1", 65536 + 9, 0, &w) == -EINVAL && !w, "port 65545: %s", nc_client_errmsg());
 }
 
 int main(int argc, char **argv)
