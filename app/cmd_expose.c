@@ -35,8 +35,8 @@ static const char expose_help[] =
     "                         --first-frame\n"
     "      --first-frame K    frame number of the first frame (keys the noise; default 0)\n"
     "  -d, --dark             dark frames: no light (radiance 0)\n"
-    "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N), 16-bit unsigned (8-bit\n"
-    "                         for an 8-bit ADC);\n"
+    "  -o, --output OUT       .fits: one FITS cube (NAXIS3 = N; one frame: a 2-D image),\n"
+    "                         16-bit unsigned (8-bit for an 8-bit ADC);\n"
     "                         .png/.tif/.exr: numbered files OUT_0000.ext, OUT_0001.ext, ...\n"
     "      --fits-rows ORDER  .fits only: top_down (default: row 1 is the top image\n"
     "                         row) or bottom_up (row 1 at the bottom, as FITS viewers\n"
@@ -46,8 +46,10 @@ static const char expose_help[] =
     "\n"
     "The noise of frame k depends only on the sensor seed and k: rerunning a command\n"
     "reproduces its frames bit for bit.\n"
-    "Example:\n"
-    "  navcam expose configs/examples/navcam_camera.yaml -L 5 -e 0.002 -n 16 -o flat.fits\n";
+    "Examples (the first from a NavCam checkout; the second anywhere, with the\n"
+    "built-in default scene's camera):\n"
+    "  navcam expose configs/examples/navcam_camera.yaml -L 5 -e 0.002 -n 16 -o flat.fits\n"
+    "  navcam scene > cam.yaml && navcam expose cam.yaml -L 5 -n 16 -o flat.fits\n";
 
 int main(int argc, char **argv)
 {

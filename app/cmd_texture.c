@@ -62,10 +62,12 @@ static const char texture_help[] =
     "corners_per_m2 (null without --gsd), band_cpp [FLO, FHI], psd_beta, psd_r2,\n"
     "grad_mean, grad_rms, grad_kurtosis (null where undefined).\n"
     "\n"
-    "Example:\n"
+    "Examples (the first from a NavCam checkout; real.fits stands for your own\n"
+    "image of the same ground; the last anywhere):\n"
     "  navcam render configs/examples/bennu_rubble.yaml -o r.fits --quantity radiance\n"
-    "  navcam texture r.fits real_image.fits --gsd 0.2\n"
-    "  navcam texture frame.tif --crop 256,128,256,256 --band 0.03125,0.25\n";
+    "  navcam texture r.fits real.fits --gsd 0.2\n"
+    "  navcam render -o frame.tif && navcam texture frame.tif --crop 256,128,256,256 \\\n"
+    "      --band 0.03125,0.25\n";
 
 /* "A,B" into two numbers; 0, or -1 if it is not that. */
 static int pair(const char *s, double *a, double *b)
