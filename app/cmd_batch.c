@@ -174,7 +174,8 @@ static int lists(const char *dir, const char *stem, const struct nc_scene *s, co
 /* The detail a frame was rendered with, as the emulator's frame records
  * give it (docs/emulator.md). */
 struct detail {
-    double lod_error_m, boulder_min_m, boulder_mesh_px, rock_fold_theta_bar_deg, line_time_s;
+    struct nc_shot_detail shot; /* levels of detail, boulder cut, fold */
+    double line_time_s;
     int rolling, time_samples;
 };
 
@@ -249,7 +250,7 @@ static int truth(const char *dir, const char *stem, const char *ext, int geometr
         fprintf(f, ", \"quality_choice\": \"%s\"", quality);
     fprintf(f, "},\n \"lod_error_m\": %.17g, \"boulder_min_m\": %.17g, \"boulder_mesh_px\": %.17g, "
                "\"rock_fold_theta_bar_deg\": %.17g}\n",
-            d->lod_error_m, d->boulder_min_m, d->boulder_mesh_px, d->rock_fold_theta_bar_deg);
+            d->shot.lod_error_m, d->shot.boulder_min_m, d->shot.boulder_mesh_px, d->shot.fold_max_deg);
     return commit(f, 0, tmp, dir, name);
 }
 
@@ -296,9 +297,9 @@ static int batch_row(struct nc_renderer *r, const struct nc_scene *base, const s
     if ((rc = nc_shot(r, &s, cs, sky, q, exposure, row->t_s, (uint64_t)i, tmp, extra, 1, &info)) < 0 ||
         (rc = nc_commit_file(tmp, path)) < 0)
         return rc;
-    const struct detail det = {nc_rt_lod_error_m(r->rt), nc_rt_boulder_min_m(r->rt), nc_rt_boulder_mesh_px(r->rt),
-                               nc_render_fold_theta_bar_deg(r, s.nbodies), cs->sensor.line_time_s,
-                               cs->sensor.shutter == NC_SHUTTER_ROLLING, info.time_samples};
+    struct detail det = {.line_time_s = cs->sensor.line_time_s, .rolling = cs->sensor.shutter == NC_SHUTTER_ROLLING,
+                         .time_samples = info.time_samples};
+    nc_shot_detail_of(r, s.nbodies, &det.shot);
     int nrocks = -1, ncraters = -1;
     if (geometry) {
         snprintf(tmp, sizeof tmp, "%s/.%s_geometry.tmp.fits", dir, stem);

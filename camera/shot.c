@@ -67,6 +67,7 @@ void nc_shot_detail_of(const struct nc_renderer *r, int nbodies, struct nc_shot_
     d->boulder_mesh_px = nc_rt_boulder_mesh_px(r->rt);
     for (int i = 0; i < NC_MAX_BODIES; i++)
         d->fold_theta_bar_deg[i] = i < nbodies ? r->fold_theta_bar_deg[i] : -1;
+    d->fold_max_deg = nc_render_fold_theta_bar_deg(r, nbodies);
 }
 
 int nc_shot_detail_attrs(const struct nc_scene *scene, const struct nc_shot_detail *d, struct nc_shot_detail_text *t,

@@ -51,10 +51,11 @@ int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_imag
 /* The detail a frame was rendered with, read off its renderer after the
  * render (the levels of detail's error bound, m; the boulder cut, m, 0:
  * every rock; the detailed surfaces' threshold, px; the roughness each
- * body's rocks not traced were folded into, deg, -1: none). */
+ * body's rocks not traced were folded into, deg, -1: none, and the largest
+ * of those, what frame records give). */
 struct nc_shot_detail {
     double lod_error_m, boulder_min_m, boulder_mesh_px;
-    double fold_theta_bar_deg[NC_MAX_BODIES];
+    double fold_theta_bar_deg[NC_MAX_BODIES], fold_max_deg;
 };
 /* The text of its attributes. */
 struct nc_shot_detail_text {

@@ -72,6 +72,10 @@ void nc_output_close(struct nc_output *o)
 
 static const char *const quality_names[] = {"interpolated", "extrapolated", "stale", "none", "scene"};
 
+/* The Sun as the frame used it, as every writer of its record gives it: a
+ * direction made a unit vector, a position as it is. */
+static struct nc_vec3 record_sun(const struct nc_pose *p) { return p->sun_is_position ? p->sun : nc_v3_unit(p->sun); }
+
 int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *buf, size_t len)
 {
     const struct nc_pose *p = &r->pose;
@@ -105,8 +109,7 @@ int nc_frame_record_json(const struct nc_frame_record *r, int wall_clock, char *
                  "\"inside\": {\"warning\": \"camera inside a boulder\", \"body\": %d, \"boulder\": %ld}, ",
                  r->in_rock_body, r->in_rock1 - 1);
     }
-    /* the Sun as the frame used it: a direction is made a unit vector */
-    const struct nc_vec3 sun = p->sun_is_position ? p->sun : nc_v3_unit(p->sun);
+    const struct nc_vec3 sun = record_sun(p);
     int n = snprintf(
         buf, len,
         "{\"frame\": %llu, \"request_sequence\": %u, \"trigger_source\": \"%s\", "
@@ -151,7 +154,7 @@ static void metadata(const struct nc_frame_record *r, uint8_t m[NC_FRAME_META_BY
     nc_le_put_u64(m + 56, (uint64_t)r->exposure_end_sim_ns);
     nc_le_put_u64(m + 64, (uint64_t)r->exposure_start_mono_ns);
     const struct nc_pose *p = &r->pose;
-    const struct nc_vec3 sun = p->sun_is_position ? p->sun : nc_v3_unit(p->sun); /* as the JSON record has it */
+    const struct nc_vec3 sun = record_sun(p);
     const double v[10] = {p->cam_position_m.x, p->cam_position_m.y, p->cam_position_m.z, p->cam_attitude_q.w,
                           p->cam_attitude_q.x, p->cam_attitude_q.y, p->cam_attitude_q.z, sun.x,
                           sun.y,               sun.z};

@@ -153,8 +153,7 @@ struct staged {
     unsigned long hits, back_hits; /* camera samples that met a surface, and its back side */
     long in_rock;                  /* the rock the camera is inside (of body in_rock_body), -1: none */
     int in_rock_body;
-    struct nc_shot_detail detail;   /* the levels of detail, the boulder cut, the fold */
-    double rock_fold_theta_bar_deg; /* the largest fold (-1: none) */
+    struct nc_shot_detail detail; /* the levels of detail, the boulder cut, the fold */
     struct nc_sky_stats stars;
     struct nc_sun_view sun;
     struct nc_render_settings used; /* render.quality: auto's choice, or the scene's */
@@ -268,7 +267,7 @@ static void finish_frame(struct stage *st, const struct staged *x)
         .pose_quality = x->q, .pose_gap_ns = x->gap, .exposure_s = j->exposure_s, .gain_db = j->gain_db,
         .time_samples = x->ts, .lod_error_m = x->detail.lod_error_m, .boulder_min_m = x->detail.boulder_min_m,
         .boulder_mesh_px = x->detail.boulder_mesh_px,
-        .rock_fold_theta_bar_deg = x->rock_fold_theta_bar_deg, .samples_per_pixel = x->used.samples_per_pixel,
+        .rock_fold_theta_bar_deg = x->detail.fold_max_deg, .samples_per_pixel = x->used.samples_per_pixel,
         .bounces = x->used.bounces, .soft_shadows = x->used.soft_shadows, .quality_auto = x->used.quality_auto,
         .stars_on = e->sky.on, .star_limit_mag = x->stars.limit_mag, .stars_drawn = x->stars.drawn,
         .stars_hidden = x->stars.hidden, .sun_off_axis_deg = x->sun.off_axis_deg, .sun_edge_deg = x->sun.edge_deg,
@@ -384,7 +383,6 @@ static void render_loop(struct nc__emu *e, struct stage *st, int overlap)
             x.rc = nc_render_sun(&e->renderer, &at, NC_SUN_NEAR_DEG, f, &x.sun);
         x.t1 = nc_mono_ns();
         nc_shot_detail_of(&e->renderer, at.nbodies, &x.detail);
-        x.rock_fold_theta_bar_deg = nc_render_fold_theta_bar_deg(&e->renderer, at.nbodies);
         if (overlap) {
             atomic_store(&e->readout_end_ns, 0); /* the next exposure may start rendering */
             hand_over(st, &x);

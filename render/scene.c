@@ -419,16 +419,22 @@ void nc_scene_free(struct nc_scene *s)
     s->nbodies = 0;
 }
 
-void nc_scene_sun_at(const struct nc_scene *s, struct nc_vec3 p, struct nc_vec3 *dir, double *irradiance_w_m2)
+/* A Sun given by its position (bodies[0]'s frame, from its origin): where it
+ * is in the scene. */
+static struct nc_vec3 sun_in_scene(const struct nc_scene *s)
 {
     const struct nc_body *b0 = &s->body[0];
+    return nc_v3_add(nc_quat_rotate(b0->attitude_q, s->sun.position_m), b0->position_m);
+}
+
+void nc_scene_sun_at(const struct nc_scene *s, struct nc_vec3 p, struct nc_vec3 *dir, double *irradiance_w_m2)
+{
     if (!s->sun.has_position) {
-        *dir = nc_quat_rotate(b0->attitude_q, s->sun.direction);
+        *dir = nc_quat_rotate(s->body[0].attitude_q, s->sun.direction);
         *irradiance_w_m2 = s->sun.irradiance_w_m2;
         return;
     }
-    struct nc_vec3 sun = nc_v3_add(nc_quat_rotate(b0->attitude_q, s->sun.position_m), b0->position_m);
-    struct nc_vec3 d = nc_v3_sub(sun, p);
+    struct nc_vec3 d = nc_v3_sub(sun_in_scene(s), p);
     double r = nc_v3_norm(d), r0 = nc_v3_norm(s->sun.position_m);
     *dir = nc_v3_scale(d, 1.0 / r);
     *irradiance_w_m2 = s->sun.irradiance_w_m2 * (r0 / r) * (r0 / r);
@@ -476,9 +482,5 @@ double nc_scene_sun_radius_rad(const struct nc_scene *s)
 
 double nc_scene_sun_radius_from(const struct nc_scene *s, struct nc_vec3 p)
 {
-    if (!s->sun.has_position)
-        return sun_radius(s->sun.distance_m);
-    const struct nc_body *b0 = &s->body[0]; /* the position is in its frame, from its origin */
-    const struct nc_vec3 sun = nc_v3_add(nc_quat_rotate(b0->attitude_q, s->sun.position_m), b0->position_m);
-    return sun_radius(nc_v3_norm(nc_v3_sub(sun, p)));
+    return sun_radius(s->sun.has_position ? nc_v3_norm(nc_v3_sub(sun_in_scene(s), p)) : s->sun.distance_m);
 }
