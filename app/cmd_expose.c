@@ -100,6 +100,11 @@ int main(int argc, char **argv)
         default: fputs("Try 'navcam expose --help'.\n", stderr); goto out;
         }
     }
+    if ((uint64_t)nframes - 1 > UINT64_MAX - first) { /* the numbers key the noise: none may wrap to 0 */
+        fprintf(stderr, "navcam expose: --first-frame %llu with %.0f frames goes past frame 2^64 - 1\n",
+                (unsigned long long)first, nframes);
+        goto out;
+    }
     if (optind < argc)
         cam_path = argv[optind++];
     if (!cam_path || optind < argc || !out || (L < 0 && !dark)) {

@@ -179,7 +179,8 @@ int nc_sky_draw(struct nc_sky *sky, struct nc_renderer *r, const struct nc_camsy
     for (size_t i = 0; i < n; i++) {
         if (nc_v3_dot(sky->dir[i], z) < cmin)
             continue;
-        sky->pts[m++] = (struct nc_point_source){nc_aberrate(sky->dir[i], v), sky->e_w_m2[i], 0}; /* no I/F */
+        sky->pts[m++] = /* at infinity, no I/F */
+            (struct nc_point_source){.dir = nc_aberrate(sky->dir[i], v), .irradiance_w_m2 = sky->e_w_m2[i]};
     }
     const double line_s = cs->sensor.shutter == NC_SHUTTER_ROLLING ? cs->sensor.line_time_s : 0;
     long hidden = 0, drawn = nc_render_points(r, s, exposure_s, line_s, sky->pts, m, 1, f, &hidden);

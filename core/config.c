@@ -422,21 +422,10 @@ int nc_cfg_set(struct nc_cfg *cfg, const char *assignment)
 
     /* Walk the dotted path, creating maps as needed. "a[0]" == "a.0". */
     char path[256];
-    size_t plen = (size_t)(eq - assignment);
-    if (plen >= sizeof path) {
+    if ((rc = nc__cfg_key_path(assignment, (size_t)(eq - assignment), path, sizeof path, origin)) < 0) {
         node_free(value);
-        return nc_error(NC_EUSAGE, "%s: key path too long", origin);
+        return rc;
     }
-    size_t j = 0;
-    for (size_t i = 0; i < plen; i++) {
-        char c = assignment[i];
-        if (c == '[')
-            c = '.';
-        else if (c == ']')
-            continue;
-        path[j++] = c;
-    }
-    path[j] = '\0';
     struct nc_cfg_node *cur = cfg->root;
     char *save = NULL;
     char *tok = strtok_r(path, ".", &save);

@@ -51,6 +51,9 @@ int nc_cfg_overlay(struct nc_cfg *base, struct nc_cfg *top);
 
 /* Child of a map by key without marking it used (internal to config*.c). */
 struct nc_cfg_node *nc__cfg_find(struct nc_cfg_node *map, const char *key);
+/* --set's KEY (len bytes) as a dotted path in out ("a[0].b": "a.0.b"); an
+ * error naming origin if it is none (an empty name, a stray bracket). */
+int nc__cfg_key_path(const char *key, size_t len, char *out, size_t cap, const char *origin);
 /* Whether a scalar is YAML's null (null, Null, NULL, ~ unquoted), which --set and a
  * file laid over another take as "leave this key out" (config.c). */
 int nc__cfg_is_null(const struct nc_cfg_node *v);
@@ -75,6 +78,10 @@ int nc_cfg_string(struct nc_cfg_node *parent, const char *key, const char **out)
 int nc_cfg_enum(struct nc_cfg_node *parent, const char *key, const char *const *names, int *out);
 int nc_cfg_doubles(struct nc_cfg_node *parent, const char *key, double *out, size_t n);
 int nc_cfg_vec3(struct nc_cfg_node *parent, const char *key, struct nc_vec3 *out);
+/* nc_cfg_vec3 with a length of at most max, else the error "LENGTH WHAT,
+ * beyond LIMIT" (what: "m from the scene's origin"; limit: "1e+15 m"). */
+int nc_cfg_vec3_max(struct nc_cfg_node *parent, const char *key, double max, const char *what, const char *limit,
+                    struct nc_vec3 *out);
 /* A unit quaternion [w, x, y, z]; within 1e-3 of unit length it is normalised. */
 int nc_cfg_quat(struct nc_cfg_node *parent, const char *key, struct nc_quat *out);
 

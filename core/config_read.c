@@ -209,6 +209,16 @@ int nc_cfg_vec3(struct nc_cfg_node *parent, const char *key, struct nc_vec3 *out
     return rc;
 }
 
+int nc_cfg_vec3_max(struct nc_cfg_node *parent, const char *key, double max, const char *what, const char *limit,
+                    struct nc_vec3 *out)
+{
+    const int rc = nc_cfg_vec3(parent, key, out);
+    const double len = rc == 1 ? hypot(hypot(out->x, out->y), out->z) : 0; /* 1e300 is not inf */
+    if (!(len <= max))
+        return nc_cfg_key_error(parent, key, "%g %s, beyond %s", len, what, limit);
+    return rc;
+}
+
 int nc_cfg_quat(struct nc_cfg_node *parent, const char *key, struct nc_quat *out)
 {
     double v[4] = {0};

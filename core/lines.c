@@ -56,9 +56,9 @@ double nc_strtod_fortran(const char *s, char **end)
     memcpy(num, s + lead, len);
     num[len] = '\0';
     if (!strpbrk(num, "xX")) /* not in a hexadecimal number's digits */
-        for (char *c = num + 1; *c; c++)
-            if ((*c == 'D' || *c == 'd') && (isdigit((unsigned char)c[-1]) || c[-1] == '.'))
-                *c = 'E';
+        for (size_t i = 1; i < len; i++) /* within the token (an empty one has nothing past its end to read) */
+            if ((num[i] == 'D' || num[i] == 'd') && (isdigit((unsigned char)num[i - 1]) || num[i - 1] == '.'))
+                num[i] = 'E';
     const double v = strtod(num, &e);
     if (end)
         *end = (char *)s + (e == num ? 0 : lead + (size_t)(e - num));

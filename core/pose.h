@@ -13,8 +13,13 @@
 /* The camera every input may describe (camera.* keys, SUM files,
  * trajectories): within 1e15 m (6700 au, beyond any mission) of the scene's
  * origin on each axis (a camera at 1e200 m left the render no image axes),
- * focal lengths of 1e-3 to 1e9 pixels, a principal point within 1e6 pixels. */
+ * focal lengths of 1e-3 to 1e9 pixels, a principal point within 1e6 pixels.
+ * Bodies' positions have the same limit, cameras' and bodies' speeds the
+ * speed of light (as the pose protocol's, include/navcam/protocol.h). */
 #define NC_CAMERA_MAX_M 1e15
+#define NC_CAMERA_MAX_TEXT "1e+15 m"
+#define NC_SPEED_MAX_M_S 299792458.0
+#define NC_SPEED_MAX_TEXT "the speed of light, 299792458 m/s"
 #define NC_FOCAL_MIN_PX 1e-3
 #define NC_FOCAL_MAX_PX 1e9
 #define NC_PRINCIPAL_MAX_PX 1e6

@@ -30,7 +30,9 @@ static const struct nc_param file_params[] = {
     NC_P_ENUM("fits_row_order", "top_down", fits_orders,
               "for .fits patterns: top_down (row 1 is the top image row) or bottom_up (row 1 at the bottom, as FITS "
               "viewers and mission archives show it); the keyword ROWORDER records which"),
-    NC_P_STRING_OR_EMPTY("sidecar", "frames.jsonl", "JSON-lines file with every frame's metadata, in the directory (empty: none)"),
+    NC_P_STRING_OR_EMPTY("sidecar", "frames.jsonl",
+                         "JSON-lines file with every frame's metadata, in the directory: a file name (no '/', not an "
+                         "image format's extension), or empty: none"),
     NC_P_END,
 };
 
@@ -54,11 +56,17 @@ static int pattern_ok(const char *pattern)
  * order only with FITS. Before the scene is built (nc_output_check). */
 static int file_check(struct nc_cfg_node *opts)
 {
-    const char *pattern = NULL;
+    const char *pattern = NULL, *sidecar = NULL;
     int rc, bottom_up = 0;
     if ((rc = nc_param_string(opts, file_params, "pattern", &pattern)) < 0 ||
+        (rc = nc_param_string(opts, file_params, "sidecar", &sidecar)) < 0 ||
         (rc = nc_param_enum(opts, file_params, "fits_row_order", &bottom_up)) < 0)
         return rc;
+    /* in the directory, and never a frame's name (a frame written over it lost every record before) */
+    if (sidecar[0] && (strchr(sidecar, '/') || !strcmp(sidecar, ".") || !strcmp(sidecar, "..") ||
+                       nc_image_format_ok(sidecar, NULL)))
+        return nc_cfg_key_error(opts, "sidecar", "expected a file name in the directory: no '/', not an image "
+                                "format's extension (frames have those), e.g. frames.jsonl");
     if (!pattern_ok(pattern) || strchr(pattern, '/'))
         return nc_cfg_key_error(opts, "pattern",
                                 "expected a file name with one %%llu conversion (flags - or 0, a width of at most 99), "

@@ -127,19 +127,20 @@ int nc_camera_from_config(struct nc_cfg_node *map, struct nc_camera *c)
     int rc = camera_read(map, c, &sum);
     if (rc < 0)
         return rc;
-    if ((rc = nc_cfg_vec3(map, "velocity_m_s", &c->velocity_m_s)) < 0 ||
+    if ((rc = nc_cfg_vec3_max(map, "velocity_m_s", NC_SPEED_MAX_M_S, "m/s", NC_SPEED_MAX_TEXT, &c->velocity_m_s)) < 0 ||
         (rc = nc_cfg_vec3(map, "angular_velocity_rad_s", &c->angular_velocity_rad_s)) < 0)
         return rc;
     if (c->from_sumfile) { /* the pose in bodies[0]'s frame (the scene moves it with that body) */
         c->position_m = nc_v3(-1e3 * sum.scobj_km[0], -1e3 * sum.scobj_km[1], -1e3 * sum.scobj_km[2]);
         c->attitude_q = sum.q;
+        if (!(nc_v3_norm(c->position_m) <= NC_CAMERA_MAX_M)) /* SCOBJ in metres read as km, say */
+            return nc_cfg_key_error(map, "sumfile", "SCOBJ puts the camera %g m from bodies[0]'s centre, beyond "
+                                    NC_CAMERA_MAX_TEXT " (SCOBJ is in km)", nc_v3_norm(c->position_m));
         return 0;
     }
-    if ((rc = nc_cfg_vec3(map, "position_m", &c->position_m)) <= 0)
+    if ((rc = nc_cfg_vec3_max(map, "position_m", NC_CAMERA_MAX_M, "m from the scene's origin", NC_CAMERA_MAX_TEXT,
+                              &c->position_m)) <= 0)
         return rc ? rc : nc_cfg_missing(map, "position_m", "[x, y, z] in metres, scene frame");
-    if (!(nc_v3_norm(c->position_m) <= NC_CAMERA_MAX_M))
-        return nc_cfg_key_error(map, "position_m", "%g m from the scene's origin, beyond %g m",
-                                nc_v3_norm(c->position_m), NC_CAMERA_MAX_M);
     struct nc_vec3 target, up = nc_v3(0, 0, 1);
     int hq = nc_cfg_quat(map, "attitude_q", &c->attitude_q);
     int ht = nc_cfg_vec3(map, "look_at_m", &target);

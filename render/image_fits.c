@@ -151,8 +151,28 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
             v = h + 1 - v;
         else if (up && (!strcmp(key, "CD1_2") || !strcmp(key, "CD2_2")))
             v = -v;
+        /* a number in digits alone (a frame number past 2^53 too) keeps every digit */
+        const char *digits = attrs[i].value + (attrs[i].value[0] == '-');
+        const int whole = digits[0] && strspn(digits, "0123456789") == strlen(digits) && v == floor(v);
+        long long sv = 0;
+        unsigned long long uv = 0;
+        int exact = 0;
+        if (whole) {
+            errno = 0;
+            sv = strtoll(attrs[i].value, NULL, 10);
+            exact = errno == 0 ? 1 : 0;
+            if (!exact && digits == attrs[i].value) {
+                errno = 0;
+                uv = strtoull(attrs[i].value, NULL, 10);
+                exact = errno == 0 ? 2 : 0;
+            }
+        }
         if (end != attrs[i].value && !*end && isfinite(v)) {
-            if (v == floor(v) && fabs(v) < 1e15 && !strpbrk(attrs[i].value, ".eE"))
+            if (exact == 1 && (double)sv == v)
+                fits_write_key_lng(f, key, sv, attrs[i].name, &status);
+            else if (exact == 2)
+                fits_write_key_ulng(f, key, uv, attrs[i].name, &status);
+            else if (v == floor(v) && fabs(v) < 1e15 && !strpbrk(attrs[i].value, ".eE"))
                 fits_write_key_lng(f, key, (LONGLONG)v, attrs[i].name, &status);
             else
                 fits_write_key_dbl(f, key, v, -17, attrs[i].name, &status);

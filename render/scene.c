@@ -164,9 +164,11 @@ static int body_read(struct nc_cfg *cfg, struct nc_cfg_node *item, int index, st
         return rc;
     b->position_m = nc_v3(0, 0, 0);
     b->attitude_q = (struct nc_quat){1, 0, 0, 0};
-    if ((rc = nc_cfg_vec3(item, "position_m", &b->position_m)) < 0 ||
+    if ((rc = nc_cfg_vec3_max(item, "position_m", NC_CAMERA_MAX_M, "m from the scene's origin", NC_CAMERA_MAX_TEXT,
+                              &b->position_m)) < 0 ||
         (rc = nc_cfg_quat(item, "attitude_q", &b->attitude_q)) < 0 ||
-        (rc = nc_cfg_vec3(item, "velocity_m_s", &b->velocity_m_s)) < 0 ||
+        (rc = nc_cfg_vec3_max(item, "velocity_m_s", NC_SPEED_MAX_M_S, "m/s", NC_SPEED_MAX_TEXT,
+                              &b->velocity_m_s)) < 0 ||
         (rc = nc_cfg_vec3(item, "angular_velocity_rad_s", &b->angular_velocity_rad_s)) < 0)
         return rc;
     return nc_cfg_check_unused_in(cfg, item);

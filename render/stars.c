@@ -13,6 +13,14 @@
 
 /* ---- drawing ------------------------------------------------------------------- */
 
+/* q's direction (scene frame) dt seconds from the middle of the exposure */
+static struct nc_vec3 point_dir(const struct nc_point_source *q, double dt)
+{
+    if (q->range_m <= 0 || dt == 0)
+        return q->dir;
+    return nc_v3_unit(nc_v3_add(nc_v3_scale(q->dir, q->range_m), nc_v3_scale(q->rel_velocity_m_s, dt)));
+}
+
 /* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance,
  * and as I/F k times that. */
 static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double y, double e, double k_iof)
@@ -46,16 +54,20 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
     int rc = nc_rt_update(r->rt, s); /* the bodies at the scene's (mid-exposure) poses */
     if (rc < 0)
         return rc;
-    /* Steps over the exposure: at most 0.1 px of turning apart (stars are
-     * at infinity: only the camera's rotation moves them). */
-    const double turn_px = nc_v3_norm(c->angular_velocity_rad_s) * exposure_s * fmax(c->fx_px, c->fy_px);
+    /* Steps over the exposure: at most 0.1 px of motion apart (stars are at
+     * infinity: only the camera's rotation moves them; a body's point also
+     * moves across the line of sight at up to its speed over its range). */
+    double rate = nc_v3_norm(c->angular_velocity_rad_s); /* rad/s, a bound on every point's */
+    for (size_t i = 0; i < n; i++)
+        if (p[i].range_m > 0)
+            rate = fmax(rate, nc_v3_norm(c->angular_velocity_rad_s) + nc_v3_norm(p[i].rel_velocity_m_s) / p[i].range_m);
+    const double turn_px = rate * exposure_s * fmax(c->fx_px, c->fy_px);
     const int K = turn_px > 0 ? (int)fmin(4096, ceil(turn_px / 0.1)) : 1;
     /* A rolling shutter exposes row y (y - (H - 1) / 2) line_time_s after
      * the middle row (y of the stored image: the view's rows counted from
      * its last for a view mirrored top to bottom): the camera has turned by
      * then, by up to roll_px. */
-    const double mid_row = 0.5 * (c->height_px - 1),
-                 roll_px = nc_v3_norm(c->angular_velocity_rad_s) * line_time_s * mid_row * fmax(c->fx_px, c->fy_px);
+    const double mid_row = 0.5 * (c->height_px - 1), roll_px = rate * line_time_s * mid_row * fmax(c->fx_px, c->fy_px);
     /* Only the stars the frame can show: projected at mid-exposure within
      * the frame, grown by the turn and a pixel. */
     size_t *in = malloc((n ? n : 1) * sizeof *in), m = 0;
@@ -93,7 +105,7 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
             for (int it = 0; it < 4 && roll_px > 0; it++) {
                 double x, y;
                 const struct nc_quat a = nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, t_row);
-                if (nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), q->dir), &x, &y) < 0)
+                if (nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), point_dir(q, t_row)), &x, &y) < 0)
                     break;
                 t_row = (y - mid_row) * (c->flip_rows ? -line_time_s : line_time_s); /* the stored image's rows */
             }
@@ -102,7 +114,7 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                 double dt = t_row + exposure_s * ((k + 0.5) / K - 0.5), x, y;
                 struct nc_quat a = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt)
                                            : c->attitude_q;
-                struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), q->dir); /* camera frame */
+                struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), point_dir(q, dt)); /* camera frame */
                 if (nc_camera_project(c, d, &x, &y) == 0)
                     shown |= splat(f, c, x, y, q->irradiance_w_m2 / K, q->iof_per_radiance);
             }
@@ -195,8 +207,10 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
         double J = s->sun.irradiance_w_m2; /* at the body: its I/F */
         if (s->sun.has_position)
             nc_scene_sun_at(s, s->body[b].position_m, &sdir, &J);
-        p[n++] = (struct nc_point_source){nc_v3_unit(nc_v3_add(rel, off)), hidden ? 0 : e * (dz / d) * (dz / d),
-                                          J > 0 ? M_PI / J : 0};
+        const struct nc_vec3 centroid = nc_v3_add(rel, off); /* from the camera, at mid-exposure */
+        p[n++] = (struct nc_point_source){nc_v3_unit(centroid), hidden ? 0 : e * (dz / d) * (dz / d),
+                                          J > 0 ? M_PI / J : 0, nc_v3_norm(centroid),
+                                          nc_v3_sub(s->body[b].velocity_m_s, c->velocity_m_s)};
         point[b] = 1;
     }
     memcpy(r->as_point, point, sizeof point);

@@ -52,11 +52,17 @@ struct nc_vec3 nc_aberrate(struct nc_vec3 p, struct nc_vec3 v_m_s);
  * its irradiance at the aperture in the renderer's units (W m^-2 as the
  * solar-equivalent total the camera model's band_fraction applies to);
  * iof_per_radiance, pi / J for a body lit by the solar irradiance J (its
- * I/F is pi L / J), 0 for a star (none in the I/F plane). */
+ * I/F is pi L / J), 0 for a star (none in the I/F plane). A body drawn as
+ * a point also has its distance (0 for a star: at infinity) and its
+ * velocity relative to the camera, so that it moves over the exposure as it
+ * moves, not only as the camera turns (its direction at time t from the
+ * middle, dir range_m + rel_velocity_m_s t, made unit). */
 struct nc_point_source {
     struct nc_vec3 dir;
     double irradiance_w_m2;
     double iof_per_radiance; /* sr m^2 W^-1 */
+    double range_m;
+    struct nc_vec3 rel_velocity_m_s; /* scene frame */
 };
 
 /* Add point sources to frame f (the scene camera's size; its pose is the
@@ -64,8 +70,8 @@ struct nc_point_source {
  * irradiance spread bilinearly over the four pixels around that point (so
  * the centroid keeps the sub-pixel position) as radiance E / Omega_pixel
  * (and I/F, iof_per_radiance times that); over the exposure (exposure_s,
- * the camera's rates) it moves as the camera turns, in steps of at most
- * 0.1 px; with a rolling shutter (line_time_s > 0; 0: global) its exposure
+ * the camera's rates) it moves as the camera turns and a body's point as
+ * it moves, in steps of at most 0.1 px; with a rolling shutter (line_time_s > 0; 0: global) its exposure
  * is that of the row it falls on, (row - (H - 1) / 2) line_time_s from the
  * middle one. With occlusion, a body in front hides it (traced with r's
  * ray tracer at the scene's poses). Returns how many were drawn (in the

@@ -319,13 +319,13 @@ expect 0 "wrote $tmp/dark_0005.png" -- "$navcam" expose "$cam" --dark -e 0.5 -n 
 for k in "CREATOR = 'NavCam" "QUANTITY= 'dn" "BUNIT   = 'adu" "INTRINS = '\[" "FRAME   =                    0"; do
   grep -aq "$k" "$tmp/flat.fits" && ok || bad "navcam expose's FITS header lacks $k"
 done
-# numbers on the command line: decimal digits, a value given, a frame number as typed (-f 1e30 was frame 0)
-expect 2 "--frame expects a whole number" -- "$navcam" render -o "$tmp/x.fits" -f 1e30
-expect 2 "--frame expects a whole number" -- "$navcam" render -o "$tmp/x.fits" -f -1
-expect 2 "--exposure expects 0..3600, got ''" -- "$navcam" render -o "$tmp/x.fits" -e ''
-expect 2 "--exposure expects 0..3600, got '0x10'" -- "$navcam" render -o "$tmp/x.fits" -e 0x10
+# numbers typed: decimal digits, a value given, a frame number as typed (-f 1e30 was frame 0), no wrap past 2^64 - 1
+for f in 1e30 -1; do expect 2 "--frame expects a whole number" -- "$navcam" render -o "$tmp/x.fits" -f $f; done
+for e in '' 0x10; do expect 2 "--exposure expects 0..3600, got '$e'" -- "$navcam" render -o "$tmp/x.fits" -e "$e"; done
 expect 2 "bad value '' for --radiance" -- "$navcam" expose "$cam" -L '' -o "$tmp/x.fits"
 expect 2 "bad value '1e30' for --first-frame" -- "$navcam" expose "$cam" -L 1 --first-frame 1e30 -o "$tmp/x.fits"
+expect 2 "--first-frame 18446744073709551615 with 2 frames goes past frame 2^64 - 1" -- \
+  "$navcam" expose "$cam" -L 1 -n 2 --first-frame 18446744073709551615 -o "$tmp/x.fits"
 # a body's name with a quote and a backslash: the dataset's JSON stays JSON
 "$navcam" batch builtin:approach -o "$tmp/bq" --shard 0/8 --no-geometry "${small[@]}" \
   --set 'bodies.0.name=rock "A"\1' > /dev/null 2>&1 &&

@@ -76,6 +76,16 @@ stop
 [ "$(json "$tmp/full/stats.json" "[(o['submitted'], o['failed']) for o in d['outputs']]")" = "[(0, 8), (8, 0)]" ] \
   && [ "$(grep -c "frames.jsonl: the frame's line not written: No space left on device" "$tmp/full/serve.log")" -ge 1 ] \
   && ok || bad "full sidecar: $(json "$tmp/full/stats.json" "d['outputs']"); $(grep jsonl "$tmp/full/serve.log" | head -2)"
+# The sidecar is a file name in the directory, never a frame's (one named frame_000001.fits lost every record
+# to that frame's file; ../up.jsonl was written outside the directory), refused before the scene is built.
+for sc in ../up.jsonl frame_000001.fits; do
+  out=$(cd "$tmp" && "$navcam" serve -t 0.5 \
+    --set "outputs=[{driver: file, pattern: 'frame_%06llu.fits', sidecar: '$sc'}]" 2>&1)
+  case "$?:$out" in
+    1:*"outputs[0].sidecar: expected a file name in the directory"*) ok ;;
+    *) bad "sidecar $sc: $out" ;;
+  esac
+done
 
 # A camera inside the body (two poses) and then outside it: those frames'
 # records say so, and the log warns once when it begins and once when it ends.

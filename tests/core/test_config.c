@@ -407,6 +407,31 @@ int main(void)
     }
     free(bomb), free(deep);
 
+    /* A --set key path is names joined by '.' with list items as [N] or .N; anything else is refused (an empty
+     * name or a stray bracket was dropped: camera..width_px set camera.width_px, bodies[[0].material.A the
+     * material's A) */
+    const char *bad_keys[] = {"camera..width_px=3", ".camera.width_px=3", "camera.width_px.=3", "camera.width]_px=3",
+                              "bodies[0.material.A=0.2", "bodies[[0].material.A=0.2", "bodies[]=1", "a[0]b=1"};
+    for (size_t i = 0; i < sizeof bad_keys / sizeof bad_keys[0]; i++) {
+        nc_cfg_init(&cfg);
+        CHECK(nc_cfg_set(&cfg, bad_keys[i]) < 0 && nc_test_contains(nc_errmsg(), "is no key path"), "--set %s: %s",
+              bad_keys[i], nc_errmsg());
+        nc_cfg_free(&cfg);
+    }
+    nc_cfg_init(&cfg);
+    CHECK(nc_cfg_set(&cfg, "bodies[0.material.A=0.2") < 0 &&
+              nc_test_contains(nc_errmsg(), "--set bodies[0.material.A=0.2: 'bodies[0.material.A' is no key path (at "
+                                            "its character 9, '.')"),
+          "the error says where: %s", nc_errmsg());
+    nc_cfg_free(&cfg);
+    nc_cfg_init(&cfg);
+    CHECK(nc_cfg_set(&cfg, "a=[[1, 2]]") == 0 && nc_cfg_set(&cfg, "a[0][1]=5") == 0 && nc_cfg_set(&cfg, "a.0.0=4") == 0,
+          "a[0][1] and a.0.0: %s", nc_errmsg());
+    struct nc_cfg_node *a0 = nc_cfg_get(cfg.root, "a")->child[0];
+    CHECK(!strcmp(a0->child[0]->value, "4") && !strcmp(a0->child[1]->value, "5"), "a[0] = [%s, %s]",
+          a0->child[0]->value, a0->child[1]->value);
+    nc_cfg_free(&cfg);
+
     /* An error about a key names it at its line, or at its map's when it is absent (a default that failed);
      * one about no node at all (nc_cfg_get of an absent key) still gives the message. */
     nc_cfg_init(&cfg);

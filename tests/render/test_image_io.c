@@ -118,6 +118,7 @@ static void fits_foreign(void)
         {"blank.fits", "BLANK", "-32768", NULL, 0},
         {"dscale.fits", "BSCALE", "2.0D0", NULL, 0},
         {"badscale.fits", "BSCALE", "'abc'", "badscale.fits: BSCALE = 'abc' is not a finite number", 0},
+        {"noscale.fits", "BSCALE", "", "noscale.fits: BSCALE =  is not a finite number", 0}, /* blank */
         {"big.fits", NULL, NULL, NULL, -DBL_MAX}, /* a float64 file's fill value: no data, as NaN */
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
@@ -247,8 +248,29 @@ static int tiff_tag(const char *path, unsigned tag)
     return found;
 }
 
+/* A whole number keeps every digit as a FITS integer: frame numbers past 2^53 were written as doubles
+ * (18446744073709551615 as 1.8446744073709552E+19). */
+static void fits_whole_numbers(void)
+{
+    const char *values[] = {"18446744073709551615", "9007199254740993", "-9007199254740993", "42"};
+    for (int i = 0; i < 4; i++) {
+        const char *path = nc_test_path("whole.fits");
+        const struct nc_image_attr a = {"navcam:frame", values[i]};
+        float img[4] = {0};
+        char card[FLEN_VALUE] = "";
+        int status = 0;
+        fitsfile *ff = NULL;
+        CHECK(nc_image_write(path, img, 2, 2, &a, 1, NULL) == 0, "FRAME %s: %s", values[i], nc_errmsg());
+        fits_open_image(&ff, path, READONLY, &status);
+        fits_read_keyword(ff, "FRAME", card, NULL, &status);
+        fits_close_file(ff, &status);
+        CHECK(status == 0 && !strcmp(card, values[i]), "FRAME %s written as '%s' (status %d)", values[i], card, status);
+    }
+}
+
 int main(void)
 {
+    fits_whole_numbers();
     struct nc_scene s;
     nc_test_scene(yaml, NULL, 0, &s);
     struct nc_frame f;

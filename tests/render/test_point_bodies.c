@@ -4,8 +4,10 @@
  * p J (R/D)^2 (p = 2A/3), at one sample a pixel as at sixteen, with its
  * centroid where it projects; a sphere in front hides it; a resolved body
  * is rendered as before; its I/F plane is pi L / J, like a resolved
- * body's. (A second body, off the Sun's line, is the screen that hides it
- * in one case.) */
+ * body's; moving across the line of sight (the camera's velocity or its
+ * own) it draws the streak of its motion, and under a rolling shutter it is
+ * where it is at its row's time. (A second body, off the Sun's line, is the
+ * screen that hides it in one case.) */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -27,7 +29,8 @@ static const char yaml[] = "bodies:\n"
                            "camera: {width_px: 64, height_px: 48, fx_px: 1000, fy_px: 1000,\n"
                            "         position_m: [0, 0, 0], attitude_q: [1, 0, 0, 0]}\n";
 
-static double iof_sum; /* the last shot's sum of I/F */
+static double iof_sum, rms_x;                        /* the last shot's sum of I/F, rms width along x (px) */
+static struct nc_exposure shot = {.exposure_s = 0.01}; /* the shots' exposure */
 
 static void shoot(const char *const *sets, int nsets, double *sum, double *cx, double *cy)
 {
@@ -35,21 +38,21 @@ static void shoot(const char *const *sets, int nsets, double *sum, double *cx, d
     nc_test_scene(yaml, sets, nsets, &s);
     struct nc_renderer r;
     struct nc_frame f;
-    struct nc_exposure ex = {.exposure_s = 0.01};
     nc_renderer_init(&r, &s, 2);
     nc_frame_alloc(&f, 64, 48);
-    CHECK(nc_render_exposure(&r, &s, &ex, &f, NULL) == 0, "render");
-    double m = 0, mx = 0, my = 0;
+    CHECK(nc_render_exposure(&r, &s, &shot, &f, NULL) == 0, "render");
+    double m = 0, mx = 0, my = 0, mxx = 0;
     iof_sum = 0;
     for (int y = 0; y < 48; y++)
         for (int x = 0; x < 64; x++) {
             double v = f.radiance[y * 64 + x];
-            m += v, mx += x * v, my += y * v;
+            m += v, mx += x * v, my += y * v, mxx += (double)x * x * v;
             iof_sum += f.iof[y * 64 + x];
         }
     *sum = m;
     *cx = m > 0 ? mx / m : NAN;
     *cy = m > 0 ? my / m : NAN;
+    rms_x = m > 0 ? sqrt(fmax(0, mxx / m - *cx * *cx)) : NAN;
     nc_frame_free(&f);
     nc_renderer_free(&r);
     nc_scene_free(&s);
@@ -87,6 +90,23 @@ int main(void)
     const double want6 = 2.0 / 3.0 * J * pow(6 / 1e4, 2) * 1e6;
     printf("1.2 px across on a pixel corner, 1 sample a pixel: %.6f of p J (R/D)^2\n", sum / want6);
     CHECK(fabs(sum / want6 - 1) < 0.005, "1.2 px on a pixel corner: %.5f of the analytic flux", sum / want6);
+    /* Moving across the line of sight at 20 km/s, 10 km away, fx 1000 px: 2000 px/s, a streak of 20 px in 0.01 s
+     * (the variance of a uniform streak, 400 / 12, and of the bilinear splat, 1 / 6); under a rolling shutter of
+     * 1e-3 s a row it is drawn at its row's time, (py - 23.5) 1e-3 s from the middle: 0.34 px further along x.
+     * (It was drawn still, with no streak, where it is at mid-exposure.) */
+    const char *moving[][2] = {{"camera.velocity_m_s=[20000, 0, 0]", "render.samples_per_pixel=1"},
+                               {"bodies.0.velocity_m_s=[-20000, 0, 0]", "render.samples_per_pixel=1"}};
+    for (int k = 0; k < 4; k++) {
+        shot = (struct nc_exposure){.exposure_s = 0.01, .rolling = k >= 2, .line_time_s = k >= 2 ? 1e-3 : 0};
+        shoot(moving[k % 2], 2, &sum, &cx, &cy);
+        const double want_x = px - 2000 * (k >= 2 ? (py - 23.5) * 1e-3 : 0), want_rms = sqrt(400.0 / 12 + 1.0 / 6);
+        printf("%s, %s shutter: streak rms %.4f px (%.4f), centroid x %.4f (%.4f), %.6f of the flux\n",
+               moving[k % 2][0], k >= 2 ? "rolling" : "global", rms_x, want_rms, cx, want_x, sum / want);
+        CHECK(fabs(rms_x - want_rms) < 0.02 && fabs(cx - want_x) < 0.01 && fabs(cy - py) < 0.01 &&
+                  fabs(sum / want - 1) < 0.005,
+              "%s: rms %.4f, centroid (%.4f, %.4f), flux %.5f", moving[k % 2][0], rms_x, cx, cy, sum / want);
+    }
+    shot = (struct nc_exposure){.exposure_s = 0.01};
     shoot(front, 2, &sum, &cx, &cy);
     printf("behind a black sphere: %.3g of the flux\n", sum / want);
     CHECK(sum < 1e-9 * want, "a body in front hides it: %.3g", sum / want);

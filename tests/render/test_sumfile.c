@@ -459,5 +459,18 @@ int main(void)
     expect_error(good, no_dist, 1, "distance_au");
     const char *with_size[] = {"camera.width_px=100"};
     expect_error(good, with_size, 1, "remove width_px");
+    /* The limits of every camera and body (core/pose.h): a SUM file's SCOBJ too (it went unchecked: a blank
+     * frame and a false warning of a camera inside a body), bodies' positions, speeds up to the speed of light
+     * (a camera faster than light lost its stars to NaN directions) */
+    replaced(bad, sizeof bad, good, "   -0.4000000000D+01    0.2000000000D+01",
+             "   -0.4000000000D+13    0.2000000000D+01");
+    expect_error(bad, NULL, 0, "camera.sumfile: SCOBJ puts the camera 4e+15 m from bodies[0]'s centre, beyond "
+                               "1e+15 m (SCOBJ is in km)");
+    const char *far_body[] = {"bodies.0.position_m=[0, 1e300, 0]"},
+               *fast_body[] = {"bodies.0.velocity_m_s=[3e8, 0, 0]"},
+               *fast_camera[] = {"camera.velocity_m_s=[0, 0, -3e9]"};
+    expect_error(good, far_body, 1, "bodies[0].position_m: 1e+300 m from the scene's origin, beyond 1e+15 m");
+    expect_error(good, fast_body, 1, "bodies[0].velocity_m_s: 3e+08 m/s, beyond the speed of light, 299792458 m/s");
+    expect_error(good, fast_camera, 1, "camera.velocity_m_s: 3e+09 m/s, beyond the speed of light");
     return nc_test_end();
 }
