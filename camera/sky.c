@@ -171,6 +171,9 @@ int nc_sky_draw(struct nc_sky *sky, struct nc_renderer *r, const struct nc_camsy
         half = fmax(half, acos(fmin(1, d.z)));
     }
     const struct nc_vec3 v = nc_v3_add(sky->observer_velocity_m_s, c->velocity_m_s);
+    if (!(nc_v3_norm(v) < NC_LIGHT_M_S)) /* each is within its limit, their sum need not be */
+        return nc_error(NC_ERANGE, "stars: the camera's velocity and observer_velocity_m_s add up to %.10g m/s, not "
+                        "under the speed of light", nc_v3_norm(v));
     const double rows_s = cs->sensor.shutter == NC_SHUTTER_ROLLING ? cs->sensor.line_time_s * c->height_px : 0;
     half += 0.5 * nc_v3_norm(c->angular_velocity_rad_s) * (exposure_s + rows_s) + 1.1 * nc_v3_norm(v) / NC_LIGHT_M_S +
             2.0 / fmin(c->fx_px, c->fy_px);

@@ -215,7 +215,7 @@ int nc_cfg_vec3_max(struct nc_cfg_node *parent, const char *key, double max, con
     const int rc = nc_cfg_vec3(parent, key, out);
     const double len = rc == 1 ? hypot(hypot(out->x, out->y), out->z) : 0; /* 1e300 is not inf */
     if (!(len <= max))
-        return nc_cfg_key_error(parent, key, "%g %s, beyond %s", len, what, limit);
+        return nc_cfg_key_error(parent, key, "%.10g %s, beyond %s", len, what, limit);
     return rc;
 }
 

@@ -52,6 +52,8 @@
 #include "emulator/output.h"
 #include "core/version.h"
 
+/* The pause between a stream channel's first leader and its payload, ns */
+#define FIRST_PAUSE_NS 5000000L
 
 struct gige {
     ArvGvFakeCamera *gv;
@@ -263,14 +265,17 @@ static void *sender_thread(void *arg)
             g->before_start++; /* the client asked for frames exposed from AcquisitionStart on */
             continue;
         }
-        if (atomic_exchange(&g->channel_closed, 0) || dest.sin_port != g->last_dest.sin_port ||
-            dest.sin_addr.s_addr != g->last_dest.sin_addr.s_addr) {
+        const int opened = atomic_exchange(&g->channel_closed, 0) || dest.sin_port != g->last_dest.sin_port ||
+                           dest.sin_addr.s_addr != g->last_dest.sin_addr.s_addr;
+        if (opened) {
             g->gvsp.block_id = 0; /* a stream channel opened: block ids from 1 (gige.md, "Block ids") */
             g->last_dest = dest;
         }
         uint32_t packet = nc__gige_reg(g->fc, REG_PACKET_SIZE) & 0xffff;
         pthread_mutex_unlock(&g->lock); /* submit() may pack and hand over the next frame meanwhile */
-        int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &g->im[k]);
+        /* A channel's first frame: its payload FIRST_PAUSE_NS after its leader, the time Aravis takes to size its
+         * socket buffer when a leader comes (gige.md, "Packet size and socket buffers") */
+        int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &g->im[k], opened ? FIRST_PAUSE_NS : 0);
         pthread_mutex_lock(&g->lock);
         if (rc < 0 && g->send_failed++ == 0)
             nc_log_warn("output/gige", "frame %llu: %s", (unsigned long long)g->rec[k].frame, nc_errmsg());

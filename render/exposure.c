@@ -166,14 +166,15 @@ static int time_samples_into(struct nc_renderer *r, const struct nc_scene *s, co
         int y0 = NC_TILE * r0, y1 = NC_TILE * r1 < H ? NC_TILE * r1 : H;
         double tc = band_times(ex, b, H, s->camera.flip_rows, row_dt);
         /* the rocks seen at the middle of the exposure: its time sample for an odd K; an even K has none
-         * there (K / 2 is T / 2K after it), so a pass of its own, with that sample's strata, renders them */
-        for (int k = 0; k < K + (f->rock_id && K % 2 == 0) && rc >= 0; k++) {
+         * there (K / 2 is T / 2K after it), so a pass of its own (k = -1, first: the renderer's state after
+         * the band is the last sample's, as without it), with that sample's strata, renders them */
+        for (int k = f->rock_id && K % 2 == 0 ? -1 : 0; k < K && rc >= 0; k++) {
             struct nc_scene at;
-            nc_scene_propagate(s, tc + (k < K ? T * ((k + 0.5) / K - 0.5) : 0), &at);
-            const struct nc_sample_pass pass = {k < K ? k : K / 2, K, K > S ? K : S};
-            if ((rc = nc_render_rows_timed(r, &at, sub, r0, r1, row_dt, &pass)) >= 0 && k < K)
+            nc_scene_propagate(s, tc + (k >= 0 ? T * ((k + 0.5) / K - 0.5) : 0), &at);
+            const struct nc_sample_pass pass = {k >= 0 ? k : K / 2, K, K > S ? K : S};
+            if ((rc = nc_render_rows_timed(r, &at, sub, r0, r1, row_dt, &pass)) >= 0 && k >= 0)
                 accumulate(&a, sub, (size_t)y0 * W, (size_t)y1 * W, k == 0);
-            if (rc >= 0 && f->rock_id && k == (K % 2 ? K / 2 : K))
+            if (rc >= 0 && f->rock_id && k == (K % 2 ? K / 2 : -1))
                 memcpy(f->rock_id + (size_t)y0 * W, sub->rock_id + (size_t)y0 * W,
                        (size_t)(y1 - y0) * (size_t)W * sizeof *f->rock_id);
         }

@@ -147,13 +147,12 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
                                &status);
         /* Numbers as FITS numbers (EXPTIME, ADCBITS, ...), the rest as strings. */
         double v = strtod(attrs[i].value, &end);
-        if (up && !strcmp(key, "CRPIX2")) /* the WCS of top-down rows, turned: FITS row p2 becomes h + 1 - p2 */
-            v = h + 1 - v;
-        else if (up && (!strcmp(key, "CD1_2") || !strcmp(key, "CD2_2")))
-            v = -v;
+        const int turned = up && (!strcmp(key, "CRPIX2") || !strcmp(key, "CD1_2") || !strcmp(key, "CD2_2"));
+        if (turned) /* the WCS of top-down rows, turned: FITS row p2 becomes h + 1 - p2 */
+            v = !strcmp(key, "CRPIX2") ? h + 1 - v : -v;
         /* a number in digits alone (a frame number past 2^53 too) keeps every digit */
         const char *digits = attrs[i].value + (attrs[i].value[0] == '-');
-        const int whole = digits[0] && strspn(digits, "0123456789") == strlen(digits) && v == floor(v);
+        const int whole = !turned && digits[0] && strspn(digits, "0123456789") == strlen(digits);
         long long sv = 0;
         unsigned long long uv = 0;
         int exact = 0;
@@ -168,7 +167,7 @@ int nc__fits_write(const char *path, const void *px, enum nc__pixel type, int w,
             }
         }
         if (end != attrs[i].value && !*end && isfinite(v)) {
-            if (exact == 1 && (double)sv == v)
+            if (exact == 1)
                 fits_write_key_lng(f, key, sv, attrs[i].name, &status);
             else if (exact == 2)
                 fits_write_key_ulng(f, key, uv, attrs[i].name, &status);

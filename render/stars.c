@@ -21,6 +21,40 @@ static struct nc_vec3 point_dir(const struct nc_point_source *q, double dt)
     return nc_v3_unit(nc_v3_add(nc_v3_scale(q->dir, q->range_m), nc_v3_scale(q->rel_velocity_m_s, dt)));
 }
 
+/* *h = t - (row - mid) row_s: how far t is from the time of the row where the camera of time t sees q at time t
+ * (row_s: the time from one stored row to the next, negative for a view mirrored top to bottom); -1 if q is not
+ * in front of that camera. */
+static int row_gap(const struct nc_camera *c, const struct nc_point_source *q, double t, double mid, double row_s,
+                   double *h)
+{
+    double x, y;
+    const struct nc_quat a = nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, t);
+    if (nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), point_dir(q, t)), &x, &y) < 0)
+        return -1;
+    *h = t - (y - mid) * row_s;
+    return 0;
+}
+
+/* The time (from the middle row's) of the row q falls on under a rolling shutter: the root of row_gap, by secant
+ * steps from 0 within the readout's span (the row moves nearly linearly with time, as the camera turns and a body
+ * moves: one step is close, a few exact; a fixed-point iteration, each step the row of the last time, strayed
+ * where a point moves along the columns by a row or more per row's time). */
+static double row_time(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s)
+{
+    const double span = (mid + 1) * fabs(row_s);
+    double t0 = 0, h0, t1, h1;
+    if (row_gap(c, q, t0, mid, row_s, &h0) < 0)
+        return 0;
+    t1 = fmin(span, fmax(-span, -h0));
+    for (int it = 0; it < 8 && t1 != t0 && row_gap(c, q, t1, mid, row_s, &h1) == 0 && h1 != 0; it++) {
+        const double t2 = t1 - h1 * (t1 - t0) / (h1 - h0);
+        if (!isfinite(t2))
+            break;
+        t0 = t1, h0 = h1, t1 = fmin(span, fmax(-span, t2));
+    }
+    return t1;
+}
+
 /* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance,
  * and as I/F k times that. */
 static int splat(struct nc_frame *f, const struct nc_camera *c, double x, double y, double e, double k_iof)
@@ -98,17 +132,8 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                 ++*hidden;
                 continue;
             }
-            /* the time of the row it falls on (rolling): found by fixed-point
-             * iteration, each step the row where the camera of the last sees it
-             * (the turn over a row's time is a small fraction of a row) */
-            double t_row = 0;
-            for (int it = 0; it < 4 && roll_px > 0; it++) {
-                double x, y;
-                const struct nc_quat a = nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, t_row);
-                if (nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), point_dir(q, t_row)), &x, &y) < 0)
-                    break;
-                t_row = (y - mid_row) * (c->flip_rows ? -line_time_s : line_time_s); /* the stored image's rows */
-            }
+            /* the time of the row it falls on (rolling; the stored image's rows) */
+            const double t_row = roll_px > 0 ? row_time(c, q, mid_row, c->flip_rows ? -line_time_s : line_time_s) : 0;
             int shown = 0;
             for (int k = 0; k < K; k++) {
                 double dt = t_row + exposure_s * ((k + 0.5) / K - 0.5), x, y;

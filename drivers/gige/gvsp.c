@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -72,7 +73,7 @@ static int flush(struct nc__gvsp *s, struct mmsghdr *m, int n)
 }
 
 int nc__gvsp_send(struct nc__gvsp *s, const struct sockaddr_in *dest, uint32_t packet_size,
-                  const struct nc__gvsp_image *im)
+                  const struct nc__gvsp_image *im, long pause_ns)
 {
     if (packet_size <= OVERHEAD + 4 || packet_size > 65500)
         return nc_error(NC_ERANGE, "gige: packet size %u bytes", packet_size);
@@ -118,12 +119,14 @@ int nc__gvsp_send(struct nc__gvsp *s, const struct sockaddr_in *dest, uint32_t p
         m[n].msg_hdr.msg_iov = iov[n];
         m[n].msg_hdr.msg_name = (void *)dest;
         m[n].msg_hdr.msg_namelen = sizeof *dest;
-        if (++n == BATCH || id == npay + 1) {
+        if (++n == BATCH || id == npay + 1 || (id == 0 && pause_ns > 0)) {
             size_t need = id * chunk < im->size ? id * chunk : im->size; /* the batch's last byte */
             while (im->ready && atomic_load_explicit(im->ready, memory_order_acquire) < need)
                 sched_yield(); /* rarely: the packer runs 3 times faster than this sends */
             rc = flush(s, m, n);
             n = 0;
+            if (id == 0 && pause_ns > 0 && rc == 0)
+                nanosleep(&(struct timespec){pause_ns / 1000000000, pause_ns % 1000000000}, NULL);
         }
     }
     return rc;

@@ -40,11 +40,12 @@ struct nc__gvsp_image {
 /* A UDP socket bound to addr (the device's IPv4 address), any port. */
 int nc__gvsp_open(struct nc__gvsp *s, const char *addr);
 /* One image block to dest in packets of packet_size bytes (IP and UDP
- * headers included, as GevSCPSPacketSize counts them). Returns 0, or a
- * negative errno when the socket refused a packet (the block is then
+ * headers included, as GevSCPSPacketSize counts them); with pause_ns > 0
+ * the leader goes alone and the payload that long after it. Returns 0, or
+ * a negative errno when the socket refused a packet (the block is then
  * incomplete at the client). */
 int nc__gvsp_send(struct nc__gvsp *s, const struct sockaddr_in *dest, uint32_t packet_size,
-                  const struct nc__gvsp_image *im);
+                  const struct nc__gvsp_image *im, long pause_ns);
 void nc__gvsp_close(struct nc__gvsp *s);
 
 #endif

@@ -101,6 +101,31 @@ static void rock_id_mid_exposure(void)
         nc_scene_free(&s);
     }
     free(still);
+    /* The renderer's state after such a frame, the rock cut the frame records (navcam:boulder_min_m) included, is
+     * its last sample's with the plane or without it (the pass of its own came last at first: a camera moving
+     * toward the body recorded another cut when the plane was asked for). */
+    sets[3] = "render.boulder_min_px=20", sets[4] = "camera.velocity_m_s=[0, 20000, 0]";
+    double cut[2] = {0};
+    int ks[2] = {0};
+    for (int w = 0; w < 2; w++) {
+        struct nc_scene s;
+        nc_test_scene(nc_test_asteroid_yaml, sets, 5, &s);
+        struct nc_exposure ex = {.exposure_s = 0.01};
+        struct nc_frame f = {0};
+        struct nc_renderer r;
+        CHECK(nc_renderer_init(&r, &s, 2) == 0 && nc_frame_alloc(&f, 128, 128) == 0 &&
+                  (!w || (f.rock_id = malloc(n * sizeof *f.rock_id)) != NULL) &&
+                  nc_render_exposure(&r, &s, &ex, &f, &ks[w]) == 0,
+              "%s", nc_errmsg());
+        cut[w] = nc_rt_boulder_min_m(r.rt);
+        nc_frame_free(&f);
+        nc_renderer_free(&r);
+        nc_scene_free(&s);
+    }
+    printf("moving toward the body, %d time samples: the recorded rock cut %.6f m without the rock_id plane, %.6f m "
+           "with it\n", ks[0], cut[0], cut[1]);
+    CHECK(ks[0] % 2 == 0 && ks[1] == ks[0] && cut[0] == cut[1], "K %d, %d: the cut %.6f m, %.6f m", ks[0], ks[1],
+          cut[0], cut[1]);
 }
 
 /* The least-squares slope over the rows of each 96-px row's centroid of
