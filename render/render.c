@@ -1113,11 +1113,13 @@ static void shade_tile(struct job *j, int tile)
                         if (planes)
                             hard[i] = sf.body[i] >= 0 ? hard[i] * sf.irr[i] : 0.0;
                     }
+                    int seen[NC_PACKET]; /* the body each sample met (indirect16 walks sf on along its path) */
+                    memcpy(seen, sf.body, sizeof seen);
                     if (j->bounces > 0)
                         indirect16(j, &sf, x0 + bx, y0 + by, sidx, L, iof, &cnt);
                     for (int i = 0; i < NC_PACKET; i++) {
                         int o = (by + (i >> 2)) * TILE + bx + (i & 3);
-                        if (sf.body[i] >= 0 && j->r->as_point[sf.body[i]])
+                        if (seen[i] >= 0 && j->r->as_point[seen[i]])
                             L[i] = iof[i] = sun[i] = hard[i] = 0; /* its light comes as a point (nc_render_exposure) */
                         acc_L[o] += L[i];
                         acc_iof[o] += iof[i];

@@ -208,10 +208,15 @@ int nc_render_point_bodies(struct nc_renderer *r, const struct nc_scene *s, stru
         nc_quat_look_at(at, s->body[b].position_m, up, &z.camera.attitude_q);
         z.render.samples_per_pixel = 16;
         z.render.quality_auto = 0;
+        /* its light alone: the other bodies in the zoom hide it where they are in front but give no light (they
+         * are counted in the frame, or as points of their own: a moon's zoom summed the primary beside it) */
+        for (int o = 0; o < s->nbodies; o++)
+            r->as_point[o] = o != b;
         struct nc_frame zf;
         int rc = nc_frame_alloc(&zf, Z, Z);
         if (rc >= 0)
             rc = nc_render_frame(r, &z, &zf);
+        memset(r->as_point, 0, sizeof r->as_point);
         if (rc < 0) {
             nc_frame_free(&zf);
             return rc;

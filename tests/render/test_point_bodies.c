@@ -6,8 +6,10 @@
  * is rendered as before; its I/F plane is pi L / J, like a resolved
  * body's; moving across the line of sight (the camera's velocity or its
  * own) it draws the streak of its motion, and under a rolling shutter it is
- * where it is at its row's time. (A second body, off the Sun's line, is the
- * screen that hides it in one case.) */
+ * where it is at its row's time; its light is its own (a zoom that also
+ * shows a larger body beside it counts none of that body's light), and
+ * indirect light adds none to a lone convex body. (A second body, off the
+ * Sun's line, is the screen that hides it in one case.) */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -121,6 +123,31 @@ int main(void)
               "%s: centroid (%.4f, %.4f), flux %.5f", along_y[k][0], cx, cy, sum / want);
     }
     shot = (struct nc_exposure){.exposure_s = 0.01};
+    /* Indirect light on a lone convex body is none: 1 bounce gives the frame of 0 (the point's direct light was
+     * counted again from its traced samples whose bounce ray escaped: 2.13 times the light in an outside check) */
+    const char *one = "bodies=[{shape: {type: sphere, radius_m: 2}, position_m: [3.3, -1.7, 10000], "
+                      "material: {model: lambert, A: 1}}]";
+    const char *lone[2][3] = {{one, "render.bounces=0", "render.samples_per_pixel=16"},
+                              {one, "render.bounces=1", "render.samples_per_pixel=16"}};
+    double sum_b[2];
+    for (int k = 0; k < 2; k++)
+        shoot(lone[k], 3, &sum_b[k], &cx, &cy);
+    printf("alone, 1 bounce against none: %.9f of the light\n", sum_b[1] / sum_b[0]);
+    CHECK(fabs(sum_b[1] / sum_b[0] - 1) < 1e-9, "1 bounce: %.6f of the light without", sum_b[1] / sum_b[0]);
+    /* A black moon (0.8 px) wholly behind a primary 4 px across: the frame is the primary's alone (the moon's
+     * zoom, +-1.33 radii about it, summed the primary's light in front of it: +13 % of the frame outside) */
+    const char *primary = "{name: primary, shape: {type: sphere, radius_m: 400}, position_m: [0, 0, 200000], "
+                          "material: {model: lambert, A: 1}}";
+    char alone[256], pair[512];
+    snprintf(alone, sizeof alone, "bodies=[%s]", primary);
+    snprintf(pair, sizeof pair, "bodies=[%s, {name: moon, shape: {type: sphere, radius_m: 80}, position_m: [0, 0, "
+             "201200], material: {model: lambert, A: 0}}]", primary);
+    const char *with_primary[2][2] = {{alone, "render.samples_per_pixel=16"}, {pair, "render.samples_per_pixel=16"}};
+    for (int k = 0; k < 2; k++)
+        shoot(with_primary[k], 2, &sum_b[k], &cx, &cy);
+    printf("a black moon behind the primary: %.9f of the primary's light alone\n", sum_b[1] / sum_b[0]);
+    CHECK(fabs(sum_b[1] / sum_b[0] - 1) < 1e-9, "the black moon behind: %.6f of the primary's light",
+          sum_b[1] / sum_b[0]);
     shoot(front, 2, &sum, &cx, &cy);
     printf("behind a black sphere: %.3g of the flux\n", sum / want);
     CHECK(sum < 1e-9 * want, "a body in front hides it: %.3g", sum / want);
