@@ -119,11 +119,14 @@ int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_imag
                            sx * deg * nc_v3_dot(x, north) / c->fx_px, sy * deg * nc_v3_dot(y, north) / c->fy_px};
     static const char *const nkeys[8] = {"fits:CRVAL1", "fits:CRVAL2", "fits:CRPIX1", "fits:CRPIX2",
                                          "fits:CD1_1",  "fits:CD1_2",  "fits:CD2_1",  "fits:CD2_2"};
-    static const char *const skeys[6][2] = {{"fits:WCSAXES", "2"},        {"fits:CTYPE1", "RA---TAN"},
+    /* LONPOLE 180, the default everywhere but at a boresight on the north pole (Dec +90 exactly, the identity
+     * attitude), where FITS's default of 0 turned the frame by 180 deg in every reader */
+    static const char *const skeys[7][2] = {{"fits:WCSAXES", "2"},        {"fits:CTYPE1", "RA---TAN"},
                                             {"fits:CTYPE2", "DEC--TAN"}, {"fits:CUNIT1", "deg"},
-                                            {"fits:CUNIT2", "deg"},      {"fits:RADESYS", "ICRS"}};
+                                            {"fits:CUNIT2", "deg"},      {"fits:RADESYS", "ICRS"},
+                                            {"fits:LONPOLE", "180"}};
     int n = 0;
-    for (int k = 0; k < 6; k++)
+    for (int k = 0; k < 7; k++)
         out[n++] = (struct nc_image_attr){skeys[k][0], skeys[k][1]};
     for (int k = 0; k < 8; k++) {
         snprintf(val[k], sizeof val[k], "%.17g", num[k]);

@@ -45,7 +45,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
             const struct nc_image_attr *extra, int nextra, struct nc_shot_info *info);
 
 /* A celestial WCS (TAN, ICRS) of camera c's stored image as FITS
- * attributes ("fits:CTYPE1", ...) into out[14], their numbers' text in
+ * attributes ("fits:CTYPE1", ...) into out[15], their numbers' text in
  * val; 0 (none) for a distorted camera. Returns how many. */
 int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_image_attr *out);
 /* The detail a frame was rendered with, read off its renderer after the

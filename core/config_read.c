@@ -214,8 +214,13 @@ int nc_cfg_vec3_max(struct nc_cfg_node *parent, const char *key, double max, con
 {
     const int rc = nc_cfg_vec3(parent, key, out);
     const double len = rc == 1 ? hypot(hypot(out->x, out->y), out->z) : 0; /* 1e300 is not inf */
+    int digits = 6; /* as few as show it beyond the limit, nearer it than the limit (not "1e+15 m" for 1e15 + 1) */
+    char text[32];
+    while (snprintf(text, sizeof text, "%.*g", digits, len) > 0 && digits < 17 &&
+           !(strtod(text, NULL) > max && fabs(strtod(text, NULL) - len) < len - max))
+        digits++;
     if (!(len <= max))
-        return nc_cfg_key_error(parent, key, "%.10g %s, beyond %s", len, what, limit);
+        return nc_cfg_key_error(parent, key, "%s %s, beyond %s", text, what, limit);
     return rc;
 }
 

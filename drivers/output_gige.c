@@ -52,9 +52,6 @@
 #include "emulator/output.h"
 #include "core/version.h"
 
-/* The pause between a stream channel's first leader and its payload, ns */
-#define FIRST_PAUSE_NS 5000000L
-
 struct gige {
     ArvGvFakeCamera *gv;
     ArvFakeCamera *fc;
@@ -273,9 +270,7 @@ static void *sender_thread(void *arg)
         }
         uint32_t packet = nc__gige_reg(g->fc, REG_PACKET_SIZE) & 0xffff;
         pthread_mutex_unlock(&g->lock); /* submit() may pack and hand over the next frame meanwhile */
-        /* A channel's first frame: its payload FIRST_PAUSE_NS after its leader, the time Aravis takes to size its
-         * socket buffer when a leader comes (gige.md, "Packet size and socket buffers") */
-        int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &g->im[k], opened ? FIRST_PAUSE_NS : 0);
+        int rc = nc__gvsp_send(&g->gvsp, &dest, packet, &g->im[k], opened);
         pthread_mutex_lock(&g->lock);
         if (rc < 0 && g->send_failed++ == 0)
             nc_log_warn("output/gige", "frame %llu: %s", (unsigned long long)g->rec[k].frame, nc_errmsg());

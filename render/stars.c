@@ -35,24 +35,29 @@ static int row_gap(const struct nc_camera *c, const struct nc_point_source *q, d
     return 0;
 }
 
-/* The time (from the middle row's) of the row q falls on under a rolling shutter: the root of row_gap, by secant
- * steps from 0 within the readout's span (the row moves nearly linearly with time, as the camera turns and a body
- * moves: one step is close, a few exact; a fixed-point iteration, each step the row of the last time, strayed
- * where a point moves along the columns by a row or more per row's time). */
-static double row_time(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s)
+/* The time (from the middle row's) of the row q falls on under a rolling shutter, *t: the root of row_gap, by
+ * secant steps from 0 (the row moves nearly linearly with time, as the camera turns and a body moves: one step is
+ * close, a few exact; a fixed-point iteration, each step the row of the last time, strayed where a point moves
+ * along the columns by a row or more per row's time). A row off the frame is a root too: the point is drawn about
+ * it, off the frame or at its edge (the steps were once held to the readout's span, and a point crossing it
+ * off the frame was drawn, whole, where it was at the span's end, inside the frame). -1 where the steps find no
+ * row within 4 readouts (a point moving with the readout, about a row per row's time): not drawn. */
+static int row_time(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s, double *t)
 {
-    const double span = (mid + 1) * fabs(row_s);
+    const double span = 4 * (mid + 1) * fabs(row_s); /* a bound on the steps alone */
     double t0 = 0, h0, t1, h1;
-    if (row_gap(c, q, t0, mid, row_s, &h0) < 0)
-        return 0;
-    t1 = fmin(span, fmax(-span, -h0));
-    for (int it = 0; it < 8 && t1 != t0 && row_gap(c, q, t1, mid, row_s, &h1) == 0 && h1 != 0; it++) {
+    if (row_gap(c, q, t0, mid, row_s, &h0) < 0 || row_gap(c, q, t1 = fmin(span, fmax(-span, -h0)), mid, row_s, &h1))
+        return -1;
+    for (int it = 0; it < 8 && t1 != t0 && h1 != 0; it++) {
         const double t2 = t1 - h1 * (t1 - t0) / (h1 - h0);
         if (!isfinite(t2))
             break;
         t0 = t1, h0 = h1, t1 = fmin(span, fmax(-span, t2));
+        if (row_gap(c, q, t1, mid, row_s, &h1) < 0)
+            return -1;
     }
-    return t1;
+    *t = t1;
+    return fabs(h1) <= 0.5 * fabs(row_s) ? 0 : -1;
 }
 
 /* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance,
@@ -133,7 +138,9 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                 continue;
             }
             /* the time of the row it falls on (rolling; the stored image's rows) */
-            const double t_row = roll_px > 0 ? row_time(c, q, mid_row, c->flip_rows ? -line_time_s : line_time_s) : 0;
+            double t_row = 0;
+            if (roll_px > 0 && row_time(c, q, mid_row, c->flip_rows ? -line_time_s : line_time_s, &t_row) < 0)
+                continue;
             int shown = 0;
             for (int k = 0; k < K; k++) {
                 double dt = t_row + exposure_s * ((k + 0.5) / K - 0.5), x, y;

@@ -22,7 +22,7 @@ pkgs=(cmake make gcc g++ pkg-config libembree-dev libopenimageio-dev libyaml-dev
       gnuplot-nox)
 case "$(uname -m)" in x86_64) pkgs+=(libsleef-dev) ;; esac
 if [ "${1:-}" = --test ]; then
-  pkgs+=(clang libclang-rt-14-dev valgrind aravis-tools-cli gpiod v4l-utils astrometry.net
+  pkgs+=(clang libclang-rt-14-dev valgrind python3-astropy aravis-tools-cli gpiod v4l-utils astrometry.net
          astrometry-data-tycho2-10-19-littleendian slurmctld slurmd slurm-client munge)
   case "$(uname -m)" in
     x86_64) pkgs+=(qemu-system-x86 busybox-static cpio kmod xz-utils dkms linux-headers-amd64 v4l2loopback-dkms udev) ;;

@@ -73,8 +73,9 @@ static int flush(struct nc__gvsp *s, struct mmsghdr *m, int n)
 }
 
 int nc__gvsp_send(struct nc__gvsp *s, const struct sockaddr_in *dest, uint32_t packet_size,
-                  const struct nc__gvsp_image *im, long pause_ns)
+                  const struct nc__gvsp_image *im, int first)
 {
+    const long pause_ns = first ? NC_GVSP_FIRST_PAUSE_NS : 0;
     if (packet_size <= OVERHEAD + 4 || packet_size > 65500)
         return nc_error(NC_ERANGE, "gige: packet size %u bytes", packet_size);
     const size_t chunk = packet_size - OVERHEAD;

@@ -40,12 +40,15 @@ struct nc__gvsp_image {
 /* A UDP socket bound to addr (the device's IPv4 address), any port. */
 int nc__gvsp_open(struct nc__gvsp *s, const char *addr);
 /* One image block to dest in packets of packet_size bytes (IP and UDP
- * headers included, as GevSCPSPacketSize counts them); with pause_ns > 0
- * the leader goes alone and the payload that long after it. Returns 0, or
- * a negative errno when the socket refused a packet (the block is then
- * incomplete at the client). */
+ * headers included, as GevSCPSPacketSize counts them); the first block of
+ * a stream channel (first != 0) has its payload NC_GVSP_FIRST_PAUSE_NS
+ * after its leader, the time Aravis takes to size its socket buffer when a
+ * leader comes (docs/gige.md, "Packet size and socket buffers"). Returns
+ * 0, or a negative errno when the socket refused a packet (the block is
+ * then incomplete at the client). */
 int nc__gvsp_send(struct nc__gvsp *s, const struct sockaddr_in *dest, uint32_t packet_size,
-                  const struct nc__gvsp_image *im, long pause_ns);
+                  const struct nc__gvsp_image *im, int first);
+#define NC_GVSP_FIRST_PAUSE_NS 5000000L
 void nc__gvsp_close(struct nc__gvsp *s);
 
 #endif

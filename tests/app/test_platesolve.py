@@ -183,4 +183,31 @@ stars: {{catalogue: '{index}'}}
     print(f"{name}: {stars_line[0].strip()}; solved centre {solved[0][0]:.5f} {solved[0][1]:.5f} "
           f"(pose {truth[0][0]:.5f} {truth[0][1]:.5f}): pointing off by {err_point:.2f} arcsec, "
           f"roll by {err_roll:+.4f} deg {'ok' if ok else 'FAILED (5 arcsec, 0.05 deg)'}")
+# The boresight on the celestial pole (the identity attitude, Dec +90 exactly), NavCam's WCS read by astropy: with
+# LONPOLE 180 (FITS's default there is 0; without it every reader turned the frame by 180 deg, stars 693 px off).
+from astropy.io import fits
+from astropy.wcs import WCS
+f_m = W * PITCH / (2 * math.tan(math.radians(20) / 2))
+f_px = f_m / PITCH
+pole, pole_fits = os.path.join(tmp, "pole.yaml"), os.path.join(tmp, "pole.fits")
+with open(pole, "w") as fh:
+    fh.write(f"""bodies: [{{shape: {{type: sphere, radius_m: 1000}}, position_m: [0, 0, -1.0e7],
+          material: {{model: lambert, A: 0.1}}}}]
+sun: {{direction: [0, 0, -1]}}
+camera: {{width_px: {W}, height_px: {H}, focal_length_m: {f_m!r}, pixel_pitch_m: {PITCH}, position_m: [0, 0, 0],
+         attitude_q: [1, 0, 0, 0]}}
+render: {{samples_per_pixel: 1}}
+optics: {{f_number: 4.0, passband: {{from_m: 5.0e-7, to_m: 7.0e-7}}}}
+stars: {{catalogue: '{index}'}}
+""")
+subprocess.run([navcam, "render", pole, "-o", pole_fits, "-q", "electrons"], check=True, capture_output=True)
+wcs = WCS(fits.getheader(pole_fits))
+cx, cy = (W - 1) / 2, (H - 1) / 2
+ident = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+worst = max(sep_arcsec(tuple(wcs.all_pix2world([[px + 1, py + 1]], 1)[0]), sky_of_pixel(ident, f_px, px, py))
+            for px, py in ((cx + 100, cy), (cx - 300, cy - 400), (0, H - 1)))
+ok = worst < 0.01
+failed += not ok
+print(f"the pole (identity attitude): NavCam's WCS read by astropy, worst {worst:.2e} arcsec "
+      f"{'ok' if ok else 'FAILED (0.01 arcsec)'}")
 sys.exit(1 if failed else 0)

@@ -470,7 +470,9 @@ int main(void)
                *fast_body[] = {"bodies.0.velocity_m_s=[3e8, 0, 0]"},
                *fast_camera[] = {"camera.velocity_m_s=[0, 0, -3e9]"};
     expect_error(good, far_body, 1, "bodies[0].position_m: 1e+300 m from the scene's origin, beyond 1e+15 m");
-    expect_error(good, fast_body, 1, "bodies[0].velocity_m_s: 300000000 m/s, beyond the speed of light, 299792458 m/s");
-    expect_error(good, fast_camera, 1, "camera.velocity_m_s: 3000000000 m/s, beyond the speed of light");
+    const char *just_beyond[] = {"bodies.0.position_m=[1000000000000001, 0, 0]"}; /* as many digits as that takes */
+    expect_error(good, just_beyond, 1, "bodies[0].position_m: 1000000000000001 m from the scene's origin");
+    expect_error(good, fast_body, 1, "bodies[0].velocity_m_s: 3e+08 m/s, beyond the speed of light, 299792458 m/s");
+    expect_error(good, fast_camera, 1, "camera.velocity_m_s: 3e+09 m/s, beyond the speed of light");
     return nc_test_end();
 }
