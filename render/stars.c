@@ -35,29 +35,87 @@ static int row_gap(const struct nc_camera *c, const struct nc_point_source *q, d
     return 0;
 }
 
-/* The time (from the middle row's) of the row q falls on under a rolling shutter, *t: the root of row_gap, by
- * secant steps from 0 (the row moves nearly linearly with time, as the camera turns and a body moves: one step is
- * close, a few exact; a fixed-point iteration, each step the row of the last time, strayed where a point moves
- * along the columns by a row or more per row's time). A row off the frame is a root too: the point is drawn about
- * it, off the frame or at its edge (the steps were once held to the readout's span, and a point crossing it
- * off the frame was drawn, whole, where it was at the span's end, inside the frame). -1 where the steps find no
- * row within 4 readouts (a point moving with the readout, about a row per row's time): not drawn. */
-static int row_time(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s, double *t)
+/* The times a point is recorded at, from the middle row's, as spans ta..tb. Under a rolling shutter row y is open
+ * (y - mid) row_s +- T / 2 (row_s: the time from one stored row to the next, negative for a view mirrored top to
+ * bottom), so a point is recorded while |row_gap| <= T / 2, within +-open, the times a row of the frame or one
+ * beside it is open. row_gap mostly goes linearly with time (the camera turns and a body moves steadily; its slope
+ * is 1 - v, v the point's speed along the columns in rows per row's time): then one span, T / |slope| long about
+ * the root of row_gap (the time of the row the point falls on: by secant steps from 0, the slope by a difference
+ * about it), checked at its ends; else (a fast turn bends it, or it has no root) the spans a scan of row_gap over
+ * +-open finds, their ends by bisection. With T = 0, the root alone, *gain 1 / |slope| (the record's density
+ * there). Returns how many spans (at most max). (Until session 66 a point was drawn over T about a root found by
+ * fixed-point steps, which strayed for motion along the columns: recorded as long as T whatever v.) */
+struct span {
+    double ta, tb;
+};
+
+static int band(const struct nc_camera *c, const struct nc_point_source *q, double t, double mid, double row_s,
+                double T)
 {
-    const double span = 4 * (mid + 1) * fabs(row_s); /* a bound on the steps alone */
-    double t0 = 0, h0, t1, h1;
-    if (row_gap(c, q, t0, mid, row_s, &h0) < 0 || row_gap(c, q, t1 = fmin(span, fmax(-span, -h0)), mid, row_s, &h1))
-        return -1;
-    for (int it = 0; it < 8 && t1 != t0 && h1 != 0; it++) {
+    double h;
+    return row_gap(c, q, t, mid, row_s, &h) == 0 && fabs(h) <= 0.5 * T;
+}
+
+static int rolling_spans(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s,
+                         double T, struct span *sp, int max, double *gain)
+{
+    const double open = (mid + 1) * fabs(row_s) + 0.5 * T, bound = 1e3 * open; /* the steps' bound */
+    double t0 = 0, h0, t1 = 0, h1 = NAN, hp, hm;
+    int rooted = row_gap(c, q, t0, mid, row_s, &h0) == 0 &&
+                 row_gap(c, q, t1 = fmin(bound, fmax(-bound, -h0)), mid, row_s, &h1) == 0;
+    for (int it = 0; rooted && it < 12 && t1 != t0 && h1 != 0; it++) {
         const double t2 = t1 - h1 * (t1 - t0) / (h1 - h0);
         if (!isfinite(t2))
             break;
-        t0 = t1, h0 = h1, t1 = fmin(span, fmax(-span, t2));
-        if (row_gap(c, q, t1, mid, row_s, &h1) < 0)
-            return -1;
+        t0 = t1, h0 = h1, t1 = fmin(bound, fmax(-bound, t2));
+        rooted = row_gap(c, q, t1, mid, row_s, &h1) == 0;
     }
-    *t = t1;
-    return fabs(h1) <= 0.5 * fabs(row_s) ? 0 : -1;
+    const double e = 0.5 * fabs(row_s);
+    rooted = rooted && fabs(h1) <= e && row_gap(c, q, t1 + e, mid, row_s, &hp) == 0 &&
+             row_gap(c, q, t1 - e, mid, row_s, &hm) == 0;
+    const double slope = rooted ? fmax(fabs(hp - hm) / (2 * e), 1e-9) : 1;
+    *gain = 1 / slope;
+    if (T == 0) {
+        sp[0] = (struct span){t1, t1};
+        return rooted && fabs(t1) <= open;
+    }
+    if (rooted) { /* linear: checked at the ends it was not cut to */
+        const double half = 0.5 * T / slope, ta = fmax(t1 - half, -open), tb = fmin(t1 + half, open);
+        double ha = 0, hb = 0;
+        if (tb < ta)
+            return 0;
+        if ((ta == -open || (row_gap(c, q, ta, mid, row_s, &ha) == 0 && fabs(fabs(ha) - 0.5 * T) <= 0.05 * T)) &&
+            (tb == open || (row_gap(c, q, tb, mid, row_s, &hb) == 0 && fabs(fabs(hb) - 0.5 * T) <= 0.05 * T))) {
+            sp[0] = (struct span){ta, tb};
+            return 1;
+        }
+    }
+    enum { SCAN = 64 };
+    int n = 0, was = band(c, q, -open, mid, row_s, T);
+    double start = -open, prev = -open;
+    for (int i = 1; i <= SCAN && n < max; i++) {
+        const double t = -open + 2 * open * i / SCAN;
+        const int is = band(c, q, t, mid, row_s, T);
+        if (is != was) { /* its edge between prev and t */
+            double lo = prev, hi = t;
+            for (int k = 0; k < 40; k++) {
+                const double m = 0.5 * (lo + hi);
+                if (band(c, q, m, mid, row_s, T) == was)
+                    lo = m;
+                else
+                    hi = m;
+            }
+            if (was)
+                sp[n++] = (struct span){start, lo};
+            else
+                start = hi;
+            was = is;
+        }
+        prev = t;
+    }
+    if (was && n < max)
+        sp[n++] = (struct span){start, open};
+    return n;
 }
 
 /* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance,
@@ -93,27 +151,26 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
     int rc = nc_rt_update(r->rt, s); /* the bodies at the scene's (mid-exposure) poses */
     if (rc < 0)
         return rc;
-    /* Steps over the exposure: at most 0.1 px of motion apart (stars are at
-     * infinity: only the camera's rotation moves them; a body's point also
-     * moves across the line of sight at up to its speed over its range). */
-    double rate = nc_v3_norm(c->angular_velocity_rad_s); /* rad/s, a bound on every point's */
+    /* Each point's motion: stars are at infinity, only the camera's rotation moves them; a body's point also moves
+     * across the line of sight at up to its speed over its range (rad/s; rate: a bound on every point's). */
+    const double spin = nc_v3_norm(c->angular_velocity_rad_s), f_px = fmax(c->fx_px, c->fy_px);
+    double rate = spin;
     for (size_t i = 0; i < n; i++)
         if (p[i].range_m > 0)
-            rate = fmax(rate, nc_v3_norm(c->angular_velocity_rad_s) + nc_v3_norm(p[i].rel_velocity_m_s) / p[i].range_m);
-    const double turn_px = rate * exposure_s * fmax(c->fx_px, c->fy_px);
-    const int K = turn_px > 0 ? (int)fmin(4096, ceil(turn_px / 0.1)) : 1;
+            rate = fmax(rate, spin + nc_v3_norm(p[i].rel_velocity_m_s) / p[i].range_m);
+    const double turn_px = rate * exposure_s * f_px;
     /* A rolling shutter exposes row y (y - (H - 1) / 2) line_time_s after
      * the middle row (y of the stored image: the view's rows counted from
      * its last for a view mirrored top to bottom): the camera has turned by
      * then, by up to roll_px. */
-    const double mid_row = 0.5 * (c->height_px - 1), roll_px = rate * line_time_s * mid_row * fmax(c->fx_px, c->fy_px);
+    const double mid_row = 0.5 * (c->height_px - 1), roll_px = rate * line_time_s * mid_row * f_px;
     /* Only the stars the frame can show: projected at mid-exposure within
-     * the frame, grown by the turn and a pixel. */
+     * the frame, grown by the turn, the readout and a pixel. */
     size_t *in = malloc((n ? n : 1) * sizeof *in), m = 0;
     if (!in)
         return nc_error(-ENOMEM, "out of memory");
     const struct nc_quat to_cam = nc_quat_conj(c->attitude_q);
-    const double grow = turn_px + roll_px + 2;
+    const double grow = turn_px + 2 * roll_px + 2;
     for (size_t i = 0; i < n; i++) {
         double x, y;
         struct nc_vec3 d = nc_quat_rotate(to_cam, p[i].dir);
@@ -137,18 +194,28 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                 ++*hidden;
                 continue;
             }
-            /* the time of the row it falls on (rolling; the stored image's rows) */
-            double t_row = 0;
-            if (roll_px > 0 && row_time(c, q, mid_row, c->flip_rows ? -line_time_s : line_time_s, &t_row) < 0)
-                continue;
+            /* the times it is recorded at, from the middle row's (the stored image's rows), in steps at most
+             * 0.1 px of its motion apart; the irradiance of each step its share of the exposure (with a zero
+             * exposure, one step: a global shutter's instant, or its row's) */
+            struct span sp[8] = {{-0.5 * exposure_s, 0.5 * exposure_s}};
+            double gain = 1;
+            const int nsp = roll_px > 0 ? rolling_spans(c, q, mid_row, c->flip_rows ? -line_time_s : line_time_s,
+                                                        exposure_s, sp, 8, &gain)
+                                        : 1;
+            const double own = q->range_m > 0 ? spin + nc_v3_norm(q->rel_velocity_m_s) / q->range_m : spin;
             int shown = 0;
-            for (int k = 0; k < K; k++) {
-                double dt = t_row + exposure_s * ((k + 0.5) / K - 0.5), x, y;
-                struct nc_quat a = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt)
-                                           : c->attitude_q;
-                struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), point_dir(q, dt)); /* camera frame */
-                if (nc_camera_project(c, d, &x, &y) == 0)
-                    shown |= splat(f, c, x, y, q->irradiance_w_m2 / K, q->iof_per_radiance);
+            for (int j = 0; j < nsp; j++) {
+                const double ta = sp[j].ta, tb = sp[j].tb;
+                const int K = (int)fmin(4096, fmax(1, ceil(own * (tb - ta) * f_px / 0.1)));
+                const double share = exposure_s > 0 ? (tb - ta) / exposure_s : gain;
+                for (int k = 0; k < K; k++) {
+                    double dt = ta + (tb - ta) * (k + 0.5) / K, x, y;
+                    struct nc_quat a = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt)
+                                               : c->attitude_q;
+                    struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), point_dir(q, dt)); /* camera frame */
+                    if (nc_camera_project(c, d, &x, &y) == 0)
+                        shown |= splat(f, c, x, y, q->irradiance_w_m2 * share / K, q->iof_per_radiance);
+                }
             }
             drawn += shown;
         }

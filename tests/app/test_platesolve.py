@@ -29,6 +29,11 @@ os.makedirs(tmp)
 for need in [stars_dat, shutil.which("solve-field"), shutil.which("wcs-xy2rd")]:
     if not need or not os.path.exists(need):
         sys.exit(f"test_platesolve: missing {need or 'solve-field / wcs-xy2rd'}: run scripts/install-deps.sh --test")
+try:
+    from astropy.io import fits
+    from astropy.wcs import WCS
+except ImportError:
+    sys.exit("test_platesolve: missing astropy for /usr/bin/python3 (python3-astropy): run scripts/install-deps.sh --test")
 
 index = os.path.join(tmp, "stars.ncs")
 subprocess.run([navcam, "stars", "index", stars_dat, "-o", index], check=True, stdout=subprocess.DEVNULL)
@@ -185,8 +190,6 @@ stars: {{catalogue: '{index}'}}
           f"roll by {err_roll:+.4f} deg {'ok' if ok else 'FAILED (5 arcsec, 0.05 deg)'}")
 # The boresight on the celestial pole (the identity attitude, Dec +90 exactly), NavCam's WCS read by astropy: with
 # LONPOLE 180 (FITS's default there is 0; without it every reader turned the frame by 180 deg, stars 693 px off).
-from astropy.io import fits
-from astropy.wcs import WCS
 f_m = W * PITCH / (2 * math.tan(math.radians(20) / 2))
 f_px = f_m / PITCH
 pole, pole_fits = os.path.join(tmp, "pole.yaml"), os.path.join(tmp, "pole.fits")
