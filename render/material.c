@@ -124,7 +124,7 @@ double nc_material_fold_rocks(const struct nc_material *m, double cover, struct 
     if (k < 0)
         return -1;
     const double rad = M_PI / 180.0, t0 = tan(m->p[k] * rad);
-    const double t1sq = NC_ROCK_FOLD_TAN * NC_ROCK_FOLD_TAN * -expm1(-NC_ROCK_FOLD_C * cover);
+    const double t1sq = (NC_ROCK_FOLD_A + NC_ROCK_FOLD_B * cover) * cover;
     double deg = atan(sqrt(t0 * t0 + t1sq)) / rad;
     out->p[k] = fmin(deg, m->model->params[k].max);
     if (m->model->prepare)

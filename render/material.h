@@ -89,17 +89,17 @@ void nc_material_free(struct nc_material *m);
 
 /* Rocks too small to trace, folded into the reflectance as macroscopic
  * roughness (docs/terrain.md). Rocks covering a fraction `cover` of the
- * surface (nc_boulders_cover) add to the mean square slope, in proportion to
- * the ground they and their shadows take, which saturates as they overlap:
- *   tan^2 theta_bar' = tan^2 theta_bar + TAN^2 (1 - exp(-C cover)),
- * at most the parameter's upper bound. For a small cover the added term is
- * TAN^2 C cover, linear in the area as a slope variance is; a surface wholly
- * of rocks adds atan(TAN) = 27.5 deg. TAN and C were fitted to rendered rocks
- * on two scenes (docs/terrain.md); test_boulders checks them on others.
+ * surface (nc_boulders_cover) add to the mean square slope:
+ *   tan^2 theta_bar' = tan^2 theta_bar + (A + B cover) cover,
+ * at most the parameter's upper bound: for a small cover linear in the area,
+ * as a slope variance is, and faster as the cover grows. A and B were fitted
+ * to the roughness that makes rendered rocks left out as bright as traced
+ * ones, at 40 and 75 deg phase and covers 0.13 to 0.69 (docs/terrain.md);
+ * test_boulders checks them on other scenes.
  * Only models with a roughness parameter named theta_bar (degrees) can fold:
  * the index of that parameter, or -1. */
-#define NC_ROCK_FOLD_TAN 0.52
-#define NC_ROCK_FOLD_C 4.0
+#define NC_ROCK_FOLD_A 0.6
+#define NC_ROCK_FOLD_B 0.35
 int nc_material_roughness_param(const struct nc_material *m);
 /* out = m with the rocks folded in (sharing m's albedo map: never free
  * out); returns the theta_bar used, degrees, or -1 (out = m) where m cannot fold. */
