@@ -283,6 +283,7 @@ struct surf {
     struct nc_vec3 sdir[NC_PACKET]; /* unit direction to the Sun's centre */
     double irr[NC_PACKET];    /* solar irradiance there, W m^-2 */
     double factor[NC_PACKET]; /* on the albedo: variation and map */
+    int facet_sun[NC_PACKET]; /* 0 where a smooth shading normal lies on a facet turned away from the Sun */
     /* The frame its shadow rays go in (shadow_frames; after the arrays
      * above, which keep their 64-byte alignment): frame -1, the camera's; b,
      * body b's far frame (nc_rt_far_frame), where the point is p - rel and
@@ -319,6 +320,19 @@ unit_normals(const struct nc_hit16 *hit, double (*un)[NC_PACKET])
         unit_lane(hit->nx[i], hit->ny[i], hit->nz[i], un, i);
 }
 
+/* Whether lane i's facet faces the Sun sdir on the side the ray d meets it:
+ * 1 unless the hit's normal is a smooth shading normal (the facet's beside
+ * it); the light of a point on a facet turned away from the Sun is none,
+ * whatever its shading normal (an outside check saw such points lit, their
+ * shadow rays lifted off along the shading normal past the facet). */
+static inline int facet_faces_sun(const struct nc_hit16 *hit, int i, struct nc_vec3 d, struct nc_vec3 sdir)
+{
+    const int smooth = (hit->fnx[i] != hit->nx[i]) | (hit->fny[i] != hit->ny[i]) | (hit->fnz[i] != hit->nz[i]);
+    const double fd = hit->fnx[i] * d.x + hit->fny[i] * d.y + hit->fnz[i] * d.z,
+                 fs = hit->fnx[i] * sdir.x + hit->fny[i] * sdir.y + hit->fnz[i] * sdir.z;
+    return (!smooth) | (fd <= 0 ? fs > 0 : fs < 0);
+}
+
 /* surface16 where j->plain holds, in one branch-free loop (AVX-512 or AVX2
  * where the CPU has it, without contraction: the same bits as the loop lane
  * by lane). A missed lane gets body -1 and values never read. */
@@ -341,6 +355,7 @@ plain_lanes(const struct job *j, const struct nc_hit16 *hit, const struct nc_vec
         s->sdir[i] = j->sun_dir;
         s->irr[i] = j->sun_irr;
         s->factor[i] = hit->albedo[i];
+        s->facet_sun[i] = facet_faces_sun(hit, i, d, j->sun_dir);
     }
 }
 
@@ -417,6 +432,7 @@ static void surface16(const struct job *j, const struct nc_hit16 *hit, const str
         s->irr[i] = j->sun_irr;
         if (sc->sun.has_position)
             nc_scene_sun_at(sc, nc_v3_add(p, sc->camera.position_m), &s->sdir[i], &s->irr[i]);
+        s->facet_sun[i] = facet_faces_sun(hit, i, d, s->sdir[i]);
         double factor = hit->albedo[i]; /* albedo variation */
         const struct nc_albedo_map *am = sc->body[hit->body[i]].material.albedo_map;
         if (am) { /* at the body-fixed position of the hit, in double */
@@ -558,7 +574,7 @@ hard_lanes(const struct surf *s, struct nc_photometry *geo, struct nc_ray16 *sha
     for (int i = 0; i < NC_PACKET; i++) {
         const struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i], d = s->d[i], p = s->p[i];
         const double mu = -nc_v3_dot(nrm, d), mu0 = nc_v3_dot(nrm, sdir), eps = 4e-6 * s->scale[i];
-        const int on = (s->body[i] >= 0) & (mu0 > 0) & (mu > 0);
+        const int on = (s->body[i] >= 0) & (mu0 > 0) & (mu > 0) & s->facet_sun[i];
         geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, d), s->factor[i]};
         shadow->ox[i] = (float)(p.x + eps * nrm.x);
         shadow->oy[i] = (float)(p.y + eps * nrm.y);
@@ -615,7 +631,7 @@ static void sunlight16(struct job *j, const struct surf *s, int px0, int py0, in
                 continue;
             struct nc_vec3 nrm = s->n[i], sdir = s->sdir[i];
             double mu = -nc_v3_dot(nrm, s->d[i]), mu0 = nc_v3_dot(nrm, sdir);
-            if (!(mu0 > 0 && mu > 0))
+            if (!(mu0 > 0 && mu > 0) || !s->facet_sun[i])
                 continue;
             geo[i] = (struct nc_photometry){mu0, mu, -nc_v3_dot(sdir, s->d[i]), s->factor[i]};
             /* Offset the origin off the surface by a few float ulps of the
@@ -939,6 +955,7 @@ static void trace_camera(const struct job *j, int px0, int py0, const struct nc_
             const int i = ik[k];
             struct nc_hit16 *h = &hit[qk[k]];
             h->t[i] = hk.t[k], h->nx[i] = hk.nx[k], h->ny[i] = hk.ny[k], h->nz[i] = hk.nz[k];
+            h->fnx[i] = hk.fnx[k], h->fny[i] = hk.fny[k], h->fnz[i] = hk.fnz[k];
             h->body[i] = hk.body[k], h->albedo[i] = hk.albedo[k], h->rock[i] = hk.rock[k];
             h->prim[i] = hk.prim[k];
         }

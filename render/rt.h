@@ -30,6 +30,9 @@ struct nc_ray16 {
 struct nc_hit16 {
     float t[NC_PACKET];                    /* ray parameter of the hit (tfar) */
     float nx[NC_PACKET], ny[NC_PACKET], nz[NC_PACKET]; /* geometric normal, scene frame, unnormalised */
+    /* the facet's normal where nx.. is a smooth shading normal (a mesh's interpolated vertex normals), else the
+     * same: a point of a facet turned away from the Sun is unlit whatever its shading normal */
+    float fnx[NC_PACKET], fny[NC_PACKET], fnz[NC_PACKET];
     int body[NC_PACKET];                   /* body index, -1 for a miss */
     float albedo[NC_PACKET];               /* factor on the albedo there (albedo_var.h; 1: none) */
     int32_t rock[NC_PACKET];               /* the boulder hit (its index in the body's list), -1: none */

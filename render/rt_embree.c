@@ -814,19 +814,28 @@ static inline void put_surface(const struct rt_body *b, int bi, float t, float x
     hit->rock[i] = -1;
     hit->body[i] = bi;
     hit->t[i] = t;
-    hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;
-    hit->ny[i] = R[3] * x + R[4] * y + R[5] * z;
-    hit->nz[i] = R[6] * x + R[7] * y + R[8] * z;
+    hit->fnx[i] = hit->nx[i] = R[0] * x + R[1] * y + R[2] * z;
+    hit->fny[i] = hit->ny[i] = R[3] * x + R[4] * y + R[5] * z;
+    hit->fnz[i] = hit->nz[i] = R[6] * x + R[7] * y + R[8] * z;
 }
 
 /* Lane i of hit: instance inst's primitive prim (a body's own triangle, or a
  * rock of a tile) met at t, barycentric (u, v), geometric normal (x, y, z)
- * unnormalised in the instanced geometry's frame (the body's). */
+ * unnormalised in the instanced geometry's frame (the body's): a body's own
+ * triangle takes its facet normal from the mesh's double vertices instead
+ * (Embree's comes from float vertices relative to the ray's origin: its
+ * error grows with the range, 2e-3 in a 67P frame's shading at 6000 km in
+ * an outside check; the bins' hits had the double one already). */
 static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float t, float u, float v, float x, float y,
                     float z, const struct nc_ray16 *ray, struct nc_hit16 *hit, int i)
 {
     const struct rt_body *b = &rt->body[rt->geom_to_body[inst]];
     const float *R = b->rot;
+    if (inst == b->inst_id && b->facet_n[b->level]) { /* a mesh's (an analytic body has none) */
+        const float *fn = b->facet_n[b->level] + 3 * (size_t)prim;
+        x = fn[0], y = fn[1], z = fn[2];
+    }
+    const float fx = x, fy = y, fz = z; /* the facet's */
     if (b->vnormal && inst == b->inst_id) {
         /* Smooth: the vertex normals at the hit's barycentric point, kept
          * only where they face the ray as the facet does (else the facet's:
@@ -862,6 +871,11 @@ static void put_hit(const struct nc_rt *rt, unsigned inst, unsigned prim, float 
             rock_relief(b, tl, prim, u != 0 ? NC_ROCK_MESH_OCTAVES : 0, t, ray, i, &x, &y, &z);
     }
     put_surface(b, (int)rt->geom_to_body[inst], t, x, y, z, alb, hit, i);
+    if (b->vnormal && inst == b->inst_id) { /* the facet's normal beside the shading normal */
+        hit->fnx[i] = R[0] * fx + R[1] * fy + R[2] * fz;
+        hit->fny[i] = R[3] * fx + R[4] * fy + R[5] * fz;
+        hit->fnz[i] = R[6] * fx + R[7] * fy + R[8] * fz;
+    }
     hit->rock[i] = rock;
     hit->prim[i] = prim;
 }
@@ -870,6 +884,7 @@ static void put_miss(struct nc_hit16 *hit, int i)
 {
     hit->body[i] = -1;
     hit->nx[i] = hit->ny[i] = hit->nz[i] = 0.0f; /* defined for the packet-wide loops */
+    hit->fnx[i] = hit->fny[i] = hit->fnz[i] = 0.0f;
 }
 
 void nc_rt_intersect16(struct nc_rt *rt, const struct nc_ray16 *ray, struct nc_hit16 *hit, int coherent)

@@ -56,6 +56,59 @@ static int band(const struct nc_camera *c, const struct nc_point_source *q, doub
     return row_gap(c, q, t, mid, row_s, &h) == 0 && fabs(h) <= 0.5 * T;
 }
 
+/* rolling_spans' scan: row_gap at 65 times over +-open; where it crosses +-T / 2 (or the point turns to or from
+ * behind the camera) between two of them, the crossing by bisection; the spans between crossings whose middles are
+ * in the band (so a span narrower than the scan's step is found where row_gap crosses both edges between two
+ * samples). */
+static int scan_spans(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s, double T,
+                      double open, struct span *sp, int max)
+{
+    enum { SCAN = 64, EDGES = 2 * SCAN + 2 };
+    double edge[EDGES], t0 = -open, h0 = 0;
+    int ne = 0, ok0 = row_gap(c, q, t0, mid, row_s, &h0) == 0;
+    edge[ne++] = -open;
+    for (int i = 1; i <= SCAN; i++) {
+        const double t = -open + 2 * open * i / SCAN;
+        double h = 0;
+        const int ok = row_gap(c, q, t, mid, row_s, &h) == 0;
+        for (int side = -1; side <= 1; side += 2) { /* the level side T / 2 */
+            const double level = 0.5 * T * side;
+            if (ok != ok0 || (ok && (h0 - level) * (h - level) < 0)) {
+                double lo = t0, hi = t;
+                for (int k = 0; k < 40; k++) {
+                    const double m = 0.5 * (lo + hi);
+                    double hm = 0;
+                    const int okm = row_gap(c, q, m, mid, row_s, &hm) == 0;
+                    if (okm == ok0 && (!okm || (h0 - level) * (hm - level) > 0))
+                        lo = m;
+                    else
+                        hi = m;
+                }
+                edge[ne++] = hi;
+            }
+            if (ok != ok0)
+                break; /* one edge for a turn behind the camera */
+        }
+        t0 = t, h0 = h, ok0 = ok;
+    }
+    edge[ne++] = open;
+    for (int i = 1; i < ne; i++) /* in order (an interval's two crossings may come either way round) */
+        for (int k = i; k > 0 && edge[k] < edge[k - 1]; k--) {
+            const double e = edge[k];
+            edge[k] = edge[k - 1], edge[k - 1] = e;
+        }
+    int n = 0;
+    for (int i = 0; i + 1 < ne && n < max; i++) {
+        if (!(edge[i + 1] > edge[i]) || !band(c, q, 0.5 * (edge[i] + edge[i + 1]), mid, row_s, T))
+            continue;
+        if (n > 0 && sp[n - 1].tb == edge[i])
+            sp[n - 1].tb = edge[i + 1]; /* continues the last */
+        else
+            sp[n++] = (struct span){edge[i], edge[i + 1]};
+    }
+    return n;
+}
+
 static int rolling_spans(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s,
                          double T, struct span *sp, int max, double *gain)
 {
@@ -79,7 +132,7 @@ static int rolling_spans(const struct nc_camera *c, const struct nc_point_source
         sp[0] = (struct span){t1, t1};
         return rooted && fabs(t1) <= open;
     }
-    if (rooted) { /* linear: checked at the ends it was not cut to */
+    if (rooted && slope >= 0.5) { /* linear (where |1 - v| is small, h bends enough to have other roots: scan) */
         const double half = 0.5 * T / slope, ta = fmax(t1 - half, -open), tb = fmin(t1 + half, open);
         double ha = 0, hb = 0;
         if (tb < ta)
@@ -90,32 +143,7 @@ static int rolling_spans(const struct nc_camera *c, const struct nc_point_source
             return 1;
         }
     }
-    enum { SCAN = 64 };
-    int n = 0, was = band(c, q, -open, mid, row_s, T);
-    double start = -open, prev = -open;
-    for (int i = 1; i <= SCAN && n < max; i++) {
-        const double t = -open + 2 * open * i / SCAN;
-        const int is = band(c, q, t, mid, row_s, T);
-        if (is != was) { /* its edge between prev and t */
-            double lo = prev, hi = t;
-            for (int k = 0; k < 40; k++) {
-                const double m = 0.5 * (lo + hi);
-                if (band(c, q, m, mid, row_s, T) == was)
-                    lo = m;
-                else
-                    hi = m;
-            }
-            if (was)
-                sp[n++] = (struct span){start, lo};
-            else
-                start = hi;
-            was = is;
-        }
-        prev = t;
-    }
-    if (was && n < max)
-        sp[n++] = (struct span){start, open};
-    return n;
+    return scan_spans(c, q, mid, row_s, T, open, sp, max);
 }
 
 /* Bilinear splat of e (W m^-2) at pixel coordinates (x, y) as radiance,

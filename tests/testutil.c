@@ -204,3 +204,28 @@ double nc_test_cpu_s(int pid)
         return -1;
     return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
 }
+
+int nc_test_mesh_hit(const struct nc_mesh *m, struct nc_vec3 o, struct nc_vec3 d, double *t, struct nc_vec3 *n,
+                     double *inside)
+{
+    int hit = 0;
+    *t = INFINITY;
+    for (size_t k = 0; k < m->nt; k++) { /* Moller-Trumbore */
+        const double *p0 = &m->v[3 * m->tri[3 * k]], *p1 = &m->v[3 * m->tri[3 * k + 1]],
+                     *p2 = &m->v[3 * m->tri[3 * k + 2]];
+        const struct nc_vec3 a = nc_v3(p0[0], p0[1], p0[2]), e1 = nc_v3_sub(nc_v3(p1[0], p1[1], p1[2]), a),
+                             e2 = nc_v3_sub(nc_v3(p2[0], p2[1], p2[2]), a), pv = nc_v3_cross(d, e2);
+        const double det = nc_v3_dot(e1, pv);
+        if (det == 0)
+            continue;
+        const struct nc_vec3 tv = nc_v3_sub(o, a), qv = nc_v3_cross(tv, e1);
+        const double u = nc_v3_dot(tv, pv) / det, v = nc_v3_dot(d, qv) / det, tt = nc_v3_dot(e2, qv) / det;
+        if (u >= 0 && v >= 0 && u + v <= 1 && tt > 0 && tt < *t) {
+            *t = tt, *inside = fmin(fmin(u, v), 1 - u - v), hit = 1;
+            *n = nc_v3_unit(nc_v3_cross(e1, e2));
+            if (nc_v3_dot(*n, d) > 0)
+                *n = nc_v3_scale(*n, -1);
+        }
+    }
+    return hit;
+}

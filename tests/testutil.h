@@ -48,6 +48,12 @@ void nc_test_render(const struct nc_scene *s, int threads, struct nc_frame *f);
 /* The lumpy test asteroid's mesh (radii 280, 230, 200 m, seed 3) at this
  * many subdivisions and craters; a failure ends the test. */
 void nc_test_asteroid_mesh(int subdivisions, int craters, struct nc_mesh *m);
+/* The nearest of mesh m's facets (body frame = scene frame) the ray o + t d
+ * meets, in double by brute force: 1 with its t, its facet's unit normal n
+ * turned to face the ray, and how far the hit is inside the facet (the
+ * least barycentric coordinate), else 0. */
+int nc_test_mesh_hit(const struct nc_mesh *m, struct nc_vec3 o, struct nc_vec3 d, double *t, struct nc_vec3 *n,
+                     double *inside);
 int nc_test_contains(const char *haystack, const char *needle);
 /* qsort's comparison of uint64_t values, ascending. */
 int nc_test_cmp_u64(const void *a, const void *b);
