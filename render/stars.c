@@ -135,10 +135,13 @@ static int rolling_spans(const struct nc_camera *c, const struct nc_point_source
     if (rooted && slope >= 0.5) { /* linear (where |1 - v| is small, h bends enough to have other roots: scan) */
         const double half = 0.5 * T / slope, ta = fmax(t1 - half, -open), tb = fmin(t1 + half, open);
         double ha = 0, hb = 0;
-        if (tb < ta)
-            return 0;
-        if ((ta == -open || (row_gap(c, q, ta, mid, row_s, &ha) == 0 && fabs(fabs(ha) - 0.5 * T) <= 0.05 * T)) &&
-            (tb == open || (row_gap(c, q, tb, mid, row_s, &hb) == 0 && fabs(fabs(hb) - 0.5 * T) <= 0.05 * T))) {
+        if (tb < ta) /* the root off the window: none, unless row_gap bends back into the band there */
+            return band(c, q, t1 > 0 ? open : -open, mid, row_s, T) ? scan_spans(c, q, mid, row_s, T, open, sp, max)
+                                                                     : 0;
+        if ((ta == -open ? band(c, q, ta, mid, row_s, T)
+                         : row_gap(c, q, ta, mid, row_s, &ha) == 0 && fabs(fabs(ha) - 0.5 * T) <= 0.05 * T) &&
+            (tb == open ? band(c, q, tb, mid, row_s, T)
+                        : row_gap(c, q, tb, mid, row_s, &hb) == 0 && fabs(fabs(hb) - 0.5 * T) <= 0.05 * T)) {
             sp[0] = (struct span){ta, tb};
             return 1;
         }

@@ -98,7 +98,7 @@ static void shading_at_range(void)
     for (int y = 0; y < 96; y++)
         for (int x = 0; x < 96; x++) {
             const struct nc_vec3 d = nc_v3_unit(nc_quat_rotate(s.camera.attitude_q, nc_camera_dir(&s.camera, x, y)));
-            double t, inside;
+            double t, inside = 0;
             struct nc_vec3 nrm;
             const double mu0 = nc_test_mesh_hit(&s.body[0].mesh, o, d, &t, &nrm, &inside) ? nc_v3_dot(nrm, sun) : 0;
             if (inside > 0.02 && mu0 > 0.05) /* Lambert: L = A J mu0 / pi */
