@@ -21,6 +21,13 @@ static struct nc_vec3 point_dir(const struct nc_point_source *q, double dt)
     return nc_v3_unit(nc_v3_add(nc_v3_scale(q->dir, q->range_m), nc_v3_scale(q->rel_velocity_m_s, dt)));
 }
 
+/* Where the camera of time t (from the middle of the exposure) images q at time t: 0, or -1 behind it. */
+static int point_at(const struct nc_camera *c, const struct nc_point_source *q, double t, double *x, double *y)
+{
+    const struct nc_quat a = t != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, t) : c->attitude_q;
+    return nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), point_dir(q, t)), x, y);
+}
+
 /* *h = t - (row - mid) row_s: how far t is from the time of the row where the camera of time t sees q at time t
  * (row_s: the time from one stored row to the next, negative for a view mirrored top to bottom); -1 if q is not
  * in front of that camera. */
@@ -28,8 +35,7 @@ static int row_gap(const struct nc_camera *c, const struct nc_point_source *q, d
                    double *h)
 {
     double x, y;
-    const struct nc_quat a = nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, t);
-    if (nc_camera_project(c, nc_quat_rotate(nc_quat_conj(a), point_dir(q, t)), &x, &y) < 0)
+    if (point_at(c, q, t, &x, &y) < 0)
         return -1;
     *h = t - (y - mid) * row_s;
     return 0;
@@ -109,6 +115,16 @@ static int scan_spans(const struct nc_camera *c, const struct nc_point_source *q
     return n;
 }
 
+/* The linear span's end t as the model says: in the band where it was cut to the window's end, else on the band's
+ * edge, |row_gap| = T / 2 within 5 % of T. */
+static int span_end_ok(const struct nc_camera *c, const struct nc_point_source *q, double t, int cut, double mid,
+                       double row_s, double T)
+{
+    double h;
+    return cut ? band(c, q, t, mid, row_s, T)
+               : row_gap(c, q, t, mid, row_s, &h) == 0 && fabs(fabs(h) - 0.5 * T) <= 0.05 * T;
+}
+
 static int rolling_spans(const struct nc_camera *c, const struct nc_point_source *q, double mid, double row_s,
                          double T, struct span *sp, int max, double *gain)
 {
@@ -134,14 +150,10 @@ static int rolling_spans(const struct nc_camera *c, const struct nc_point_source
     }
     if (rooted && slope >= 0.5) { /* linear (where |1 - v| is small, h bends enough to have other roots: scan) */
         const double half = 0.5 * T / slope, ta = fmax(t1 - half, -open), tb = fmin(t1 + half, open);
-        double ha = 0, hb = 0;
         if (tb < ta) /* the root off the window: none, unless row_gap bends back into the band there */
             return band(c, q, t1 > 0 ? open : -open, mid, row_s, T) ? scan_spans(c, q, mid, row_s, T, open, sp, max)
                                                                      : 0;
-        if ((ta == -open ? band(c, q, ta, mid, row_s, T)
-                         : row_gap(c, q, ta, mid, row_s, &ha) == 0 && fabs(fabs(ha) - 0.5 * T) <= 0.05 * T) &&
-            (tb == open ? band(c, q, tb, mid, row_s, T)
-                        : row_gap(c, q, tb, mid, row_s, &hb) == 0 && fabs(fabs(hb) - 0.5 * T) <= 0.05 * T)) {
+        if (span_end_ok(c, q, ta, ta == -open, mid, row_s, T) && span_end_ok(c, q, tb, tb == open, mid, row_s, T)) {
             sp[0] = (struct span){ta, tb};
             return 1;
         }
@@ -240,11 +252,8 @@ long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double ex
                 const int K = (int)fmin(4096, fmax(1, ceil(own * (tb - ta) * f_px / 0.1)));
                 const double share = exposure_s > 0 ? (tb - ta) / exposure_s : gain;
                 for (int k = 0; k < K; k++) {
-                    double dt = ta + (tb - ta) * (k + 0.5) / K, x, y;
-                    struct nc_quat a = dt != 0 ? nc_quat_propagate(c->attitude_q, c->angular_velocity_rad_s, dt)
-                                               : c->attitude_q;
-                    struct nc_vec3 d = nc_quat_rotate(nc_quat_conj(a), point_dir(q, dt)); /* camera frame */
-                    if (nc_camera_project(c, d, &x, &y) == 0)
+                    double x, y;
+                    if (point_at(c, q, ta + (tb - ta) * (k + 0.5) / K, &x, &y) == 0)
                         shown |= splat(f, c, x, y, q->irradiance_w_m2 * share / K, q->iof_per_radiance);
                 }
             }

@@ -71,9 +71,11 @@ struct nc_point_source {
  * the centroid keeps the sub-pixel position) as radiance E / Omega_pixel
  * (and I/F, iof_per_radiance times that); over the exposure (exposure_s,
  * the camera's rates) it moves as the camera turns and a body's point as
- * it moves, in steps of at most 0.1 px; with a rolling shutter (line_time_s > 0; 0: global) its exposure
- * is that of the row it falls on, (row - (H - 1) / 2) line_time_s from the
- * middle one. With occlusion, a body in front hides it (traced with r's
+ * it moves, in steps of at most 0.1 px; with a rolling shutter (line_time_s
+ * > 0; 0: global, row y read (y - (H - 1) / 2) line_time_s after the middle
+ * one) it is drawn where it is while the row it is on is open (about the
+ * row it falls on, T / |1 - v| long, v its speed along the columns in rows
+ * per row's time; docs/camera.md). With occlusion, a body in front hides it (traced with r's
  * ray tracer at the scene's poses). Returns how many were drawn (in the
  * frame and not hidden), or < 0 on error; *hidden counts the hidden ones. */
 long nc_render_points(struct nc_renderer *r, const struct nc_scene *s, double exposure_s, double line_time_s,
