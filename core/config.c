@@ -233,6 +233,18 @@ static int too_deep(const char *text, size_t len, const char *origin, int with_l
     return rc;
 }
 
+/* The parser's syntax error, with its line; after: it came after the
+ * first document. */
+static int syntax_error(const yaml_parser_t *parser, const char *origin, int with_line, int after)
+{
+    char at[16];
+    return nc_error(NC_ECONFIG, "%s%s: YAML syntax error: %s%s%s%s", origin,
+                    at_line(at, with_line ? (int)parser->problem_mark.line + 1 : 0),
+                    parser->problem ? parser->problem : "unknown", parser->context ? " " : "",
+                    parser->context ? parser->context : "",
+                    after ? " (text after the end of the value: one value, one document)" : "");
+}
+
 /* Parse one YAML document from memory into a node tree. */
 static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const char *origin, int with_line,
                       struct nc_cfg_node **out)
@@ -246,11 +258,7 @@ static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const ch
         return nc_error(-ENOMEM, "%s: cannot initialise the YAML parser", origin);
     yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
     if (!yaml_parser_load(&parser, &doc)) {
-        char at[16];
-        rc = nc_error(NC_ECONFIG, "%s%s: YAML syntax error: %s%s%s", origin,
-                      at_line(at, with_line ? (int)parser.problem_mark.line + 1 : 0),
-                      parser.problem ? parser.problem : "unknown", parser.context ? " " : "",
-                      parser.context ? parser.context : "");
+        rc = syntax_error(&parser, origin, with_line, 0);
         yaml_parser_delete(&parser);
         return rc;
     }
@@ -262,9 +270,15 @@ static int parse_yaml(struct nc_cfg *cfg, const char *text, size_t len, const ch
         rc = convert(cfg, &doc, root, origin, with_line, 0, &left, out);
     yaml_document_delete(&doc);
     /* One document: a second one ('---', after a '...' or not) would be
-     * dropped unseen, its keys neither read nor refused. */
+     * dropped unseen, its keys neither read nor refused; so would text that
+     * does not parse after the first (`[1, 2] [3]`, `{a: 1}]`, keys after
+     * a '...'). */
     yaml_document_t more;
-    if (rc >= 0 && yaml_parser_load(&parser, &more)) { /* (also after an empty first one) */
+    if (rc >= 0 && !yaml_parser_load(&parser, &more)) {
+        rc = syntax_error(&parser, origin, with_line, 1);
+        node_free(*out);
+        *out = NULL;
+    } else if (rc >= 0) { /* (also after an empty first one) */
         yaml_node_t *r2 = yaml_document_get_root_node(&more);
         if (r2) {
             char at[16];

@@ -113,6 +113,16 @@ int main(void)
                  "a second YAML document ('---'): one document a file");
     expect_error("a second document after '...'", NULL, "...\n---\nrender: {samples_per_pixel: 3}\n", NULL, 0,
                  "test.yaml:15", "a second YAML document");
+    /* ... nor text that does not parse after the first: it was dropped unseen too */
+    expect_error("keys after '...'", NULL, "...\ncamera: {width_px: 8}\n", NULL, 0, "test.yaml:14",
+                 "YAML syntax error: did not find expected <document start> (text after the end of the value");
+    {
+        const char *two[] = {"camera.position_m=[0, -6000, 0] [0, -9000, 0]"}, *br[] = {"render={seed: 2}]"};
+        expect_error("a --set with a second list", NULL, NULL, two, 1, "--set camera.position_m=[0, -6000, 0] [0, "
+                     "-9000, 0]: YAML syntax error", "(text after the end of the value: one value, one document)");
+        expect_error("a --set with a stray bracket", NULL, NULL, br, 1, "--set render={seed: 2}]: YAML syntax error",
+                     NULL);
+    }
     {
         struct nc_cfg cfg;
         nc_cfg_init(&cfg);
