@@ -46,10 +46,11 @@ struct nc_asteroid_params {
     double lump_amplitude; /* relative radius variation of the lumps, e.g. 0.08 */
 };
 /* Relief below the mesh's resolution (mesh_relief.c): the mesh subdivided
- * until its mean edge is at most edge_m, each new vertex displaced along
- * the normal as fractional Brownian motion of Hurst exponent hurst would
- * put a midpoint, E[(h(x + l) - h(x))^2] = s^2 l^(2H), with s measured on
- * the mesh itself (times amplitude). The mesh's own vertices do not move. */
+ * until its mean edge is at most edge_m, every vertex (the mesh's own
+ * too) displaced along the normal by fractional Brownian motion of Hurst
+ * exponent hurst, E[(h(x + l) - h(x))^2] = s^2 l^(2H), in octaves from half
+ * the mesh's mean edge down to the final edge, with s measured on the mesh
+ * itself (times amplitude). */
 struct nc_relief_params {
     double edge_m;    /* subdivide until the mean edge is at most this, m */
     double hurst;     /* 0 < H < 1 */

@@ -1,8 +1,9 @@
 /* mesh_relief.c - relief below a mesh's resolution (mesh.h): the mesh is
- * subdivided and each new vertex is displaced as fractional Brownian motion
- * would put it, with an amplitude measured on the mesh itself, so that the
- * finer relief continues the model's own roughness. The model's vertices
- * never move. Deterministic from the mesh and the parameters; no I/O. */
+ * subdivided and every vertex is displaced along its normal by fractional
+ * Brownian motion of wavelengths below the model's resolution, with an
+ * amplitude measured on the mesh itself, so that the finer relief
+ * continues the model's own roughness. Deterministic from the mesh and the
+ * parameters; no I/O. */
 #include "render/mesh.h"
 
 #include <errno.h>
@@ -64,7 +65,6 @@ static int measure(const struct nc_mesh *m, const double *nrm, double hurst, dou
 struct relief {
     double *base; /* per vertex: the point under it on the model's own faces */
     double *nrm;  /* its normal there, interpolated from the model's vertices */
-    double *lin;  /* the relief interpolated linearly from the model's vertices */
     double s, hurst, factor, wl_max_m, wl_min_m;
     uint64_t seed;
     double amp[64]; /* per octave: s wl^H factor / NC_NOISE_RMS, as fbm() multiplies it out */
@@ -91,10 +91,14 @@ static void octaves(struct relief *r)
         r->amp[r->noct++] = r->s * pow(wl, r->hurst) * r->factor / NC_NOISE_RMS;
 }
 
-/* A new vertex: its base, normal and linear part from its edge's ends (the
- * model's faces are flat, so the base stays on them), then displaced by
- * what the relief adds to the linear part there. The model's own vertices
- * have zero displacement, and so does everything the model resolves. */
+/* A new vertex: its base and normal from its edge's ends (the model's
+ * faces are flat, so the base stays on them), then displaced by the relief
+ * there, as the model's own vertices are. The relief has no octave longer
+ * than half the model's edge, so what the model resolves stays (the
+ * gradient noise's leakage below its lowest octave aside: docs/terrain.md).
+ * Until session 67 each vertex took the relief minus its linear
+ * interpolation between the model's vertices, which kept those still but
+ * moved each facet's mean height by about 0.6 of the relief's RMS. */
 static void displace(void *ctx, const struct nc_mesh *m, uint32_t a, uint32_t b, uint32_t index, double *p)
 {
     (void)m;
@@ -107,8 +111,7 @@ static void displace(void *ctx, const struct nc_mesh *m, uint32_t a, uint32_t b,
         nl += n[k] * n[k];
     }
     nl = sqrt(nl);
-    r->lin[index] = 0.5 * (r->lin[a] + r->lin[b]);
-    double d = fbm(r, B) - r->lin[index];
+    const double d = fbm(r, B);
     for (int k = 0; k < 3; k++) {
         n[k] = nl > 0 ? n[k] / nl : 0;
         p[k] = B[k] + d * n[k];
@@ -150,14 +153,16 @@ int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t m
     size_t cap = nv + 3 * nt; /* generous: a closed mesh adds 3/2 vertex per face per level */
     r.base = malloc(3 * cap * sizeof *r.base);
     r.nrm = malloc(3 * cap * sizeof *r.nrm);
-    r.lin = malloc(cap * sizeof *r.lin);
-    if (!r.base || !r.nrm || !r.lin)
+    if (!r.base || !r.nrm)
         rc = nc_error(-ENOMEM, "out of memory for the relief of %zu vertices", cap);
     if (rc == 0) {
         memcpy(r.base, m->v, 3 * m->nv * sizeof *m->v);
         nc_mesh_vertex_normals(m, r.nrm);
-        for (size_t i = 0; i < m->nv; i++)
-            r.lin[i] = fbm(&r, m->v + 3 * i);
+        for (size_t i = 0; i < m->nv; i++) {
+            const double d = fbm(&r, r.base + 3 * i);
+            for (int k = 0; k < 3; k++)
+                m->v[3 * i + k] = r.base[3 * i + k] + d * r.nrm[3 * i + k];
+        }
     }
     for (int k = 0; k < levels && rc == 0; k++) {
         if (m->nv + 3 * m->nt > cap) {
@@ -174,6 +179,5 @@ int nc_mesh_relief(struct nc_mesh *m, const struct nc_relief_params *p, size_t m
     }
     free(r.base);
     free(r.nrm);
-    free(r.lin);
     return rc;
 }
