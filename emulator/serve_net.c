@@ -321,13 +321,14 @@ void *nc__serve_net_thread(void *arg)
         }
         pthread_mutex_unlock(&e->client_lock);
         if (poll(pf, (nfds_t)n, held ? 2 : 50) > 0) {
+            int incoming = 0;
             for (int k = 0; k < n; k++) {
                 if (!pf[k].revents)
                     continue;
                 if (map[k] == -1) {
                     read_datagrams(e);
                 } else if (map[k] == -2) {
-                    accept_client(e);
+                    incoming = 1;
                 } else {
                     if (pf[k].revents & POLLOUT) {
                         pthread_mutex_lock(&e->client_lock);
@@ -338,6 +339,11 @@ void *nc__serve_net_thread(void *arg)
                         client_read(e, map[k]);
                 }
             }
+            /* New connections after the clients' hang-ups of the same
+             * round: a client that closes and at once connects again finds
+             * its old slot free (it was refused with max_clients taken). */
+            if (incoming)
+                accept_client(e);
         }
         take_requests(e);
     }
