@@ -27,8 +27,10 @@ static const char expose_help[] =
     "characterises it (photon transfer, dark current, linearity).\n"
     "\n"
     "  CAMERA.yaml            camera (intrinsics), optics, sensor and exposure sections;\n"
-    "                         a whole scene file works too (its pose, bodies and Sun\n"
-    "                         are ignored)\n"
+    "                         a whole scene file works too, read as render reads it\n"
+    "                         (base: builtin:default; its pose, camera rates, bodies\n"
+    "                         and Sun are ignored); a mirrored SUM camera's frames are\n"
+    "                         stored as render stores them\n"
     "  -L, --radiance L       uniform scene radiance, W m^-2 sr^-1 (0 or more)\n"
     "  -e, --exposure T       exposure time, seconds, 0 to 3600 (default: exposure.time_s)\n"
     "  -n, --frames N         number of frames, 1 to 100000 (default 1), numbered from\n"
@@ -147,6 +149,12 @@ int main(int argc, char **argv)
     for (size_t i = 0; ok && i < nr; i++)
         rad[i] = (float)L;
     ok = ok && nc_camsys_electrons(&cs, rad, T, e) >= 0;
+    /* A mirrored camera (a SUM file's K11 or K22 < 0) stores its image as
+     * `navcam render` does: the optics act on the view, then the electrons
+     * are mirrored, so that the flat's vignetting is the render's and the
+     * sensor's patterns belong to stored pixels. */
+    if (ok && (geom.flip_rows || geom.flip_cols))
+        nc_image_flip(e, sizeof *e, geom.width_px, geom.height_px, geom.flip_rows, geom.flip_cols);
     int is_fits = nc_image_is_fits(out);
     struct nc_image_attr attrs[32];
     char text[16][200], ltxt[64], ntxt[32], sw[64], intr[160];
@@ -160,6 +168,9 @@ int main(int argc, char **argv)
                                            {"navcam:quantity", "dn"}, {"navcam:units", "DN"},
                                            {"navcam:intrinsics_fx_fy_cx_cy_px", intr}};
     const int ncommon = (int)(sizeof common / sizeof common[0]);
+    char flip[32]; /* as `navcam render` records a mirrored camera (FITS IMAGE_MIRRORED) */
+    snprintf(flip, sizeof flip, "rows=%d columns=%d", geom.flip_rows, geom.flip_cols);
+    const int mirrored = geom.flip_rows || geom.flip_cols;
     for (size_t k = 0; ok && k < nf; k++) {
         uint64_t fno = first + (uint64_t)k;
         ok = nc_camsys_digitise(&cs, e, T, fno, dn + k * n) >= 0;
@@ -171,6 +182,8 @@ int main(int argc, char **argv)
             for (int i = 0; i < ncommon; i++)
                 attrs[na++] = common[i];
             attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
+            if (mirrored)
+                attrs[na++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
             ok = nc_image_write_dn(path, dn + k * n, geom.width_px, geom.height_px, cs.sensor.adc_bits, attrs, na) >= 0;
             if (ok)
                 printf("wrote %s\n", path);
@@ -182,6 +195,8 @@ int main(int argc, char **argv)
             attrs[na++] = common[i];
         attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
         attrs[na++] = (struct nc_image_attr){"navcam:frames", ntxt};
+        if (mirrored)
+            attrs[na++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
         if (rows)
             attrs[na++] = (struct nc_image_attr){"navcam:fits_row_order", rows};
         ok = nc_image_write_dn_cube(out, dn, geom.width_px, geom.height_px, (int)nf, cs.sensor.adc_bits, attrs, na) >= 0;

@@ -53,9 +53,9 @@ int nc_camsys_load(const char *path, const char *const *sets, int nsets, struct 
 {
     struct nc_cfg cfg;
     nc_cfg_init(&cfg);
-    int rc = path ? nc_cfg_load_file(&cfg, path) : nc_error(NC_EUSAGE, "a camera configuration file is needed");
-    for (int i = 0; rc >= 0 && i < nsets; i++)
-        rc = nc_cfg_set(&cfg, sets[i]);
+    /* as a scene file is read (`base: builtin:default` laid under it), for a whole scene works too */
+    int rc = path ? nc_cfg_load_scene(&cfg, path, sets, nsets)
+                  : nc_error(NC_EUSAGE, "a camera configuration file is needed");
     struct nc_cfg_node *cam = NULL;
     if (rc >= 0 && (rc = nc_cfg_map(cfg.root, "camera", &cam)) == 0)
         rc = nc_cfg_missing(cfg.root, "camera", "a map with width_px, height_px and focal length and pitch");
@@ -64,13 +64,14 @@ int nc_camsys_load(const char *path, const char *const *sets, int nsets, struct 
     if (rc >= 0) {
         /* Parts of a scene file that a camera alone does not use. */
         static const char *const ignore_top[] = {"bodies", "sun", "render", "serve", "outputs", "stars"};
-        static const char *const ignore_cam[] = {"position_m", "attitude_q", "look_at_m", "up"};
-        for (int i = 0; i < 6; i++) {
+        static const char *const ignore_cam[] = {"position_m", "attitude_q", "look_at_m", "up", "velocity_m_s",
+                                                 "angular_velocity_rad_s"};
+        for (size_t i = 0; i < sizeof ignore_top / sizeof ignore_top[0]; i++) {
             struct nc_cfg_node *n = nc_cfg_get(cfg.root, ignore_top[i]);
             if (n)
                 nc_cfg_mark_used(n);
         }
-        for (int i = 0; i < 4; i++) {
+        for (size_t i = 0; i < sizeof ignore_cam / sizeof ignore_cam[0]; i++) {
             struct nc_cfg_node *n = nc_cfg_get(cam, ignore_cam[i]);
             if (n)
                 nc_cfg_mark_used(n);

@@ -5,24 +5,7 @@
 # tables print it.
 # Usage: test_cli.sh NAVCAM TMPDIR SOURCE_DIR
 set -u
-navcam=$1
-tmp=$2
-src=$3
-rm -rf "$tmp" && mkdir -p "$tmp"
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
-# expect CODE NEEDLE -- command...: exit code and a substring of stdout+stderr
-expect() {
-  local code=$1 needle=$2
-  shift 3
-  local out rc
-  out=$("$@" 2>&1)
-  rc=$?
-  if [ "$rc" -ne "$code" ]; then bad "$* -> exit $rc, want $code: $out"; return; fi
-  case "$out" in *"$needle"*) ok ;; *) bad "$* -> output lacks '$needle': $out" ;; esac
-}
+. "$(dirname "$0")/expect.sh" # navcam, tmp (made afresh), src; ok, bad, expect
 small=(--set camera.width_px=96 --set camera.height_px=96 --set bodies.0.shape.subdivisions=4)
 
 expect 0 "render [SCENE.yaml] -o OUT" -- "$navcam" --help
@@ -267,7 +250,6 @@ expect 0 "wrote $tmp/up.fits" -- "$navcam" render -o "$tmp/up.fits" --fits-rows 
 grep -a -q "ROWORDER= 'BOTTOM-UP'" "$tmp/up.fits" && ok || bad "up.fits lacks ROWORDER = 'BOTTOM-UP'"
 grep -a -q "ROWORDER= 'TOP-DOWN'" "$tmp/radiance.fits" && ok || bad "radiance.fits lacks ROWORDER = 'TOP-DOWN'"
 expect 2 "--fits-rows: applies to .fits output only" -- "$navcam" render -o "$tmp/x.png" --fits-rows bottom_up
-expect 2 "expected top_down" -- "$navcam" expose "$src/configs/examples/navcam_camera.yaml" -L 1 -o "$tmp/x.fits" --fits-rows up
 expect 1 "fits_row_order: applies to .fits patterns only" -- "$navcam" serve \
   --set "outputs=[{driver: file, fits_row_order: bottom_up}]"
 # One pixel pitch for geometry and radiometry.
@@ -306,26 +288,14 @@ expect 2 "give --model NAME or --preset NAME" -- "$navcam" brdf --geometry 0,0,0
 expect 2 "navcam brdf: --model: unknown reflectance model 'foo'" -- "$navcam" brdf --model foo
 expect 2 "navcam brdf: --preset: unknown preset 'mars'" -- "$navcam" brdf --preset mars
 
-# The camera model: DN and electrons from a render; navcam expose.
+# The camera model: DN and electrons from a render (navcam expose: test_expose.sh).
 expect 0 "dn [DN]" -- "$navcam" render -o "$tmp/dn.png" -q dn "${small[@]}"
 expect 0 "electrons [e-]" -- "$navcam" render -o "$tmp/e.exr" -q electrons "${small[@]}" --exposure 0.001
 expect 0 "dn [DN]" -- "$navcam" render -o "$tmp/dn.fits" -q dn "${small[@]}" --frame 7
 expect 2 "--exposure expects" -- "$navcam" render -o "$tmp/x.png" -q dn --exposure -1
-cam="$tmp/cam.yaml"
-printf 'camera: {width_px: 64, height_px: 48, focal_length_m: 0.02, pixel_pitch_m: 1.0e-5}\noptics: {f_number: 4}\nsensor: {read_noise_e: 5, full_well_e: 10000, gain_e_per_dn: 2, bias_dn: 20, adc_bits: 12}\n' > "$cam"
-expect 0 "wrote $tmp/flat.fits: 4 frames of 64x48, 12-bit" -- "$navcam" expose "$cam" -L 3 -e 0.001 -n 4 -o "$tmp/flat.fits"
-expect 0 "wrote $tmp/dark_0005.png" -- "$navcam" expose "$cam" --dark -e 0.5 -n 2 --first-frame 4 -o "$tmp/dark.png"
-# what every image carries (docs/config.md): the maker, the quantity and its units, the intrinsics
-for k in "CREATOR = 'NavCam" "QUANTITY= 'dn" "BUNIT   = 'adu" "INTRINS = '\[" "FRAME   =                    0"; do
-  grep -aq "$k" "$tmp/flat.fits" && ok || bad "navcam expose's FITS header lacks $k"
-done
 # numbers typed: decimal digits, a value given, a frame number as typed (-f 1e30 was frame 0), no wrap past 2^64 - 1
 for f in 1e30 -1; do expect 2 "--frame expects a whole number" -- "$navcam" render -o "$tmp/x.fits" -f $f; done
 for e in '' 0x10; do expect 2 "--exposure expects 0..3600, got '$e'" -- "$navcam" render -o "$tmp/x.fits" -e "$e"; done
-expect 2 "bad value '' for --radiance" -- "$navcam" expose "$cam" -L '' -o "$tmp/x.fits"
-expect 2 "bad value '1e30' for --first-frame" -- "$navcam" expose "$cam" -L 1 --first-frame 1e30 -o "$tmp/x.fits"
-expect 2 "--first-frame 18446744073709551615 with 2 frames goes past frame 2^64 - 1" -- \
-  "$navcam" expose "$cam" -L 1 -n 2 --first-frame 18446744073709551615 -o "$tmp/x.fits"
 # a body's name with a quote and a backslash: the dataset's JSON stays JSON
 "$navcam" batch builtin:approach -o "$tmp/bq" --shard 0/8 --no-geometry "${small[@]}" \
   --set 'bodies.0.name=rock "A"\1' > /dev/null 2>&1 &&
@@ -333,13 +303,6 @@ expect 2 "--first-frame 18446744073709551615 with 2 frames goes past frame 2^64 
   "$tmp/bq/frame_000000.json" && ok || bad "batch JSON with a quoted body name: $(head -c 300 "$tmp/bq/frame_000000.json")"
 # a SUM file's path with a quote in it: the file named, not a YAML error about an option never typed
 expect 1 "it's.SUM: No such file or directory" -- "$navcam" render -o "$tmp/s.fits" --sumfile "$tmp/it's.SUM"
-[ -s "$tmp/dark_0004.png" ] && ok || bad "dark_0004.png not written"
-# Same command, same frames: bit for bit.
-"$navcam" expose "$cam" -L 3 -e 0.001 -n 4 -o "$tmp/flat2.fits" >/dev/null
-cmp -s "$tmp/flat.fits" "$tmp/flat2.fits" && ok || bad "expose is not reproducible"
-expect 1 "cam.yaml:3: sensor.gain: unknown key" -- sh -c "sed 's/gain_e_per_dn/gain/' '$cam' > '$tmp/cam.yaml.bad' && mv '$tmp/cam.yaml.bad' '$tmp/cam2.yaml' && '$navcam' expose '$tmp/cam2.yaml' -L 1 -o '$tmp/x.fits' 2>&1 | sed 's/cam2/cam/'; exit 1"
-expect 2 "missing --radiance L (or --dark)" -- "$navcam" expose "$cam" -o "$tmp/x.fits"
-expect 0 "photon transfer" -- "$navcam" expose --help
 
 # The shading choice is recorded in the file.
 "$navcam" render "${small[@]}" --set bodies.0.shape.normals=smooth -o "$tmp/smooth.fits" >/dev/null 2>&1
