@@ -213,18 +213,36 @@ static void take_requests(struct nc__emu *e)
     }
 }
 
+/* A client's end of stream (or a broken connection): what it sent before
+ * is taken while the job queue has room, as it would have been, the rest
+ * discarded unread, and its slot freed at once. */
+static void hang_up(struct nc__emu *e, int i)
+{
+    while (client_take(e, i) > 0)
+        ;
+    if (e->clients[i].fd >= 0)
+        close_client(e, i);
+}
+
+/* Read until the socket is empty (or the buffer full: a whole request
+ * waits for room in the job queue), so that an end of stream right behind
+ * the last request is seen in the same poll round as the request: a client
+ * that sends, closes and connects again at once finds its slot free. */
 static void client_read(struct nc__emu *e, int i)
 {
     struct nc__client *c = &e->clients[i];
-    if (c->have == sizeof c->buf)
-        return; /* a whole request waits for room in the job queue */
-    ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
-    if (n <= 0) {
-        if (n == 0 || (errno != EAGAIN && errno != EINTR))
-            close_client(e, i);
+    while (c->have < sizeof c->buf) {
+        ssize_t n = read(c->fd, c->buf + c->have, sizeof c->buf - c->have);
+        if (n > 0) {
+            c->have += (size_t)n;
+            continue;
+        }
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n == 0 || errno != EAGAIN)
+            hang_up(e, i);
         return;
     }
-    c->have += (size_t)n;
 }
 
 static void read_datagrams(struct nc__emu *e)
