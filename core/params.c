@@ -149,10 +149,10 @@ int nc_param_map(struct nc_cfg_node *map, const struct nc_param *table, const ch
 
 int nc_params_values(struct nc_cfg_node *map, const struct nc_param *const *tables, int ntables)
 {
-    if (!map || map->kind != NC_CFG_MAP)
+    if (map && map->kind != NC_CFG_MAP)
         return 0;
     int rc = 0;
-    for (size_t i = 0; i < map->nchild && rc >= 0; i++) {
+    for (size_t i = 0; map && i < map->nchild && rc >= 0; i++) {
         const char *key = map->child[i]->key;
         const struct nc_param *t = NULL, *p = NULL;
         for (int k = 0; k < ntables && !p; k++)
@@ -181,7 +181,7 @@ int nc_params_values(struct nc_cfg_node *map, const struct nc_param *const *tabl
     }
     for (int k = 0; k < ntables && rc >= 0; k++) /* the keys that must be given */
         for (const struct nc_param *p = tables[k]; p->key && rc >= 0; p++)
-            if ((p->flags & NC_PARAM_REQUIRED) && !nc__cfg_find(map, p->key))
+            if ((p->flags & NC_PARAM_REQUIRED) && !(map && nc__cfg_find(map, p->key))) /* map NULL: none given */
                 rc = nc_cfg_missing(map, p->key, p->doc);
     return rc < 0 ? rc : 0;
 }

@@ -16,7 +16,8 @@ Checks, on the source tree and the built static libraries:
      use the wire protocols and core/ only: proto/, core/, include/;
   6. drivers stand alone (docs/writing-drivers.md): a driver's files
      (drivers/output_NAME.c or trigger_NAME.c and drivers/NAME/) include no
-     other driver's, and its main file exports its struct nc_KIND_NAME alone.
+     other driver's and, of the emulator, emulator/output.h and trigger.h
+     alone; its main file exports its struct nc_KIND_NAME alone.
 Usage: test_layers.py SOURCE_DIR BUILD_DIR
 """
 import os
@@ -33,6 +34,7 @@ HOT_PATH = {"render/render.c", "render/rt_embree.c"}
 MAX_LINES = 520
 GENERATED = {"core/version.h", "drivers/navcam_genicam_xml.h"}
 GENERATED_DRIVER = {"drivers/navcam_genicam_xml.h": "gige"}  # generated headers and the driver they belong to
+DRIVER_API = {"emulator/output.h", "emulator/trigger.h"}  # what a driver may include of the emulator
 
 src, build = sys.argv[1], sys.argv[2]
 failures = []
@@ -96,6 +98,9 @@ for rel in sources():
         elif layer == tl == "drivers" and driver_of(rel) and driver_of(target) not in (None, driver_of(rel)):
             failures.append(f"{rel}:{n}: the driver '{driver_of(rel)}' includes {target} of the driver "
                             f"'{driver_of(target)}': a driver uses no other driver's code")
+        elif layer == "drivers" and driver_of(rel) and tl == "emulator" and target not in DRIVER_API:
+            failures.append(f"{rel}:{n}: the driver '{driver_of(rel)}' includes {target}: of the emulator, a "
+                            f"driver includes {' or '.join(sorted(DRIVER_API))} alone")
     lines = text.count("\n")
     if lines > MAX_LINES and rel not in HOT_PATH:
         failures.append(f"{rel}: {lines} lines (at most {MAX_LINES} outside the render hot path)")

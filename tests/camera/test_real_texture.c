@@ -53,6 +53,8 @@ static void measure(const char *path, int seed, double *got)
     float *el = malloc(n * sizeof *el), *img = malloc(n * sizeof *img);
     uint16_t *dn = malloc(n * sizeof *dn);
     CHECK(el && img && dn, "out of memory");
+    if (nc_test_failed)
+        return;
     CHECK(nc_renderer_init(&r, &s, 2) == 0 && nc_frame_alloc(&f, s.camera.width_px, s.camera.height_px) == 0 &&
               nc_render_frame(&r, &s, &f) == 0,
           "%s", nc_errmsg());

@@ -116,6 +116,9 @@ static void test_tables(void)
               nc_test_contains(nc_errmsg(), "t.yaml:1: port: missing required key (expected the port to use)"),
           "required: %s", nc_errmsg());
     nc_cfg_free(&cfg);
+    /* no map at all (a trigger's options may be NULL): none given, so the required one is missing */
+    CHECK(nc_params_values(NULL, musts, 1) < 0 && nc_test_contains(nc_errmsg(), "port: missing required key"),
+          "required, no map: %s", nc_errmsg());
     CHECK(load(&cfg, "port: p\nid: AC7\n") == 0, "load");
     CHECK(nc_params_values(cfg.root, musts, 1) < 0 &&
               nc_test_contains(nc_errmsg(), "t.yaml:2: id: 'AC7' is not AB and digits"), "form: %s", nc_errmsg());
