@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "drivers/gige/gige_image.h"
 
 uint32_t nc__gige_reg(ArvFakeCamera *fc, uint32_t a)
@@ -85,7 +86,21 @@ void nc__gige_publish_changed(ArvFakeCamera *fc, const struct nc_acquisition *a,
         nc__gige_reg_set_double(fc, REG_TRIGGER_DELAY, a->trigger_delay_s * 1e6);
 }
 
-void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a) { nc__gige_publish_changed(fc, a, NULL); }
+void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a)
+{
+    nc__gige_publish_changed(fc, a, NULL);
+    /* A setting the registers show rounded stands until a client writes
+     * another value: a write of the value shown leaves the register as it
+     * was, which is all a poll sees. */
+    const double ex_us = exposure_reg(a), gain = gain_reg(a) * 0.01;
+    if (fabs(ex_us * 1e-6 - a->exposure_s) > 1e-9 * a->exposure_s)
+        nc_log_warn("output/gige", "the exposure %.17g s shows as ExposureTime %.0f us; frames take %.17g s until a "
+                    "client writes another value (a write of %.0f us is not seen)", a->exposure_s, ex_us,
+                    a->exposure_s, ex_us);
+    if (fabs(gain - a->gain_db) > 1e-9)
+        nc_log_warn("output/gige", "the gain %.17g dB shows as Gain %.2f dB; frames take %.17g dB until a client "
+                    "writes another value (a write of %.2f dB is not seen)", a->gain_db, gain, a->gain_db, gain);
+}
 
 void nc__gige_read_settings(ArvFakeCamera *fc, const struct nc_acquisition *base, struct nc_acquisition *a)
 {

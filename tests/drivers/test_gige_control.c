@@ -278,17 +278,25 @@ static void test_errors(void)
     char *text = nc_test_read(log, &got);
     CHECK(text && strstr(text, rel) && strstr(text, "is invalid"), "xml relative to %s: '%s'", cfg, text ? text : "");
     free(text);
-    /* Port 3956 taken by a first camera. */
+    /* Port 3956 taken by a first camera, whose configured gain the Gain
+     * register cannot show: the log says a write of what it shows is not
+     * seen. */
     char dir[4096];
     snprintf(dir, sizeof dir, "%s/first", tmp);
-    const char *gige[] = {"outputs=[{driver: gige}]"};
-    pid_t first = serve(dir, gige, 1);
+    const char *gige[] = {"outputs=[{driver: gige}]", "sensor.analog_gain_db=-6"};
+    pid_t first = serve(dir, gige, 2);
     ArvCamera *c = open_camera();
     CHECK(c != NULL, "first camera");
     if (c)
         g_object_unref(c);
     expect_fail("port_taken", gige, 1, "UDP port 3956 (GigE Vision control) on 127.0.0.1 (lo) is already in use");
     CHECK(stop(first) == 0, "first serve did not exit cleanly");
+    snprintf(log, sizeof log, "%s/serve.log", dir);
+    text = nc_test_read(log, &got);
+    CHECK(text && strstr(text, "the gain -6 dB shows as Gain 0.00 dB; frames take -6 dB until a client writes another "
+                               "value (a write of 0.00 dB is not seen)"), "no warning of the gain shown: '%s'",
+          text ? text : "");
+    free(text);
 }
 
 /* Until register reg reads v (up to s seconds); 1 when it did. */
