@@ -143,6 +143,7 @@ static void close_client(struct nc__emu *e, int i)
     e->clients[i].have = 0;
     e->clients[i].skip = 0;
     e->clients[i].out_len = 0;
+    e->clients[i].gone = 0;
     pthread_mutex_unlock(&e->client_lock);
 }
 
@@ -195,39 +196,9 @@ static int client_take(struct nc__emu *e, int i)
     return 1;
 }
 
-/* Requests waiting in the clients' buffers, one per client in turn, so that
- * no client's backlog goes before another's: the turn goes on from the
- * client after the one whose request was taken last, also across calls (a
- * lock-step queue that frees one place at a time goes to each in turn). */
-static void take_requests(struct nc__emu *e)
-{
-    for (int progress = 1; progress;) {
-        progress = 0;
-        for (int k = 0, first = e->next_client; k < e->max_clients; k++) {
-            const int i = (first + k) % e->max_clients;
-            if (e->clients[i].fd >= 0 && client_take(e, i) > 0) {
-                progress = 1;
-                e->next_client = (i + 1) % e->max_clients;
-            }
-        }
-    }
-}
-
-/* A client's end of stream (or a broken connection): what it sent before
- * is taken while the job queue has room, as it would have been, the rest
- * discarded unread, and its slot freed at once. */
-static void hang_up(struct nc__emu *e, int i)
-{
-    while (client_take(e, i) > 0)
-        ;
-    if (e->clients[i].fd >= 0)
-        close_client(e, i);
-}
-
-/* Read until the socket is empty (or the buffer full: a whole request
- * waits for room in the job queue), so that an end of stream right behind
- * the last request is seen in the same poll round as the request: a client
- * that sends, closes and connects again at once finds its slot free. */
+/* Read until the socket is empty or the buffer full (a whole request waits
+ * there for room in the job queue); an end of stream or a broken
+ * connection marks the client gone. */
 static void client_read(struct nc__emu *e, int i)
 {
     struct nc__client *c = &e->clients[i];
@@ -240,9 +211,38 @@ static void client_read(struct nc__emu *e, int i)
         if (n < 0 && errno == EINTR)
             continue;
         if (n == 0 || errno != EAGAIN)
-            hang_up(e, i);
+            c->gone = 1;
         return;
     }
+}
+
+/* Requests waiting in the clients' buffers, one per client in turn, so that
+ * no client's backlog goes before another's: the turn goes on from the
+ * client after the one whose request was taken last, also across calls (a
+ * lock-step queue that frees one place at a time goes to each in turn). A
+ * client that hung up takes its turns from what its socket still holds,
+ * and is closed after them (docs/emulator.md: what the job queue has no
+ * room for then is discarded unread); so its slot is free before the new
+ * connections of the round are taken, and a client that closes and
+ * connects again at once finds it so. */
+static void take_requests(struct nc__emu *e)
+{
+    for (int progress = 1; progress;) {
+        progress = 0;
+        for (int k = 0, first = e->next_client; k < e->max_clients; k++) {
+            const int i = (first + k) % e->max_clients;
+            struct nc__client *c = &e->clients[i];
+            if (c->fd >= 0 && c->gone && c->have < sizeof c->buf)
+                client_read(e, i);
+            if (c->fd >= 0 && client_take(e, i) > 0) {
+                progress = 1;
+                e->next_client = (i + 1) % e->max_clients;
+            }
+        }
+    }
+    for (int i = 0; i < e->max_clients; i++)
+        if (e->clients[i].fd >= 0 && e->clients[i].gone)
+            close_client(e, i);
 }
 
 static void read_datagrams(struct nc__emu *e)
@@ -301,6 +301,7 @@ static void accept_client(struct nc__emu *e)
     e->clients[slot].have = 0;
     e->clients[slot].skip = 0;
     e->clients[slot].out_len = 0;
+    e->clients[slot].gone = 0;
     pthread_mutex_unlock(&e->client_lock);
 }
 
@@ -330,16 +331,16 @@ void *nc__serve_net_thread(void *arg)
             pf[n] = (struct pollfd){e->tcp_fd, POLLIN, 0}, map[n++] = -2;
         pthread_mutex_lock(&e->client_lock);
         for (int i = 0; i < e->max_clients; i++) {
-            /* a client with a full buffer and no answers waiting is not polled: poll would report its hang-up
-             * at once, again and again, until the queue takes one of its requests */
+            /* a client with a full buffer is polled for its hang-up alone (POLLRDHUP: the peer closed, with
+             * data unread or not), which closes it this round */
             const struct nc__client *c = &e->clients[i];
-            const short ev = (short)((c->have < sizeof c->buf ? POLLIN : 0) | (c->out_len ? POLLOUT : 0));
-            if (c->fd >= 0 && ev)
+            const short ev = (short)((c->have < sizeof c->buf ? POLLIN : 0) | POLLRDHUP | (c->out_len ? POLLOUT : 0));
+            if (c->fd >= 0)
                 pf[n] = (struct pollfd){c->fd, ev, 0}, map[n++] = i;
         }
         pthread_mutex_unlock(&e->client_lock);
+        int incoming = 0;
         if (poll(pf, (nfds_t)n, held ? 2 : 50) > 0) {
-            int incoming = 0;
             for (int k = 0; k < n; k++) {
                 if (!pf[k].revents)
                     continue;
@@ -353,17 +354,19 @@ void *nc__serve_net_thread(void *arg)
                         nc__serve_flush_client(e, &e->clients[map[k]]);
                         pthread_mutex_unlock(&e->client_lock);
                     }
-                    if (pf[k].revents & (POLLIN | POLLHUP | POLLERR))
+                    if (pf[k].revents & POLLIN)
                         client_read(e, map[k]);
+                    if (pf[k].revents & (POLLRDHUP | POLLHUP | POLLERR))
+                        e->clients[map[k]].gone = 1;
                 }
             }
-            /* New connections after the clients' hang-ups of the same
-             * round: a client that closes and at once connects again finds
-             * its old slot free (it was refused with max_clients taken). */
-            if (incoming)
-                accept_client(e);
         }
         take_requests(e);
+        /* New connections after the round's hang-ups are closed: a client
+         * that closes and at once connects again finds its old slot free
+         * (it was refused with max_clients taken). */
+        if (incoming)
+            accept_client(e);
     }
     free(pf);
     free(map);
