@@ -60,7 +60,7 @@ struct nc_boulder_params {
     double c_per_km2;  /* C of N(>D) = C D^-b per km^2, D in metres: N(>1 m) */
     double slope;      /* b > 0 */
     double d_min_m, d_max_m;
-    double burial_min, burial_max; /* buried fraction of each rock's height, drawn uniformly */
+    double burial_min, burial_max; /* beta, drawn uniformly: the centre at (1 - 2 beta) x its depth below it */
     int shapes;        /* distinct rock shapes, 1..NC_ROCK_SHAPES_MAX */
     double roughness_deg; /* the faces' relief: RMS slope, 0..45 deg (0: flat faces) */
     uint64_t seed;
