@@ -94,11 +94,11 @@ void nc__gige_publish(ArvFakeCamera *fc, const struct nc_acquisition *a)
      * was, which is all a poll sees. */
     const double ex_us = exposure_reg(a), gain = gain_reg(a) * 0.01;
     if (fabs(ex_us * 1e-6 - a->exposure_s) > 1e-9 * a->exposure_s)
-        nc_log_warn("output/gige", "the exposure %.17g s shows as ExposureTime %.0f us; frames take %.17g s until a "
+        nc_log_warn("output/gige", "the exposure %.15g s shows as ExposureTime %.0f us; frames take %.15g s until a "
                     "client writes another value (a write of %.0f us is not seen)", a->exposure_s, ex_us,
                     a->exposure_s, ex_us);
     if (fabs(gain - a->gain_db) > 1e-9)
-        nc_log_warn("output/gige", "the gain %.17g dB shows as Gain %.2f dB; frames take %.17g dB until a client "
+        nc_log_warn("output/gige", "the gain %.15g dB shows as Gain %.2f dB; frames take %.15g dB until a client "
                     "writes another value (a write of %.2f dB is not seen)", a->gain_db, gain, a->gain_db, gain);
 }
 
