@@ -31,6 +31,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "core/clock.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "emulator/output.h"
@@ -214,12 +215,10 @@ static int setup(struct v4l2_out *v)
                           "still streaming, or keep_format=1, holds the last producer's format)",
                           fourcc_text(f.fmt.pix.pixelformat, a), fourcc_text(v->fourcc, b));
     }
-    if ((int)f.fmt.pix.width != v->width)
-        return fail_setup(v, NC_EUNSUPPORTED, "the driver set width %u, the camera has %d (v4l2loopback: max_width)",
-                          f.fmt.pix.width, v->width);
-    if ((int)f.fmt.pix.height != v->height)
-        return fail_setup(v, NC_EUNSUPPORTED, "the driver set height %u, the camera has %d (v4l2loopback: max_height)",
-                          f.fmt.pix.height, v->height);
+    if ((int)f.fmt.pix.width != v->width || (int)f.fmt.pix.height != v->height)
+        return fail_setup(v, NC_EUNSUPPORTED, "the driver set %ux%u, the camera has %dx%d (v4l2loopback: max_width or "
+                          "max_height, or a reader still streaming, or keep_format=1, holds the last producer's format)",
+                          f.fmt.pix.width, f.fmt.pix.height, v->width, v->height);
     if (f.fmt.pix.field != V4L2_FIELD_NONE)
         return fail_setup(v, NC_EUNSUPPORTED, "the driver set field order %u, NavCam writes progressive frames "
                           "(V4L2_FIELD_NONE)", f.fmt.pix.field);
@@ -232,8 +231,7 @@ static int setup(struct v4l2_out *v)
     /* The frame interval is what readers see as the frame rate; drivers
      * that do not keep one (ENOTTY) are fine. */
     struct v4l2_streamparm p = {.type = V4L2_BUF_TYPE_VIDEO_OUTPUT};
-    p.parm.output.timeperframe.numerator = 1000;
-    p.parm.output.timeperframe.denominator = (uint32_t)lround(v->fps * 1000);
+    nc_period_fraction(v->fps, &p.parm.output.timeperframe.numerator, &p.parm.output.timeperframe.denominator);
     if (xioctl(v->fd, VIDIOC_S_PARM, &p) < 0 && errno != ENOTTY && errno != EINVAL)
         return fail_setup(v, -errno, "VIDIOC_S_PARM: %s", strerror(errno));
     v->interval = xioctl(v->fd, VIDIOC_G_PARM, &p) == 0 ? p.parm.output.timeperframe : (struct v4l2_fract){0, 0};

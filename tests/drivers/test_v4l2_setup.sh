@@ -5,7 +5,8 @@
 # stale errno or run on with the device closed. Then, with the shim's
 # NAVCAM_SHIM_UNPLUG, a device that is unplugged for 2.5 s: the failure and
 # the failed reopenings say why, the reopening counts that outage's frames;
-# and with reopen_limit the output says once that it gave up.
+# and with reopen_limit the output says once that it gave up; the frame
+# interval asked for, and a format held at another width.
 # Usage: test_v4l2_setup.sh NAVCAM SHIM
 set -u
 navcam=$1 shim=$2
@@ -42,6 +43,11 @@ expect "failed reopening" "$out" "reopening failed (attempt *): v4l2 output: /de
 n=$(printf '%s\n' "$out" | sed -n "s/.*(card 'Unplugged') reopened after \([0-9]*\) lost frames.*/\1/p")
 if [ -n "$n" ] && [ "$n" -ge 18 ] && [ "$n" -le 30 ]; then pass=$((pass + 1)); else
   fail=$((fail + 1)); echo "FAIL: reopened after '$n' lost frames, want the outage's 25 to 30: $out"; fi
+# the frame interval asked for, to 5e-7 of the rate (1000/2 s for 0.0015 Hz until session 67)
+expect interval "$(unplugged ", frame_rate_hz: 0.0015")" "frame interval 10000/15 s (0.0015 Hz)"
+# a format held at another width: the message names both causes (only max_width until session 67)
+expect "held width" "$(NAVCAM_SHIM_WIDTH=32 unplugged "")" "the driver set 32x48, the camera has 64x48 (v4l2loopback: \
+max_width or max_height, or a reader still streaming, or keep_format=1, holds the last producer's format)"
 out=$(unplugged ", reopen_limit: 2")
 expect "reopen_limit" "$out" "2 attempts to reopen it failed (reopen_limit): given up, its frames are lost from now on"
 expect "reopen_limit" "$out" "not looked for any more (reopen_limit)"

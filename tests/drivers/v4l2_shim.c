@@ -8,7 +8,9 @@
  * device taking frames by write(): the 3rd frame finds no free buffer
  * (EAGAIN), the 6th finds the device unplugged (ENODEV), and for 2.5 s
  * after that /dev/null cannot be opened (ENOENT), as a device that is
- * away; then it is back.
+ * away; then it is back. It keeps the frame interval set (VIDIOC_S_PARM,
+ * read back by G_PARM), and with NAVCAM_SHIM_WIDTH=N it keeps a width of N
+ * whatever is asked, as v4l2loopback holding a reader's format does.
  * Everything else goes to the real calls. */
 #define _GNU_SOURCE 1
 #include <dlfcn.h>
@@ -26,6 +28,7 @@
 #include <sys/sysmacros.h>
 
 static struct v4l2_format kept;
+static struct v4l2_streamparm parm;
 
 static int is_dev_null(int fd)
 {
@@ -98,9 +101,14 @@ int ioctl(int fd, unsigned long request, ...)
             return 0;
         }
         case VIDIOC_STREAMON: return 0;
-        case VIDIOC_S_FMT: kept = *(struct v4l2_format *)arg; return 0;
+        case VIDIOC_S_FMT:
+            kept = *(struct v4l2_format *)arg;
+            if (getenv("NAVCAM_SHIM_WIDTH"))
+                kept.fmt.pix.width = (uint32_t)atoi(getenv("NAVCAM_SHIM_WIDTH"));
+            return 0;
         case VIDIOC_G_FMT: *(struct v4l2_format *)arg = kept; return 0;
-        case VIDIOC_S_PARM: return 0;
+        case VIDIOC_S_PARM: parm = *(struct v4l2_streamparm *)arg; return 0;
+        case VIDIOC_G_PARM: *(struct v4l2_streamparm *)arg = parm; return 0;
         case VIDIOC_REQBUFS: ((struct v4l2_requestbuffers *)arg)->count = 0; return 0;
         default: errno = ENOTTY; return -1;
         }
