@@ -217,7 +217,8 @@ static int setup(struct v4l2_out *v)
     }
     if ((int)f.fmt.pix.width != v->width || (int)f.fmt.pix.height != v->height)
         return fail_setup(v, NC_EUNSUPPORTED, "the driver set %ux%u, the camera has %dx%d (v4l2loopback: max_width or "
-                          "max_height, or a reader still streaming, or keep_format=1, holds the last producer's format)",
+                          "max_height, or a reader still streaming, or keep_format=1, holds the last producer's "
+                          "format)",
                           f.fmt.pix.width, f.fmt.pix.height, v->width, v->height);
     if (f.fmt.pix.field != V4L2_FIELD_NONE)
         return fail_setup(v, NC_EUNSUPPORTED, "the driver set field order %u, NavCam writes progressive frames "
