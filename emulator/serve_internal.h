@@ -106,7 +106,8 @@ struct nc__client {
     uint32_t skip; /* bytes of a refused message still to come, to be passed over */
     uint8_t out[NC_SERVE_CLIENT_OUT_BYTES]; /* answers not yet sent (the client reads slowly) */
     size_t out_len;
-    int gone; /* it hung up: its requests take their turns this round, then it is closed */
+    int gone;  /* it hung up: its requests take their turns, then it is closed */
+    int moved; /* its last turn took a request, or read or passed over bytes (take_requests) */
 };
 
 struct nc__emu {

@@ -220,18 +220,21 @@ static void client_read(struct nc__emu *e, int i)
  * no client's backlog goes before another's: the turn goes on from the
  * client after the one whose request was taken last, also across calls (a
  * lock-step queue that frees one place at a time goes to each in turn).
- * Each turn first refills the client's buffer from its socket, every
- * client's alike, so that a client that hung up takes its turns from what
- * its socket still holds, as the others do; it is closed after them
- * (docs/emulator.md: what the job queue has no room for then is discarded
- * unread), so that its slot is free before the new connections of the
- * round are taken, and a client that closes and connects again at once
- * finds it so. At most 256 turns a client a call (a client that sends
- * without end does not keep the thread from the rest). */
+ * A client being served reads its socket at its next turn (the poll found
+ * the others' news), a hung-up one from its first: it takes its turns from
+ * what its socket still holds, as the others do, and is closed once a turn
+ * of it moves nothing (docs/emulator.md: what the job queue has no room
+ * for then is discarded unread), before the round's new connections are
+ * taken, so that a client that closes and connects again at once finds its
+ * slot free. At most 256 turns a client a call: a client that sends
+ * without end does not keep the thread from the rest (what is left waits
+ * for the next round). */
 static void take_requests(struct nc__emu *e)
 {
-    for (int pass = 0, moved = 1; moved && pass < 256; pass++) {
-        moved = 0;
+    for (int i = 0; i < e->max_clients; i++)
+        e->clients[i].moved = e->clients[i].gone;
+    for (int pass = 0, any = 1; any && pass < 256; pass++) {
+        any = 0;
         for (int k = 0, first = e->next_client; k < e->max_clients; k++) {
             const int i = (first + k) % e->max_clients;
             struct nc__client *c = &e->clients[i];
@@ -239,17 +242,17 @@ static void take_requests(struct nc__emu *e)
                 continue;
             const size_t had = c->have;
             const uint32_t skip = c->skip;
-            if (c->have < sizeof c->buf)
+            if (c->moved && c->have < sizeof c->buf)
                 client_read(e, i);
             const int taken = client_take(e, i);
             if (taken > 0)
                 e->next_client = (i + 1) % e->max_clients;
-            /* a request taken, or bytes read or passed over (a refused message's) */
-            moved |= taken > 0 || (c->fd >= 0 && (c->have != had || c->skip != skip));
+            c->moved = taken > 0 || (c->fd >= 0 && (c->have != had || c->skip != skip));
+            any |= c->moved;
         }
     }
     for (int i = 0; i < e->max_clients; i++)
-        if (e->clients[i].fd >= 0 && e->clients[i].gone)
+        if (e->clients[i].fd >= 0 && e->clients[i].gone && !e->clients[i].moved)
             close_client(e, i);
 }
 
