@@ -227,13 +227,15 @@ static void client_read(struct nc__emu *e, int i)
  * for then is discarded unread), before the round's new connections are
  * taken, so that a client that closes and connects again at once finds its
  * slot free. At most 256 turns a client a call: a client that sends
- * without end does not keep the thread from the rest (what is left waits
- * for the next round). */
-static void take_requests(struct nc__emu *e)
+ * without end does not keep the thread from the rest; returns 1 when turns
+ * were left (the next round then does not wait in poll, and a new
+ * connection waits while a hung-up client still holds a slot). */
+static int take_requests(struct nc__emu *e)
 {
     for (int i = 0; i < e->max_clients; i++)
         e->clients[i].moved = e->clients[i].gone;
-    for (int pass = 0, any = 1; any && pass < 256; pass++) {
+    int any = 1;
+    for (int pass = 0; any && pass < 256; pass++) {
         any = 0;
         for (int k = 0, first = e->next_client; k < e->max_clients; k++) {
             const int i = (first + k) % e->max_clients;
@@ -254,6 +256,7 @@ static void take_requests(struct nc__emu *e)
     for (int i = 0; i < e->max_clients; i++)
         if (e->clients[i].fd >= 0 && e->clients[i].gone && !e->clients[i].moved)
             close_client(e, i);
+    return any;
 }
 
 static void read_datagrams(struct nc__emu *e)
@@ -292,15 +295,19 @@ static void refuse(struct nc__emu *e, int fd)
     }
 }
 
-static void accept_client(struct nc__emu *e)
+static void accept_client(struct nc__emu *e, int more)
 {
+    int slot = -1, gone = 0;
+    for (int i = 0; i < e->max_clients; i++) {
+        if (e->clients[i].fd < 0 && slot < 0)
+            slot = i;
+        gone |= e->clients[i].fd >= 0 && e->clients[i].gone;
+    }
+    if (slot < 0 && gone && more)
+        return; /* a hung-up client's last turns free its slot in a round or two: the connection waits */
     int fd = accept4(e->tcp_fd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0)
         return;
-    int slot = -1;
-    for (int i = 0; i < e->max_clients && slot < 0; i++)
-        if (e->clients[i].fd < 0)
-            slot = i;
     if (slot < 0) {
         refuse(e, fd);
         return;
@@ -329,6 +336,7 @@ void *nc__serve_net_thread(void *arg)
         atomic_store(&e->stop, 1);
         return NULL;
     }
+    int more = 0; /* turns were left in the last round (take_requests) */
     while (atomic_load(&e->stop) == 0) {
         /* Lock-step with a full job queue: requests wait in the clients'
          * buffers, and when those are full in the sockets (the simulator's
@@ -351,7 +359,7 @@ void *nc__serve_net_thread(void *arg)
         }
         pthread_mutex_unlock(&e->client_lock);
         int incoming = 0;
-        if (poll(pf, (nfds_t)n, held ? 2 : 50) > 0) {
+        if (poll(pf, (nfds_t)n, more ? 0 : held ? 2 : 50) > 0) {
             for (int k = 0; k < n; k++) {
                 if (!pf[k].revents)
                     continue;
@@ -372,12 +380,12 @@ void *nc__serve_net_thread(void *arg)
                 }
             }
         }
-        take_requests(e);
+        more = take_requests(e);
         /* New connections after the round's hang-ups are closed: a client
          * that closes and at once connects again finds its old slot free
          * (it was refused with max_clients taken). */
         if (incoming)
-            accept_client(e);
+            accept_client(e, more);
     }
     free(pf);
     free(map);
