@@ -216,13 +216,17 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
         return NC_REJECT_BAD_QUATERNION;
     if (type == NC_MSG_POSE && nc_v3_is_zero(m->sun))
         return NC_REJECT_BAD_VALUE;
-    if (m->sim_time_ns < -NC_PROTO_TIME_MAX_NS || m->sim_time_ns > NC_PROTO_TIME_MAX_NS)
+    /* (a FRAME echoes its request's time, which may be the value that had it refused) */
+    if (type != NC_MSG_FRAME && (m->sim_time_ns < -NC_PROTO_TIME_MAX_NS || m->sim_time_ns > NC_PROTO_TIME_MAX_NS))
         return NC_REJECT_BAD_VALUE;
     if (!(nc_v3_norm(m->cam_position_m) <= NC_PROTO_POSITION_MAX_M) ||
         !(nc_v3_norm(m->body_position_m) <= NC_PROTO_POSITION_MAX_M) ||
         !(nc_v3_norm(m->cam_velocity_m_s) <= NC_PROTO_SPEED_MAX_M_S) ||
         !(nc_v3_norm(m->body_velocity_m_s) <= NC_PROTO_SPEED_MAX_M_S))
         return NC_REJECT_BAD_VALUE;
+    if ((flags & NC_MSG_SUN_POSITION) &&
+        !(nc_v3_norm(m->sun) > NC_PROTO_SUN_RADIUS_M && nc_v3_norm(m->sun) <= NC_PROTO_POSITION_MAX_M))
+        return NC_REJECT_BAD_VALUE; /* (a frame took a non-unit direction and no light from 1e300 m, NaN from 1e-300) */
     if ((flags & NC_MSG_EXPOSURE) && !(m->exposure_s >= 0 && m->exposure_s <= NC_PROTO_EXPOSURE_MAX_S))
         return NC_REJECT_BAD_VALUE;
     if ((flags & NC_MSG_GAIN) && !(m->gain_db >= -NC_PROTO_GAIN_MAX_DB && m->gain_db <= NC_PROTO_GAIN_MAX_DB))

@@ -31,6 +31,8 @@ extern "C" { /* C linkage, for simulators written in C++ */
  * plus an exposure, and the difference of two times, fit in 64 bits. */
 #define NC_PROTO_TIME_MAX_NS 4600000000000000000LL
 #define NC_PROTO_POSITION_MAX_M 1e15 /* camera and body positions: |p| up to this (6700 au) */
+#define NC_PROTO_SUN_RADIUS_M 6.957e8 /* a Sun position (SUN_POSITION): farther than this, and no farther than
+                                       * NC_PROTO_POSITION_MAX_M, from bodies[0]'s origin */
 #define NC_PROTO_SPEED_MAX_M_S 299792458.0 /* camera and body velocities: |v| up to the speed of light */
 
 /* POSE and TRIGGER: simulator -> NavCam. FRAME: NavCam -> simulator over

@@ -15,7 +15,8 @@ static struct nc_pose_msg sample(uint32_t flags)
     struct nc_pose_msg m = {.type = NC_MSG_POSE, .sequence = 77, .flags = flags, .sim_time_ns = 123456789012LL};
     m.cam_position_m = nc_v3(1000.5, -2000.25, 3e7);
     m.cam_attitude_q = (struct nc_quat){0.5, 0.5, -0.5, 0.5};
-    m.sun = nc_v3(0.6, 0.0, -0.8);
+    /* 1.5e11 m, or a direction */
+    m.sun = flags & NC_MSG_SUN_POSITION ? nc_v3(0.9e11, 0.0, -1.2e11) : nc_v3(0.6, 0.0, -0.8);
     m.body_position_m = nc_v3(1, 2, 3);
     m.body_attitude_q = (struct nc_quat){1, 0, 0, 0};
     m.cam_velocity_m_s = nc_v3(0.1, 0.2, 0.3);
@@ -128,8 +129,29 @@ int main(void)
     EXPECT(BAD_VALUE, n, nc_le_put_u64(t + 24, (uint64_t)(-NC_PROTO_TIME_MAX_NS - 1)), reseal(t, n));
     EXPECT(NONE, n, nc_le_put_u64(t + 24, (uint64_t)-NC_PROTO_TIME_MAX_NS), reseal(t, n));
     EXPECT(NONE, n, nc_le_put_u64(t + 24, (uint64_t)NC_PROTO_TIME_MAX_NS), reseal(t, n));
+    { /* but a FRAME echoes its request's time: the answer to a capture refused for it is one (the client library
+       * dropped it, and the capture was never answered) */
+        struct nc_pose_msg f = {.type = NC_MSG_FRAME, .sequence = 7, .sim_time_ns = NC_PROTO_TIME_MAX_NS + 1,
+                                .frame = UINT64_MAX, .status = NC_FRAME_DROPPED},
+                           g;
+        uint8_t fb[NC_PROTO_MAX_BYTES];
+        const size_t fn = nc_msg_encode(&f, fb, sizeof fb);
+        CHECK(fn > 0 && nc_msg_decode(fb, fn, &g) == NC_REJECT_NONE && g.sequence == 7 &&
+                  g.sim_time_ns == f.sim_time_ns && g.status == NC_FRAME_DROPPED,
+              "a FRAME with its request's time out of range: %s", nc_reject_name(nc_msg_decode(fb, fn, &g)));
+    }
     EXPECT(BAD_VALUE, n, put_f64(t + 32, 2e15), reseal(t, n));   /* the camera 2e15 m out */
     EXPECT(BAD_VALUE, n, put_f64(t + 120, 1e300), reseal(t, n)); /* the body 1e300 m out */
+    { /* a Sun position: beyond the Sun's radius of bodies[0]'s origin, within 1e15 m */
+        const double r[] = {1e-300, 4e8, 1.5e11, 1e16, 1e300};
+        for (int k = 0; k < 5; k++) {
+            struct nc_pose_msg v = sample(NC_MSG_SUN_POSITION);
+            v.sun = nc_v3(r[k], -r[k], 0);
+            size_t vn = nc_msg_encode(&v, t, sizeof t);
+            CHECK(vn && nc_msg_decode(t, vn, &out) == (k == 2 ? NC_REJECT_NONE : NC_REJECT_BAD_VALUE),
+                  "a Sun position of [%g, %g, 0] m %s", r[k], -r[k], k == 2 ? "refused" : "accepted");
+        }
+    }
     for (int who = 0; who < 2; who++) {
         struct nc_pose_msg v = sample(NC_MSG_CAMERA_RATES | NC_MSG_BODY_RATES);
         *(who ? &v.body_velocity_m_s : &v.cam_velocity_m_s) = nc_v3(0, 3e8, 0);
