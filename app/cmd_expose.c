@@ -15,6 +15,7 @@
 #include "app/cli.h"
 #include "camera/camsys.h"
 #include "camera/load.h"
+#include "camera/shot.h"
 #include "core/error.h"
 #include "core/version.h"
 #include "render/image_io.h"
@@ -148,13 +149,7 @@ int main(int argc, char **argv)
     int ok = rad && e && dn;
     for (size_t i = 0; ok && i < nr; i++)
         rad[i] = (float)L;
-    ok = ok && nc_camsys_electrons(&cs, rad, T, e) >= 0;
-    /* A mirrored camera (a SUM file's K11 or K22 < 0) stores its image as
-     * `navcam render` does: the optics act on the view, then the electrons
-     * are mirrored, so that the flat's vignetting is the render's and the
-     * sensor's patterns belong to stored pixels. */
-    if (ok && (geom.flip_rows || geom.flip_cols))
-        nc_image_flip(e, sizeof *e, geom.width_px, geom.height_px, geom.flip_rows, geom.flip_cols);
+    ok = ok && nc_shot_electrons(&cs, &geom, rad, T, e) >= 0; /* stored as `navcam render` stores its frames */
     int is_fits = nc_image_is_fits(out);
     struct nc_image_attr attrs[32];
     char text[16][200], ltxt[64], ntxt[32], sw[64], intr[160];
@@ -169,8 +164,6 @@ int main(int argc, char **argv)
                                            {"navcam:intrinsics_fx_fy_cx_cy_px", intr}};
     const int ncommon = (int)(sizeof common / sizeof common[0]);
     char flip[32]; /* as `navcam render` records a mirrored camera (FITS IMAGE_MIRRORED) */
-    snprintf(flip, sizeof flip, "rows=%d columns=%d", geom.flip_rows, geom.flip_cols);
-    const int mirrored = geom.flip_rows || geom.flip_cols;
     for (size_t k = 0; ok && k < nf; k++) {
         uint64_t fno = first + (uint64_t)k;
         ok = nc_camsys_digitise(&cs, e, T, fno, dn + k * n) >= 0;
@@ -182,8 +175,7 @@ int main(int argc, char **argv)
             for (int i = 0; i < ncommon; i++)
                 attrs[na++] = common[i];
             attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
-            if (mirrored)
-                attrs[na++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
+            na += nc_shot_mirrored_attr(&geom, flip, attrs + na);
             ok = nc_image_write_dn(path, dn + k * n, geom.width_px, geom.height_px, cs.sensor.adc_bits, attrs, na) >= 0;
             if (ok)
                 printf("wrote %s\n", path);
@@ -195,8 +187,7 @@ int main(int argc, char **argv)
             attrs[na++] = common[i];
         attrs[na++] = (struct nc_image_attr){"navcam:radiance_w_m2_sr", ltxt};
         attrs[na++] = (struct nc_image_attr){"navcam:frames", ntxt};
-        if (mirrored)
-            attrs[na++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
+        na += nc_shot_mirrored_attr(&geom, flip, attrs + na);
         if (rows)
             attrs[na++] = (struct nc_image_attr){"navcam:fits_row_order", rows};
         ok = nc_image_write_dn_cube(out, dn, geom.width_px, geom.height_px, (int)nf, cs.sensor.adc_bits, attrs, na) >= 0;

@@ -135,6 +135,24 @@ int nc_shot_wcs_attrs(const struct nc_camera *c, char (*val)[32], struct nc_imag
     return n;
 }
 
+int nc_shot_electrons(const struct nc_camsys *cs, const struct nc_camera *c, const float *radiance,
+                      double exposure_s, float *electrons)
+{
+    const int rc = nc_camsys_electrons(cs, radiance, exposure_s, electrons);
+    if (rc >= 0 && (c->flip_rows || c->flip_cols))
+        nc_image_flip(electrons, sizeof *electrons, cs->width_px, cs->height_px, c->flip_rows, c->flip_cols);
+    return rc;
+}
+
+int nc_shot_mirrored_attr(const struct nc_camera *c, char val[32], struct nc_image_attr *out)
+{
+    if (!c->flip_rows && !c->flip_cols)
+        return 0;
+    snprintf(val, 32, "rows=%d columns=%d", c->flip_rows, c->flip_cols);
+    *out = (struct nc_image_attr){"navcam:image_mirrored", val};
+    return 1;
+}
+
 /* Electrons (float) or a digitised frame of a rendered radiance image (the
  * camera model's render size: the sensor plus the PSF's margin), in the
  * rendered orientation: the optics (vignetting, PSF) act there, and the
@@ -151,9 +169,7 @@ static int write_sensor_frame(const char *out, const struct nc_frame *f, enum nc
     uint16_t *dn = malloc(n * sizeof *dn);
     struct nc_image_attr attrs[64];
     char text[32][200];
-    int rc = e && dn ? nc_camsys_electrons(cs, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
-    if (rc >= 0 && (s->camera.flip_rows || s->camera.flip_cols))
-        nc_image_flip(e, sizeof *e, W, H, s->camera.flip_rows, s->camera.flip_cols);
+    int rc = e && dn ? nc_shot_electrons(cs, &s->camera, f->radiance, exposure, e) : nc_error(-ENOMEM, "out of memory");
     int na = nc_frame_meta(s, q, attrs, text, 32);
     na += nc_camsys_meta(cs, exposure, frame_no, attrs + na, text + na, 31 - na);
     for (int i = 0; i < nextra && na < 64; i++)
@@ -235,8 +251,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
     info->stars_ms = t2 - ts0;
     if (q <= NC_Q_ROCK_ID) /* the sensor's quantities are mirrored after the optics (write_sensor_frame) */
         nc_frame_flip(&f, scene->camera.flip_rows, scene->camera.flip_cols);
-    char flip[40];
-    snprintf(flip, sizeof flip, "rows=%d columns=%d", scene->camera.flip_rows, scene->camera.flip_cols);
+    char flip[32];
     struct nc_image_attr extra[48];
     struct nc_shot_detail detail;
     struct nc_shot_detail_text detail_text;
@@ -246,8 +261,7 @@ int nc_shot(struct nc_renderer *r, struct nc_scene *scene, const struct nc_camsy
         extra[nextra++] = (struct nc_image_attr){"navcam:sun_view", suninfo};
     if (starinfo[0])
         extra[nextra++] = (struct nc_image_attr){"navcam:stars", starinfo};
-    if (scene->camera.flip_rows || scene->camera.flip_cols)
-        extra[nextra++] = (struct nc_image_attr){"navcam:image_mirrored", flip};
+    nextra += nc_shot_mirrored_attr(&scene->camera, flip, extra + nextra);
     if (scene->camera.from_sumfile)
         extra[nextra++] = (struct nc_image_attr){"navcam:sumfile_utc", scene->camera.sumfile_utc};
     char wcsval[8][32];

@@ -36,6 +36,16 @@ int nc_shot_setup(const char *path, const char *const *sets, int nsets, struct n
  * (nc_camera.flip_rows, flip_cols). */
 void nc_frame_flip(struct nc_frame *f, int rows, int cols);
 
+/* Electrons of a radiance image (the camera model's render size) as camera
+ * c stores its image: the optics act on the rendered view, then a mirrored
+ * camera's (a SUM file's K11 or K22 < 0) electrons are mirrored, so that
+ * the sensor's patterns and noise belong to stored pixels. */
+int nc_shot_electrons(const struct nc_camsys *cs, const struct nc_camera *c, const float *radiance,
+                      double exposure_s, float *electrons);
+/* A mirrored camera's attribute navcam:image_mirrored ("rows=R columns=C",
+ * its text in val) into *out: 1, or 0 (nothing) for a camera that is not. */
+int nc_shot_mirrored_attr(const struct nc_camera *c, char val[32], struct nc_image_attr *out);
+
 /* Render scene (its quality settings may be changed by render.quality auto:
  * they are recorded in the file) to path as quantity q; sky may be off (on,
  * its stars move by their proper motion to t_sim_s after simulation time

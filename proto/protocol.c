@@ -224,9 +224,9 @@ enum nc_reject nc_msg_decode(const uint8_t *buf, size_t len, struct nc_pose_msg 
         !(nc_v3_norm(m->cam_velocity_m_s) <= NC_PROTO_SPEED_MAX_M_S) ||
         !(nc_v3_norm(m->body_velocity_m_s) <= NC_PROTO_SPEED_MAX_M_S))
         return NC_REJECT_BAD_VALUE;
-    if ((flags & NC_MSG_SUN_POSITION) &&
-        !(nc_v3_norm(m->sun) > NC_PROTO_SUN_RADIUS_M && nc_v3_norm(m->sun) <= NC_PROTO_POSITION_MAX_M))
-        return NC_REJECT_BAD_VALUE; /* (a frame took a non-unit direction and no light from 1e300 m, NaN from 1e-300) */
+    const double sun_m = nc_v3_norm(m->sun); /* (a frame took no light from 1e300 m, NaN from 1e-300) */
+    if ((flags & NC_MSG_SUN_POSITION) && !(sun_m > NC_PROTO_SUN_RADIUS_M && sun_m <= NC_PROTO_POSITION_MAX_M))
+        return NC_REJECT_BAD_VALUE;
     if ((flags & NC_MSG_EXPOSURE) && !(m->exposure_s >= 0 && m->exposure_s <= NC_PROTO_EXPOSURE_MAX_S))
         return NC_REJECT_BAD_VALUE;
     if ((flags & NC_MSG_GAIN) && !(m->gain_db >= -NC_PROTO_GAIN_MAX_DB && m->gain_db <= NC_PROTO_GAIN_MAX_DB))
